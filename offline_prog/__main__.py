@@ -1,0 +1,7 @@
+"""``python -m offline_prog`` is the ``offline-prog`` command."""
+
+import sys
+
+from offline_prog.cli import main
+
+sys.exit(main())

@@ -1,0 +1,86 @@
+"""Command line: ``offline-prog plan CELL.yaml --out DIR``.
+
+Thin by design: parse flags, call the library, print a short summary. Bad input
+ends with one line on stderr and exit code 2; an internal error with one line
+and exit code 3 (``--debug`` shows the traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from rich.console import Console
+
+EXIT_BAD_INPUT = 2
+EXIT_INTERNAL = 3
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="offline-prog",
+        description="Plan robot motions that carry a part past a spatially fixed tool.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    commands = parser.add_subparsers(dest="command", required=True)
+    plan = commands.add_parser("plan", help="plan a cell and write the outputs")
+    plan.add_argument("cell", type=Path, help="work-cell YAML file")
+    plan.add_argument("--out", type=Path, default=None,
+                      help="output folder (default: out/<cell name>)")
+    return parser
+
+
+def _summary(console: Console, report: dict, files: dict, seconds: float) -> None:
+    fit, motion, traj = report["fit"], report["motion"], report["trajectory"]
+    console.print(f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
+                  f"tool {report['tool']}, part {report['part']}")
+    console.print(f"  path      {report['path']['length_m'] * 1e3:.1f} mm "
+                  f"({report['path']['source']}, {'closed' if report['path']['closed'] else 'open'})"
+                  f", fit degree {fit['degree']} with {fit['n_control_points']} control points, "
+                  f"max error {fit['max_error_mm']:.4f} mm, RMS {fit['rms_error_mm']:.4f} mm")
+    reduced = " (reduced: short path)" if motion["top_speed_reduced"] else ""
+    console.print(f"  motion    {motion['top_speed_m_s'] * 1e3:.1f} mm/s at the "
+                  f"{motion['speed_reference']}{reduced}, cycle {traj['duration_s']:.3f} s, "
+                  f"{traj['n_samples']} samples, speed error "
+                  f"{traj['chord_speed_max_error_rel'] * 100:.4f} %")
+    cusps = report["cusps"]
+    console.print(f"  cusps     {len(cusps)}" + (
+        "  " + ", ".join(f"{c['kind']} at σ={c['sigma_m']:.3f} m" for c in cusps[:5])
+        if cusps else ""))
+    for name, path in files.items():
+        console.print(f"  {name:<9} {path}")
+    console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
+    started = time.perf_counter()
+    try:
+        from offline_prog.cell import CellError
+        from offline_prog.outputs import report, write_outputs
+        from offline_prog.plan import plan_cell
+
+        try:
+            with errors.status("planning") as status:
+                plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
+                out = args.out or Path("out") / args.cell.stem
+                status.update("writing outputs")
+                files = write_outputs(plan, out)
+        except CellError as error:
+            errors.print(f"error: {error}", markup=False, highlight=False)
+            return EXIT_BAD_INPUT
+        _summary(console, report(plan), files, time.perf_counter() - started)
+        return 0
+    except Exception as error:  # one line, never a traceback unless asked
+        if args.debug:
+            raise
+        errors.print(f"internal error: {type(error).__name__}: {error} (rerun with --debug)",
+                     markup=False, highlight=False)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

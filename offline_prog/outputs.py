@@ -1,0 +1,135 @@
+"""Plan outputs: trajectory.csv and report.json, written atomically.
+
+Every file is written to a temporary name in the target folder and renamed into
+place, so a crash never leaves a half-written file that looks complete.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime
+import io
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog import __version__
+from offline_prog.plan import Plan
+from offline_prog.trajectory import CSV_COLUMNS
+
+
+def write_atomic(target: Path, text: str) -> None:
+    """Write ``text`` to ``target`` via a temporary file and an atomic rename."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    handle, temp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "w", newline="") as stream:
+            stream.write(text)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temp)
+        raise
+
+
+def trajectory_csv(plan: Plan) -> str:
+    """CSV text: header CSV_COLUMNS, one row per sample, SI units (s, m, rad)."""
+    buffer = io.StringIO()
+    np.savetxt(buffer, plan.trajectory.table(), delimiter=",", fmt="%.10g",
+               header=",".join(CSV_COLUMNS), comments="")
+    return buffer.getvalue()
+
+
+def speed_checks(plan: Plan) -> dict[str, float]:
+    """Independent checks of the speed that the time law promised.
+
+    ``tcp_speed_max_error_rel``: max |v_Q − σ̇| / v_peak, with v_Q the rigid-body
+    speed of the part point under the TCP (tcp reference; for the flange
+    reference the flange speed |v_IE| is compared instead).
+    ``chord_speed_max_error_rel``: during cruise, max |chord/Δt − v_peak| / v_peak
+    from consecutive sampled positions alone (no derivatives): this checks that
+    σ is the true arc length.
+    """
+    tr = plan.trajectory
+    v_peak = tr.law.v_peak
+    if tr.reference == "tcp":
+        commanded, measured, points = tr.s_dot, tr.tcp_speed, tr.flange.p_PF
+    else:
+        _, commanded, _, _ = tr.law(tr.t)
+        measured, points = np.linalg.norm(tr.v_IE, axis=1), tr.flange.p_IE
+    chord = np.linalg.norm(np.diff(points, axis=0), axis=1) / np.diff(tr.t)
+    _, v_law, _, _ = tr.law(tr.t)
+    cruise = (v_law[:-1] >= v_peak * (1 - 1e-12)) & (v_law[1:] >= v_peak * (1 - 1e-12))
+    chord_error = np.abs(chord[cruise] - v_peak).max() / v_peak if cruise.any() else 0.0
+    return {
+        "tcp_speed_max_error_rel": float(np.abs(measured - commanded).max() / v_peak),
+        "chord_speed_max_error_rel": float(chord_error),
+        "cruise_samples": int(cruise.sum()),
+    }
+
+
+def report(plan: Plan) -> dict:
+    """The machine-readable plan summary (SI units unless the key says otherwise)."""
+    cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
+    law = tr.law
+    source = next(k for k in ("points", "dxf", "analytic") if getattr(cell.path, k) is not None)
+    smoothing = None
+    if hasattr(plan.flange, "max_deviation_m"):
+        smoothing = {"max_deviation_mm": plan.flange.max_deviation_m * 1e3,
+                     "n_control_points": plan.flange.n_control_points}
+    return {
+        "generator": f"offline_prog {__version__}",
+        "generated": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "cell": str(plan.cell_file),
+        "name": cell.name,
+        "robot": cell.robot.model,
+        "tool": cell.tool.name,
+        "part": cell.part.name,
+        "path": {
+            "source": source,
+            "n_points": int(len(plan.points.p_PR)),
+            "closed": bool(cell.path.closed),
+            "polygon_length_m": fitted.period,
+            "length_m": plan.path.length,
+        },
+        "fit": {
+            "degree": fitted.degree,
+            "n_control_points": fitted.n_control_points,
+            "tolerance_mm": cell.path.fit_tolerance_mm,
+            "max_error_mm": fitted.max_error_m * 1e3,
+            "rms_error_mm": fitted.rms_error_m * 1e3,
+        },
+        "motion": {
+            "speed_reference": tr.reference,
+            "limits": {"speed_m_s": law.v_max, "max_acceleration_m_s2": law.a_max,
+                       "max_jerk_m_s3": law.j_max},
+            "top_speed_m_s": law.v_peak,
+            "top_speed_reduced": law.reduced,
+            "sample_rate_hz": cell.motion.sample_rate_hz,
+        },
+        "trajectory": {
+            "duration_s": tr.duration,
+            "n_samples": int(len(tr.t)),
+            "max_flange_speed_m_s": float(np.linalg.norm(tr.v_IE, axis=1).max()),
+            "max_flange_acceleration_m_s2": float(np.linalg.norm(tr.a_IE, axis=1).max()),
+            "max_angular_speed_rad_s": float(np.linalg.norm(tr.w_IE_I, axis=1).max()),
+            **speed_checks(plan),
+        },
+        "cusps": [c.__dict__ for c in plan.cusps],
+        "cusp_smoothing": smoothing,
+        "timings_s": plan.timings_s,
+    }
+
+
+def write_outputs(plan: Plan, out_dir: Path) -> dict[str, Path]:
+    """Write trajectory.csv and report.json into ``out_dir``; returns their paths."""
+    out_dir = Path(out_dir)
+    files = {"trajectory": out_dir / "trajectory.csv", "report": out_dir / "report.json"}
+    write_atomic(files["trajectory"], trajectory_csv(plan))
+    write_atomic(files["report"], json.dumps(report(plan), indent=2) + "\n")
+    return files

@@ -1,0 +1,143 @@
+"""The workspace trajectory of the flange, sampled in time (paper §4, eq. 9).
+
+With the time law σ(t) and the flange path z_E(σ):
+    ż_E = ∂z_E/∂σ · σ̇,    z̈_E = ∂²z_E/∂σ² · σ̇² + ∂z_E/∂σ · σ̈,
+evaluated with the analytic s-derivatives of the flange path (no finite
+differences). σ is either the TCP arc length s along the processing path
+(speed_reference "tcp") or the arc length λ along the flange path ("flange");
+in the latter case s(λ) is found by the same true arc-length machinery.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.arc_length import ArcLengthMap
+from offline_prog.constants import DEFAULT_SAMPLE_RATE_HZ
+from offline_prog.fixed_tcp import FlangePath, FlangeSamples
+from offline_prog.time_law import Sin2TimeLaw, sin2_time_law
+
+CSV_COLUMNS = (
+    "t,sigma,x,y,z,alpha,beta,gamma,vx,vy,vz,wx,wy,wz,ax,ay,az,tcp_speed,dwx,dwy,dwz"
+).split(",")
+
+
+def tait_bryan_xyz(R: np.ndarray) -> np.ndarray:
+    """(N, 3) angles (α, β, γ) with R = Rx(α)·Ry(β)·Rz(γ), unwrapped along N [rad]."""
+    alpha = np.arctan2(-R[:, 1, 2], R[:, 2, 2])
+    beta = np.arctan2(R[:, 0, 2], np.hypot(R[:, 1, 2], R[:, 2, 2]))
+    gamma = np.arctan2(-R[:, 0, 1], R[:, 0, 0])
+    return np.stack([np.unwrap(alpha), beta, np.unwrap(gamma)], axis=1)
+
+
+def flange_arc_length(flange: FlangePath, s_breakpoints: np.ndarray) -> ArcLengthMap:
+    """λ(s) = ∫ |dp_IE/ds| ds: arc length along the flange path as a function of s."""
+
+    def speed(s: np.ndarray):
+        f = flange(s)
+        g = np.linalg.norm(f.dp_IE, axis=1)
+        return g, np.einsum("ij,ij->i", f.dp_IE, f.ddp_IE) / g, None
+
+    return ArcLengthMap(speed, s_breakpoints, periodic=False)
+
+
+@dataclasses.dataclass(frozen=True)
+class WorkspaceTrajectory:
+    """Flange trajectory sampled at times t (all arrays have N rows).
+
+    Attributes:
+        t: (N,) time [s]; s: (N,) TCP arc length on the processing path [m].
+        s_dot, s_ddot: (N,) its first two time derivatives (speed of the path
+            point under the TCP [m/s] and its rate [m/s²]).
+        flange: the FlangeSamples at s (poses X_IE and s-derivatives).
+        v_IE, a_IE: (N, 3) flange linear velocity / acceleration in I [m/s, m/s²].
+        w_IE_I, dw_IE_I: (N, 3) angular velocity / acceleration in I [rad/s, rad/s²].
+        rpy_IE: (N, 3) Tait-Bryan X-Y-Z angles of R_IE [rad], unwrapped.
+        tcp_speed: (N,) speed of the part point under the TCP relative to the tool
+            [m/s], from the rigid-body velocity of the part.
+        law: the time law; reference: "tcp" or "flange".
+    """
+
+    t: np.ndarray
+    s: np.ndarray
+    s_dot: np.ndarray
+    s_ddot: np.ndarray
+    flange: FlangeSamples
+    v_IE: np.ndarray
+    a_IE: np.ndarray
+    w_IE_I: np.ndarray
+    dw_IE_I: np.ndarray
+    rpy_IE: np.ndarray
+    tcp_speed: np.ndarray
+    law: Sin2TimeLaw
+    reference: str
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+    def table(self) -> np.ndarray:
+        """(N, len(CSV_COLUMNS)) rows in the order of CSV_COLUMNS (SI units)."""
+        return np.column_stack([
+            self.t, self.s, self.flange.p_IE, self.rpy_IE, self.v_IE, self.w_IE_I,
+            self.a_IE, self.tcp_speed, self.dw_IE_I,
+        ])
+
+
+def sample_times(duration: float, rate_hz: float) -> np.ndarray:
+    """(N,) times 0, 1/rate, … with the end time appended exactly."""
+    t = np.arange(0.0, duration, 1.0 / rate_hz)
+    if duration - t[-1] > 1e-9 / rate_hz:
+        t = np.append(t, duration)
+    return t
+
+
+def plan_workspace_trajectory(
+    flange: FlangePath,
+    *,
+    v_max: float,
+    a_max: float,
+    j_max: float,
+    reference: str = "tcp",
+    rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
+) -> WorkspaceTrajectory:
+    """Time the flange path with the sin² law and sample it (paper §4).
+
+    Args:
+        flange: the flange path X_IE(s).
+        v_max, a_max, j_max: limits of σ̇, σ̈, σ⃛ [m/s, m/s², m/s³].
+        reference: "tcp" (σ = s, the process speed at the tool) or "flange"
+            (σ = λ, the speed of the flange origin).
+        rate_hz: sample rate [Hz].
+    """
+    if reference == "tcp":
+        law = sin2_time_law(flange.length, v_max=v_max, a_max=a_max, j_max=j_max)
+        t = sample_times(law.duration, rate_hz)
+        s, s_dot, s_ddot, _ = law(t)
+    elif reference == "flange":
+        s_knots = flange.path.map.s_of_u(flange.path.fitted.breakpoints)
+        lam_map = flange_arc_length(flange, s_knots)
+        law = sin2_time_law(lam_map.length, v_max=v_max, a_max=a_max, j_max=j_max)
+        t = sample_times(law.duration, rate_hz)
+        lam, lam_dot, lam_ddot, _ = law(t)
+        s, ds, dds = lam_map.u_of_s(lam, order=2)
+        s_dot = ds * lam_dot
+        s_ddot = dds * lam_dot**2 + ds * lam_ddot
+    else:
+        raise ValueError(f"speed_reference must be 'tcp' or 'flange', got {reference!r}")
+
+    f = flange(s)
+    v_IE = f.dp_IE * s_dot[:, None]
+    a_IE = f.ddp_IE * (s_dot**2)[:, None] + f.dp_IE * s_ddot[:, None]
+    w_IE_I = f.w_s * s_dot[:, None]
+    dw_IE_I = f.dw_s * (s_dot**2)[:, None] + f.w_s * s_ddot[:, None]
+    # Velocity of the part's material point at the TCP: v_IE + w × (p_IT − p_IE).
+    p_IT = flange.X_IT.translation()
+    v_IQ = v_IE + np.cross(w_IE_I, p_IT - f.p_IE)
+    return WorkspaceTrajectory(
+        t=t, s=s, s_dot=s_dot, s_ddot=s_ddot, flange=f, v_IE=v_IE, a_IE=a_IE,
+        w_IE_I=w_IE_I, dw_IE_I=dw_IE_I, rpy_IE=tait_bryan_xyz(f.R_IE),
+        tcp_speed=np.linalg.norm(v_IQ, axis=1), law=law, reference=reference,
+    )

@@ -1,0 +1,63 @@
+"""Shared fixtures: seeded random paths, frames and cell files."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pydrake.common.eigen_geometry import Quaternion
+from pydrake.math import RigidTransform, RotationMatrix
+
+from offline_prog.arc_length import ArcLengthPath
+from offline_prog.bspline_fit import fit_bspline
+from offline_prog.fixed_tcp import FlangePath
+from offline_prog.process_frames import constant_normal
+
+REPO = Path(__file__).resolve().parents[1]
+CELLS = REPO / "cells"
+
+# Pose comparison tolerances.
+POSITION_TOL_M = 1e-9
+ANGLE_TOL_RAD = 1e-9
+
+
+def random_curve_points(rng, *, closed: bool, n: int = 300, scale: float = 0.2) -> np.ndarray:
+    """(n, 3) points on a smooth random Fourier curve that stays far from straight."""
+    phase = np.linspace(0.0, 2 * np.pi, n, endpoint=not closed) * (1.0 if closed else 0.7)
+    coefficients = rng.normal(scale=0.25, size=(3, 3, 2))
+    base = np.stack([np.cos(phase), np.sin(phase), 0.1 * np.sin(2 * phase)], axis=1)
+    wobble = np.zeros_like(base)
+    for k in range(3):
+        wobble += (np.outer(np.cos((k + 2) * phase), coefficients[k, :, 0])
+                   + np.outer(np.sin((k + 2) * phase), coefficients[k, :, 1])) / (k + 2) ** 2
+    return scale * (base + 0.3 * wobble)
+
+
+def random_transform(rng, reach: float = 1.0) -> RigidTransform:
+    """A uniformly random rotation and a translation in [−reach, reach]³ [m]."""
+    q = rng.normal(size=4)
+    return RigidTransform(RotationMatrix(Quaternion(q / np.linalg.norm(q))),
+                          rng.uniform(-reach, reach, 3))
+
+
+def random_flange_path(rng, *, closed: bool, planar: bool = False) -> FlangePath:
+    """A random curved path with a normal roughly perpendicular to its plane
+    (exactly perpendicular, into the plane z = 0 of P, when planar)."""
+    points = random_curve_points(rng, closed=closed)
+    normal = [0.1, -0.2, -1.0]
+    if planar:
+        points[:, 2], normal = 0.0, [0.0, 0.0, -1.0]
+    path = ArcLengthPath(fit_bspline(points, closed=closed, tolerance_m=1e-5))
+    return FlangePath(path, constant_normal(normal),
+                      X_IT=random_transform(rng), X_PE=random_transform(rng, 0.3))
+
+
+def rotation_log(R: np.ndarray) -> np.ndarray:
+    """(N, 3) rotation vectors of (N, 3, 3) rotation matrices."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(R).as_rotvec()
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(0)
