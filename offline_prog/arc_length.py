@@ -122,9 +122,7 @@ def compose_derivatives(c: list[np.ndarray], u: list[np.ndarray]) -> list[np.nda
         out.append(c[2] * (u[1] ** 2)[:, None] + c[1] * u[2][:, None])
     if len(c) > 3:
         out.append(
-            c[3] * (u[1] ** 3)[:, None]
-            + 3.0 * c[2] * (u[1] * u[2])[:, None]
-            + c[1] * u[3][:, None]
+            c[3] * (u[1] ** 3)[:, None] + 3.0 * c[2] * (u[1] * u[2])[:, None] + c[1] * u[3][:, None]
         )
     return out
 
@@ -152,9 +150,7 @@ class ArcLengthPath:
     def __init__(self, fitted):
         self.fitted = fitted
         self.closed = fitted.closed
-        self.map = ArcLengthMap(
-            curve_speed(fitted), fitted.breakpoints, periodic=fitted.closed
-        )
+        self.map = ArcLengthMap(curve_speed(fitted), fitted.breakpoints, periodic=fitted.closed)
         self.length = self.map.length
 
     def parameter(self, s: np.ndarray, order: int = 3) -> list[np.ndarray]:

@@ -6,7 +6,6 @@ load, the raw YAML is checked against the same dataclasses so that every error
 names the file, the dotted key and the reason in one line.
 """
 
-
 import dataclasses
 import math
 import os
@@ -135,14 +134,18 @@ def _check_transform(file, key, raw):
         raise CellError(file, key, "expected {translation: [x, y, z], rotation: !Rpy {deg: [...]}}")
     unknown = set(raw) - {"translation", "rotation", "base_frame"}
     if unknown:
-        raise CellError(file, f"{key}.{sorted(unknown)[0]}", "unknown key (allowed: translation, "
-                        "rotation)")
+        raise CellError(
+            file, f"{key}.{sorted(unknown)[0]}", "unknown key (allowed: translation, rotation)"
+        )
     if "translation" in raw:
         _check_vector(file, f"{key}.translation", raw["translation"], 3)
     rotation = raw.get("rotation")
     if rotation is not None:
-        if not (isinstance(rotation, dict) and rotation.get("__tag__") == "!Rpy"
-                and set(rotation) == {"__tag__", "deg"}):
+        if not (
+            isinstance(rotation, dict)
+            and rotation.get("__tag__") == "!Rpy"
+            and set(rotation) == {"__tag__", "deg"}
+        ):
             raise CellError(file, f"{key}.rotation", "expected !Rpy {deg: [roll, pitch, yaw]}")
         _check_vector(file, f"{key}.rotation.deg", rotation["deg"], 3)
 
@@ -164,8 +167,12 @@ def _check_value(file, key, raw, schema):
         if not all(math.isfinite(v) for v in raw):
             raise CellError(file, key, f"NaN or infinity in {raw!r}")
         return
-    expected = {float: _is_number, int: lambda v: isinstance(v, int) and not isinstance(v, bool),
-                bool: lambda v: isinstance(v, bool), str: lambda v: isinstance(v, str)}[schema]
+    expected = {
+        float: _is_number,
+        int: lambda v: isinstance(v, int) and not isinstance(v, bool),
+        bool: lambda v: isinstance(v, bool),
+        str: lambda v: isinstance(v, str),
+    }[schema]
     if not expected(raw):
         raise CellError(file, key, f"expected {schema.__name__}, got {raw!r}")
     if schema is float and not math.isfinite(raw):
@@ -206,7 +213,9 @@ def load_cell(file: str | os.PathLike) -> Cell:
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         line = f"line {mark.line + 1}: " if mark else ""
-        raise CellError(file, "", f"{line}not valid YAML ({getattr(error, 'problem', error)})")
+        raise CellError(
+            file, "", f"{line}not valid YAML ({getattr(error, 'problem', error)})"
+        ) from None
     _check_mapping(file, "", raw, Cell)
     try:
         return yaml_load_typed(schema=Cell, data=text)

@@ -27,28 +27,40 @@ def _parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", required=True)
     plan = commands.add_parser("plan", help="plan a cell and write the outputs")
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
-    plan.add_argument("--out", type=Path, default=None,
-                      help="output folder (default: out/<cell name>)")
+    plan.add_argument(
+        "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
+    )
     return parser
 
 
 def _summary(console: Console, report: dict, files: dict, seconds: float) -> None:
     fit, motion, traj = report["fit"], report["motion"], report["trajectory"]
-    console.print(f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
-                  f"tool {report['tool']}, part {report['part']}")
-    console.print(f"  path      {report['path']['length_m'] * 1e3:.1f} mm "
-                  f"({report['path']['source']}, {'closed' if report['path']['closed'] else 'open'})"
-                  f", fit degree {fit['degree']} with {fit['n_control_points']} control points, "
-                  f"max error {fit['max_error_mm']:.4f} mm, RMS {fit['rms_error_mm']:.4f} mm")
+    console.print(
+        f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
+        f"tool {report['tool']}, part {report['part']}"
+    )
+    console.print(
+        f"  path      {report['path']['length_m'] * 1e3:.1f} mm "
+        f"({report['path']['source']}, {'closed' if report['path']['closed'] else 'open'})"
+        f", fit degree {fit['degree']} with {fit['n_control_points']} control points, "
+        f"max error {fit['max_error_mm']:.4f} mm, RMS {fit['rms_error_mm']:.4f} mm"
+    )
     reduced = " (reduced: short path)" if motion["top_speed_reduced"] else ""
-    console.print(f"  motion    {motion['top_speed_m_s'] * 1e3:.1f} mm/s at the "
-                  f"{motion['speed_reference']}{reduced}, cycle {traj['duration_s']:.3f} s, "
-                  f"{traj['n_samples']} samples, speed error "
-                  f"{traj['chord_speed_max_error_rel'] * 100:.4f} %")
+    console.print(
+        f"  motion    {motion['top_speed_m_s'] * 1e3:.1f} mm/s at the "
+        f"{motion['speed_reference']}{reduced}, cycle {traj['duration_s']:.3f} s, "
+        f"{traj['n_samples']} samples, speed error "
+        f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
+    )
     cusps = report["cusps"]
-    console.print(f"  cusps     {len(cusps)}" + (
-        "  " + ", ".join(f"{c['kind']} at σ={c['sigma_m']:.3f} m" for c in cusps[:5])
-        if cusps else ""))
+    console.print(
+        f"  cusps     {len(cusps)}"
+        + (
+            "  " + ", ".join(f"{c['kind']} at σ={c['sigma_m']:.3f} m" for c in cusps[:5])
+            if cusps
+            else ""
+        )
+    )
     for name, path in files.items():
         console.print(f"  {name:<9} {path}")
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
@@ -77,8 +89,11 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as error:  # one line, never a traceback unless asked
         if args.debug:
             raise
-        errors.print(f"internal error: {type(error).__name__}: {error} (rerun with --debug)",
-                     markup=False, highlight=False)
+        errors.print(
+            f"internal error: {type(error).__name__}: {error} (rerun with --debug)",
+            markup=False,
+            highlight=False,
+        )
         return EXIT_INTERNAL
 
 

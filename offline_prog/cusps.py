@@ -58,14 +58,23 @@ def find_cusps(flange: FlangePath) -> list[Cusp]:
     ratio = np.linalg.norm(f.dp_IE, axis=1)
     rate = np.linalg.norm(f.w_s, axis=1)
     events = [(r[np.argmin(ratio[r])], "cusp") for r in _regions(ratio < CUSP_MIN_FLANGE_RATIO)]
-    events += [(r[np.argmax(ratio[r])], "speed_peak")
-               for r in _regions(ratio > CUSP_PEAK_RATIO * np.median(ratio))]
+    events += [
+        (r[np.argmax(ratio[r])], "speed_peak")
+        for r in _regions(ratio > CUSP_PEAK_RATIO * np.median(ratio))
+    ]
     cusps = []
     for i, kind in sorted(events):
         a, b = f.dp_IE[max(i - 3, 0)], f.dp_IE[min(i + 3, n - 1)]
         cos_turn = np.dot(a, b) / max(np.linalg.norm(a) * np.linalg.norm(b), 1e-300)
-        cusps.append(Cusp(float(s[i]), kind, float(ratio[i]),
-                          float(np.rad2deg(np.arccos(np.clip(cos_turn, -1, 1)))), float(rate[i])))
+        cusps.append(
+            Cusp(
+                float(s[i]),
+                kind,
+                float(ratio[i]),
+                float(np.rad2deg(np.arccos(np.clip(cos_turn, -1, 1)))),
+                float(rate[i]),
+            )
+        )
     return cusps
 
 

@@ -40,8 +40,14 @@ def write_atomic(target: Path, text: str) -> None:
 def trajectory_csv(plan: Plan) -> str:
     """CSV text: header CSV_COLUMNS, one row per sample, SI units (s, m, rad)."""
     buffer = io.StringIO()
-    np.savetxt(buffer, plan.trajectory.table(), delimiter=",", fmt="%.10g",
-               header=",".join(CSV_COLUMNS), comments="")
+    np.savetxt(
+        buffer,
+        plan.trajectory.table(),
+        delimiter=",",
+        fmt="%.10g",
+        header=",".join(CSV_COLUMNS),
+        comments="",
+    )
     return buffer.getvalue()
 
 
@@ -80,8 +86,10 @@ def report(plan: Plan) -> dict:
     source = next(k for k in ("points", "dxf", "analytic") if getattr(cell.path, k) is not None)
     smoothing = None
     if hasattr(plan.flange, "max_deviation_m"):
-        smoothing = {"max_deviation_mm": plan.flange.max_deviation_m * 1e3,
-                     "n_control_points": plan.flange.n_control_points}
+        smoothing = {
+            "max_deviation_mm": plan.flange.max_deviation_m * 1e3,
+            "n_control_points": plan.flange.n_control_points,
+        }
     return {
         "generator": f"offline_prog {__version__}",
         "generated": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
@@ -106,8 +114,11 @@ def report(plan: Plan) -> dict:
         },
         "motion": {
             "speed_reference": tr.reference,
-            "limits": {"speed_m_s": law.v_max, "max_acceleration_m_s2": law.a_max,
-                       "max_jerk_m_s3": law.j_max},
+            "limits": {
+                "speed_m_s": law.v_max,
+                "max_acceleration_m_s2": law.a_max,
+                "max_jerk_m_s3": law.j_max,
+            },
             "top_speed_m_s": law.v_peak,
             "top_speed_reduced": law.reduced,
             "sample_rate_hz": cell.motion.sample_rate_hz,

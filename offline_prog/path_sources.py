@@ -100,7 +100,7 @@ def rounded_rectangle_points(center, size, corner_radius) -> np.ndarray:
     at the end)."""
     center = np.asarray(center, float)
     w, h, r = float(size[0]), float(size[1]), float(corner_radius)
-    if not (0.0 < r and 2 * r <= min(w, h)):
+    if not (r > 0.0 and 2 * r <= min(w, h)):
         raise ValueError(f"corner_radius {r} must be > 0 and at most half of size {list(size)}")
     hx, hy = w / 2 - r, h / 2 - r
     outline = [np.array([[0.0, -h / 2]])]
@@ -117,7 +117,6 @@ def read_dxf_points(file: Path, *, layer: str | None, closed: bool, units: str) 
     """Sample the one path entity (LINE, ARC, CIRCLE, (LW)POLYLINE, SPLINE, ELLIPSE)
     of a DXF file's modelspace (optionally on one layer), scaled to metres."""
     import ezdxf
-    from ezdxf import path as ezpath
 
     try:
         document = ezdxf.readfile(file)
@@ -135,18 +134,36 @@ def read_dxf_points(file: Path, *, layer: str | None, closed: bool, units: str) 
         )
     entity = entities[0]
     scale = UNIT_SCALE[units]
-    curve = ezpath.make_path(entity)
-    vertices = np.array([tuple(v) for v in curve.flattening(distance=1e-6 / scale)], dtype=float)
-    is_closed = entity.dxftype() == "CIRCLE" or bool(getattr(entity, "closed", False)) or (
-        getattr(entity, "is_closed", False) is True
+    vertices = _flatten(entity, 1e-6 / scale)
+    is_closed = (
+        entity.dxftype() == "CIRCLE"
+        or bool(getattr(entity, "closed", False))
+        or (getattr(entity, "is_closed", False) is True)
     )
     if is_closed != closed:
-        raise ValueError(f"the DXF {entity.dxftype()} is {'closed' if is_closed else 'open'} "
-                         f"but path.closed is {str(closed).lower()}")
+        raise ValueError(
+            f"the DXF {entity.dxftype()} is {'closed' if is_closed else 'open'} "
+            f"but path.closed is {str(closed).lower()}"
+        )
     if closed:
         vertices = np.vstack([vertices, vertices[:1]])
     points = resample_polyline(vertices * scale, CURVE_SAMPLE_SPACING_M)
     return clean_points(points, None, closed=closed)
+
+
+def _flatten(entity, sagitta: float) -> np.ndarray:
+    """(N, 3) vertices on the entity's exact curve (arcs and splines are not
+    replaced by Bézier approximations), within ``sagitta`` in drawing units."""
+    kind = entity.dxftype()
+    if kind in ("LWPOLYLINE", "POLYLINE"):
+        pieces = [_flatten(piece, sagitta) for piece in entity.virtual_entities()]
+        joined = [pieces[0]] + [piece[1:] for piece in pieces[1:]]
+        return np.vstack(joined)
+    if kind == "LINE":
+        return np.array([tuple(entity.dxf.start), tuple(entity.dxf.end)], dtype=float)
+    if kind in ("ARC", "CIRCLE"):
+        return np.array([tuple(v) for v in entity.flattening(sagitta)], dtype=float)
+    return np.array([tuple(v) for v in entity.flattening(distance=sagitta)], dtype=float)
 
 
 def resample_polyline(points: np.ndarray, spacing: float) -> np.ndarray:

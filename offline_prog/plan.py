@@ -60,19 +60,27 @@ def _error(file, key, reason):
 
 def _check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     """Semantic checks the types alone cannot express."""
-    robot_dirs = sorted(p.name for p in robots_dir.iterdir() if p.is_dir()) if (
-        robots_dir.is_dir()) else []
+    robot_dirs = (
+        sorted(p.name for p in robots_dir.iterdir() if p.is_dir()) if (robots_dir.is_dir()) else []
+    )
     if cell.robot.model not in robot_dirs:
-        raise _error(file, "robot.model", f"{cell.robot.model!r} is not a robot folder in "
-                     f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})")
+        raise _error(
+            file,
+            "robot.model",
+            f"{cell.robot.model!r} is not a robot folder in "
+            f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})",
+        )
     path, motion = cell.path, cell.motion
     for key, value in (("path.units", path.units), ("part.mesh_units", cell.part.mesh_units)):
         if value not in path_sources.UNIT_SCALE:
             raise _error(file, key, f"{value!r} is not a unit (use m or mm)")
     sources = [k for k in ("points", "dxf", "analytic") if getattr(path, k) is not None]
     if len(sources) != 1:
-        raise _error(file, "path", f"give exactly one of points, dxf, analytic (got "
-                     f"{', '.join(sources) or 'none'})")
+        raise _error(
+            file,
+            "path",
+            f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
+        )
     for key in ("points", "dxf"):
         value = getattr(path, key)
         if value is not None and not (file.parent / value).is_file():
@@ -85,24 +93,30 @@ def _check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "path.normal", "is the zero vector")
     if path.degree < 5:
         raise _error(file, "path.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
-    for key, value in (("path.fit_tolerance_mm", path.fit_tolerance_mm),
-                       ("motion.speed", motion.speed),
-                       ("motion.max_acceleration", motion.max_acceleration),
-                       ("motion.max_jerk", motion.max_jerk),
-                       ("motion.sample_rate_hz", motion.sample_rate_hz)):
+    for key, value in (
+        ("path.fit_tolerance_mm", path.fit_tolerance_mm),
+        ("motion.speed", motion.speed),
+        ("motion.max_acceleration", motion.max_acceleration),
+        ("motion.max_jerk", motion.max_jerk),
+        ("motion.sample_rate_hz", motion.sample_rate_hz),
+    ):
         if not value > 0:
             raise _error(file, key, f"must be > 0, got {value}")
     if motion.speed_reference not in ("tcp", "flange"):
-        raise _error(file, "motion.speed_reference",
-                     f"{motion.speed_reference!r} (use tcp or flange)")
+        raise _error(
+            file, "motion.speed_reference", f"{motion.speed_reference!r} (use tcp or flange)"
+        )
     if motion.cusp_smoothing_mm is not None and not motion.cusp_smoothing_mm > 0:
         raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
 
 
 def _analytic_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     a, scale = cell.path.analytic, path_sources.UNIT_SCALE[cell.path.units]
-    needs = {"line": ("start", "end"), "arc": ("center", "radius", "start_deg", "end_deg"),
-             "rounded_rectangle": ("center", "size", "corner_radius")}
+    needs = {
+        "line": ("start", "end"),
+        "arc": ("center", "radius", "start_deg", "end_deg"),
+        "rounded_rectangle": ("center", "size", "corner_radius"),
+    }
     if a.kind not in needs:
         raise _error(file, "path.analytic.kind", f"{a.kind!r} (use {', '.join(needs)})")
     for key in needs[a.kind]:
@@ -118,14 +132,16 @@ def _analytic_points(file: Path, cell: Cell) -> path_sources.PathPoints:
             raise _error(file, "path.closed", "a closed arc must sweep 360°")
         if a.radius <= 0 or a.start_deg == a.end_deg:
             raise _error(file, "path.analytic", "an arc needs radius > 0 and start ≠ end")
-        p = path_sources.arc_points(np.multiply(a.center, scale), a.radius * scale,
-                                    a.start_deg, a.end_deg, closed=closed)
+        p = path_sources.arc_points(
+            np.multiply(a.center, scale), a.radius * scale, a.start_deg, a.end_deg, closed=closed
+        )
     else:
         if not closed:
             raise _error(file, "path.closed", "a rounded_rectangle is closed: set true")
         try:
             p = path_sources.rounded_rectangle_points(
-                np.multiply(a.center, scale), np.multiply(a.size, scale), a.corner_radius * scale)
+                np.multiply(a.center, scale), np.multiply(a.size, scale), a.corner_radius * scale
+            )
         except ValueError as error:
             raise _error(file, "path.analytic", str(error)) from None
     return path_sources.clean_points(p, None, closed=closed)
@@ -139,21 +155,33 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
     try:
         if path.points:
-            return path_sources.read_csv_points(file.parent / source, units=path.units,
-                                                closed=path.closed)
-        return path_sources.read_dxf_points(file.parent / source, layer=path.dxf_layer,
-                                            closed=path.closed, units=path.units)
+            return path_sources.read_csv_points(
+                file.parent / source, units=path.units, closed=path.closed
+            )
+        return path_sources.read_dxf_points(
+            file.parent / source, layer=path.dxf_layer, closed=path.closed, units=path.units
+        )
     except ValueError as error:
         raise _error(file, key, f"{source}: {error}") from None
 
 
 def _normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
-    given = [k for k, v in (("nx,ny,nz columns", points.normals_P is not None),
-                            ("path.normal", cell.path.normal is not None),
-                            ("path.normal_from_mesh", cell.path.normal_from_mesh)) if v]
+    given = [
+        k
+        for k, v in (
+            ("nx,ny,nz columns", points.normals_P is not None),
+            ("path.normal", cell.path.normal is not None),
+            ("path.normal_from_mesh", cell.path.normal_from_mesh),
+        )
+        if v
+    ]
     if len(given) != 1:
-        raise _error(file, "path.normal", "give the surface normal exactly one way: nx,ny,nz "
-                     f"columns, path.normal, or path.normal_from_mesh (got {given or 'none'})")
+        raise _error(
+            file,
+            "path.normal",
+            "give the surface normal exactly one way: nx,ny,nz "
+            f"columns, path.normal, or path.normal_from_mesh (got {given or 'none'})",
+        )
     if cell.path.normal is not None:
         return constant_normal(np.asarray(cell.path.normal, float))
     if points.normals_P is not None:
@@ -175,9 +203,13 @@ def _check_turns(file: Path, path: ArcLengthPath) -> None:
     worst = int(np.argmin(cos_turn))
     if cos_turn[worst] < np.cos(MAX_TANGENT_TURN_RAD):
         turn = np.rad2deg(np.arccos(np.clip(cos_turn[worst], -1.0, 1.0)))
-        raise _error(file, "path", f"the path stops and turns back (tangent turns {turn:.0f}° "
-                     f"within {s[1] * 1e3:.2f} mm at σ = {s[worst]:.4f} m); split it or "
-                     "check the point order")
+        raise _error(
+            file,
+            "path",
+            f"the path stops and turns back (tangent turns {turn:.0f}° "
+            f"within {s[1] * 1e3:.2f} mm at σ = {s[worst]:.4f} m); split it or "
+            "check the point order",
+        )
 
 
 def plan_cell(
@@ -215,17 +247,22 @@ def plan_cell(
     points = load_points(file, cell)
     lap("load", "fitting the B-spline")
     try:
-        fitted = fit_bspline(points.p_PR, closed=cell.path.closed, degree=cell.path.degree,
-                             tolerance_m=cell.path.fit_tolerance_mm * 1e-3,
-                             n_control_points=cell.path.n_control_points)
+        fitted = fit_bspline(
+            points.p_PR,
+            closed=cell.path.closed,
+            degree=cell.path.degree,
+            tolerance_m=cell.path.fit_tolerance_mm * 1e-3,
+            n_control_points=cell.path.n_control_points,
+        )
     except ValueError as error:
         raise _error(file, "path", str(error)) from None
     path = ArcLengthPath(fitted)
     _check_turns(file, path)
     lap("fit", "process frames and flange path")
     normal = _normal_field(file, cell, points, path)
-    flange = FlangePath(path, normal, X_IT=transform(cell.tool.X_IT),
-                        X_PE=transform(cell.part.X_PE))
+    flange = FlangePath(
+        path, normal, X_IT=transform(cell.tool.X_IT), X_PE=transform(cell.part.X_PE)
+    )
     try:
         flange(np.linspace(0.0, path.length, 2001))  # frames defined everywhere?
         cusps = find_cusps(flange)
@@ -240,10 +277,19 @@ def plan_cell(
     motion = cell.motion
     if motion.speed_reference == "flange" and any(c.kind == "cusp" for c in cusps):
         first = next(c for c in cusps if c.kind == "cusp")
-        raise _error(file, "motion.speed_reference", f"flange: the flange stops at a cusp at "
-                     f"σ = {first.sigma_m:.4f} m; use tcp or motion.cusp_smoothing_mm")
+        raise _error(
+            file,
+            "motion.speed_reference",
+            f"flange: the flange stops at a cusp at "
+            f"σ = {first.sigma_m:.4f} m; use tcp or motion.cusp_smoothing_mm",
+        )
     trajectory = plan_workspace_trajectory(
-        flange, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk,
-        reference=motion.speed_reference, rate_hz=motion.sample_rate_hz)
+        flange,
+        v_max=motion.speed,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
+        reference=motion.speed_reference,
+        rate_hz=motion.sample_rate_hz,
+    )
     lap("trajectory")
     return Plan(file, cell, points, fitted, path, flange, trajectory, cusps, timings)

@@ -53,8 +53,9 @@ class Sin2TimeLaw:
         s = v = a = 0.0
         for i in range(7):
             state[i] = s, v, a
-            s, v, a, _ = _pulse(self.signs[i], self.durations[i], self.j_max, s, v, a,
-                                np.array([self.durations[i]]))
+            s, v, a, _ = _pulse(
+                self.signs[i], self.durations[i], self.j_max, s, v, a, np.array([self.durations[i]])
+            )
             s, v, a = float(s[0]), float(v[0]), float(a[0])
         return starts, state
 
@@ -65,8 +66,13 @@ class Sin2TimeLaw:
         seg = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, 6)
         tau = t - starts[seg]
         s, v, a, j = _pulse(
-            self.signs[seg], self.durations[seg], self.j_max,
-            state[seg, 0], state[seg, 1], state[seg, 2], tau,
+            self.signs[seg],
+            self.durations[seg],
+            self.j_max,
+            state[seg, 0],
+            state[seg, 1],
+            state[seg, 2],
+            tau,
         )
         # Pin the end exactly at rest at the path's end (removes rounding).
         end = t >= self.duration
@@ -118,7 +124,10 @@ def sin2_time_law(length: float, *, v_max: float, a_max: float, j_max: float) ->
     if 2.0 * _acceleration_distance(v_max, a_max, j_max) > length:
         v_peak = brentq(
             lambda v: 2.0 * _acceleration_distance(v, a_max, j_max) - length,
-            0.0, v_max, xtol=1e-15, rtol=1e-15,
+            0.0,
+            v_max,
+            xtol=1e-15,
+            rtol=1e-15,
         )
     t_j, t_a = _acceleration_phase(v_peak, a_max, j_max)
     t_v = max(0.0, (length - 2.0 * _acceleration_distance(v_peak, a_max, j_max)) / v_peak)

@@ -20,8 +20,8 @@ from offline_prog.fixed_tcp import FlangePath, FlangeSamples
 from offline_prog.time_law import Sin2TimeLaw, sin2_time_law
 
 CSV_COLUMNS = (
-    "t,sigma,x,y,z,alpha,beta,gamma,vx,vy,vz,wx,wy,wz,ax,ay,az,tcp_speed,dwx,dwy,dwz"
-).split(",")
+    "t,sigma,x,y,z,alpha,beta,gamma,vx,vy,vz,wx,wy,wz,ax,ay,az,tcp_speed,dwx,dwy,dwz".split(",")
+)
 
 
 def tait_bryan_xyz(R: np.ndarray) -> np.ndarray:
@@ -80,10 +80,19 @@ class WorkspaceTrajectory:
 
     def table(self) -> np.ndarray:
         """(N, len(CSV_COLUMNS)) rows in the order of CSV_COLUMNS (SI units)."""
-        return np.column_stack([
-            self.t, self.s, self.flange.p_IE, self.rpy_IE, self.v_IE, self.w_IE_I,
-            self.a_IE, self.tcp_speed, self.dw_IE_I,
-        ])
+        return np.column_stack(
+            [
+                self.t,
+                self.s,
+                self.flange.p_IE,
+                self.rpy_IE,
+                self.v_IE,
+                self.w_IE_I,
+                self.a_IE,
+                self.tcp_speed,
+                self.dw_IE_I,
+            ]
+        )
 
 
 def sample_times(duration: float, rate_hz: float) -> np.ndarray:
@@ -137,7 +146,17 @@ def plan_workspace_trajectory(
     p_IT = flange.X_IT.translation()
     v_IQ = v_IE + np.cross(w_IE_I, p_IT - f.p_IE)
     return WorkspaceTrajectory(
-        t=t, s=s, s_dot=s_dot, s_ddot=s_ddot, flange=f, v_IE=v_IE, a_IE=a_IE,
-        w_IE_I=w_IE_I, dw_IE_I=dw_IE_I, rpy_IE=tait_bryan_xyz(f.R_IE),
-        tcp_speed=np.linalg.norm(v_IQ, axis=1), law=law, reference=reference,
+        t=t,
+        s=s,
+        s_dot=s_dot,
+        s_ddot=s_ddot,
+        flange=f,
+        v_IE=v_IE,
+        a_IE=a_IE,
+        w_IE_I=w_IE_I,
+        dw_IE_I=dw_IE_I,
+        rpy_IE=tait_bryan_xyz(f.R_IE),
+        tcp_speed=np.linalg.norm(v_IQ, axis=1),
+        law=law,
+        reference=reference,
     )

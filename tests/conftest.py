@@ -27,16 +27,19 @@ def random_curve_points(rng, *, closed: bool, n: int = 300, scale: float = 0.2) 
     base = np.stack([np.cos(phase), np.sin(phase), 0.1 * np.sin(2 * phase)], axis=1)
     wobble = np.zeros_like(base)
     for k in range(3):
-        wobble += (np.outer(np.cos((k + 2) * phase), coefficients[k, :, 0])
-                   + np.outer(np.sin((k + 2) * phase), coefficients[k, :, 1])) / (k + 2) ** 2
+        wobble += (
+            np.outer(np.cos((k + 2) * phase), coefficients[k, :, 0])
+            + np.outer(np.sin((k + 2) * phase), coefficients[k, :, 1])
+        ) / (k + 2) ** 2
     return scale * (base + 0.3 * wobble)
 
 
 def random_transform(rng, reach: float = 1.0) -> RigidTransform:
     """A uniformly random rotation and a translation in [−reach, reach]³ [m]."""
     q = rng.normal(size=4)
-    return RigidTransform(RotationMatrix(Quaternion(q / np.linalg.norm(q))),
-                          rng.uniform(-reach, reach, 3))
+    return RigidTransform(
+        RotationMatrix(Quaternion(q / np.linalg.norm(q))), rng.uniform(-reach, reach, 3)
+    )
 
 
 def random_flange_path(rng, *, closed: bool, planar: bool = False) -> FlangePath:
@@ -47,8 +50,9 @@ def random_flange_path(rng, *, closed: bool, planar: bool = False) -> FlangePath
     if planar:
         points[:, 2], normal = 0.0, [0.0, 0.0, -1.0]
     path = ArcLengthPath(fit_bspline(points, closed=closed, tolerance_m=1e-5))
-    return FlangePath(path, constant_normal(normal),
-                      X_IT=random_transform(rng), X_PE=random_transform(rng, 0.3))
+    return FlangePath(
+        path, constant_normal(normal), X_IT=random_transform(rng), X_PE=random_transform(rng, 0.3)
+    )
 
 
 def rotation_log(R: np.ndarray) -> np.ndarray:

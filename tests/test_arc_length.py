@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
-from conftest import random_curve_points
 
 from offline_prog.arc_length import ArcLengthPath
 from offline_prog.bspline_fit import fit_bspline
+
+from conftest import random_curve_points
 
 
 @pytest.mark.parametrize("closed", [False, True])

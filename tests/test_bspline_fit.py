@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
-from conftest import random_curve_points
 
 from offline_prog.bspline_fit import chord_length_parameter, fit_bspline
+
+from conftest import random_curve_points
 
 
 @pytest.mark.parametrize("closed", [False, True])

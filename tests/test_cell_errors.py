@@ -5,10 +5,11 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import REPO
 
 from offline_prog.cell import CellError, load_cell
 from offline_prog.plan import plan_cell
+
+from conftest import REPO
 
 BASE = """\
 name: test
@@ -81,20 +82,24 @@ def test_bad_cell_names_file_key_and_reason(tmp_path, old, new, key, reason):
 
 
 def test_speed_reference_must_be_tcp_or_flange(tmp_path):
-    cell = write_cell(tmp_path, BASE.replace("max_jerk: 10.0", "max_jerk: 10.0\n"
-                                             "  speed_reference: wrist"))
+    cell = write_cell(
+        tmp_path, BASE.replace("max_jerk: 10.0", "max_jerk: 10.0\n  speed_reference: wrist")
+    )
     with pytest.raises(CellError, match="motion.speed_reference: 'wrist'"):
         plan_cell(cell)
 
 
-@pytest.mark.parametrize(("csv", "reason"), [
-    ("x,y\n1,2\n", "header must start with x,y,z"),
-    ("x,y,z\n1,2,3\n1,2\n", "line 3 has 2 values"),
-    ("x,y,z\n1,2,3\n1,nan,3\n", "line 3 holds NaN"),
-    ("x,y,z\n1,2,3\n1,b,3\n", "not a number"),
-    ("x,y,z,nx,ny,nz\n1,2,3,0,0,0\n", "normal (nx,ny,nz) is zero"),
-    ("x,y,z,w\n1,2,3,1\n", "unknown columns"),
-])
+@pytest.mark.parametrize(
+    ("csv", "reason"),
+    [
+        ("x,y\n1,2\n", "header must start with x,y,z"),
+        ("x,y,z\n1,2,3\n1,2\n", "line 3 has 2 values"),
+        ("x,y,z\n1,2,3\n1,nan,3\n", "line 3 holds NaN"),
+        ("x,y,z\n1,2,3\n1,b,3\n", "not a number"),
+        ("x,y,z,nx,ny,nz\n1,2,3,0,0,0\n", "normal (nx,ny,nz) is zero"),
+        ("x,y,z,w\n1,2,3,1\n", "unknown columns"),
+    ],
+)
 def test_bad_csv_names_line(tmp_path, csv, reason):
     cell = write_cell(tmp_path, csv=csv)
     with pytest.raises(CellError, match="path.points: path.csv: ") as info:
@@ -102,11 +107,14 @@ def test_bad_csv_names_line(tmp_path, csv, reason):
     assert reason in str(info.value)
 
 
-@pytest.mark.parametrize(("csv", "reason"), [
-    ("x,y,z\n" + "1,2,3\n" * 10, "at least 6"),  # duplicates collapse to one point
-    ("x,y,z\n0,0,0\n1,0,0\n2,0,0\n", "at least 6"),
-    ("x,y,z\n" + "".join(f"{v},0,0\n" for v in [0, 1, 2, 3, 2, 1, 0, 1, 2, 3]), "turns back"),
-])
+@pytest.mark.parametrize(
+    ("csv", "reason"),
+    [
+        ("x,y,z\n" + "1,2,3\n" * 10, "at least 6"),  # duplicates collapse to one point
+        ("x,y,z\n0,0,0\n1,0,0\n2,0,0\n", "at least 6"),
+        ("x,y,z\n" + "".join(f"{v},0,0\n" for v in [0, 1, 2, 3, 2, 1, 0, 1, 2, 3]), "turns back"),
+    ],
+)
 def test_geometry_the_method_cannot_handle(tmp_path, csv, reason):
     with pytest.raises(CellError, match=f"cell.yaml: path: .*{reason}"):
         plan_cell(write_cell(tmp_path, csv=csv))
@@ -119,8 +127,12 @@ def test_yaml_syntax_error_names_line(tmp_path):
 
 def test_cli_bad_input_is_one_line_exit_2(tmp_path):
     cell = write_cell(tmp_path, BASE.replace("units: mm", "units: furlong"))
-    done = subprocess.run([sys.executable, "-m", "offline_prog", "plan", str(cell), "--out",
-                           str(tmp_path / "out")], capture_output=True, text=True, cwd=REPO)
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+    )
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()
     assert lines == [f"error: {cell}: path.units: 'furlong' is not a unit (use m or mm)"]
@@ -129,8 +141,12 @@ def test_cli_bad_input_is_one_line_exit_2(tmp_path):
 
 
 def test_cli_missing_cell_file(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "offline_prog", "plan",
-                           str(tmp_path / "none.yaml")], capture_output=True, text=True, cwd=REPO)
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(tmp_path / "none.yaml")],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+    )
     assert done.returncode == 2
     assert "none.yaml: cannot read" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1

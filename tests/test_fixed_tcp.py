@@ -3,9 +3,10 @@ the part point under the fixed TCP is the path point, with the tool axes on [t n
 
 import numpy as np
 import pytest
-from conftest import random_flange_path, rotation_log
 
 from offline_prog.process_frames import NormalTangentError, constant_normal, process_frames
+
+from conftest import random_flange_path, rotation_log
 
 
 @pytest.mark.parametrize("closed", [False, True])
@@ -20,20 +21,21 @@ def test_part_point_under_tcp_stays_on_path(rng, closed):
         R_IP = f.R_IE @ R_PE.T
         p_IP = f.p_IE - np.einsum("nij,j->ni", R_IP, p_PE)
         p_I_path = p_IP + np.einsum("nij,nj->ni", R_IP, f.p_PF)
-        np.testing.assert_allclose(p_I_path, np.broadcast_to(flange.X_IT.translation(),
-                                                             p_I_path.shape), atol=1e-12)
+        np.testing.assert_allclose(
+            p_I_path, np.broadcast_to(flange.X_IT.translation(), p_I_path.shape), atol=1e-12
+        )
         # Tool axes match [t n b] of the process frame, expressed in I.
         R_IT = flange.X_IT.rotation().matrix()
-        np.testing.assert_allclose(R_IP @ f.R_PF, np.broadcast_to(R_IT, f.R_PF.shape),
-                                   atol=1e-12)
+        np.testing.assert_allclose(R_IP @ f.R_PF, np.broadcast_to(R_IT, f.R_PF.shape), atol=1e-12)
 
 
 def test_process_frames_are_right_handed_tnb(rng):
     flange = random_flange_path(rng, closed=True)
     s = np.linspace(0, flange.length, 400)
     R, _, _ = process_frames(flange.path, flange.normal, s)
-    np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.broadcast_to(np.eye(3), R.shape),
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        R @ np.swapaxes(R, 1, 2), np.broadcast_to(np.eye(3), R.shape), atol=1e-12
+    )
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
     _, t, _, _ = flange.path(s)
     np.testing.assert_allclose(R[:, :, 0], t, atol=1e-12)

@@ -27,7 +27,10 @@ def test_limits_rest_to_rest_and_continuity(length, v, a, j):
     assert np.abs(sddd).max() <= j * (1 + eps)
     # Continuous jerk: the step between neighbours shrinks with the sample step.
     dt = t[1] - t[0]
-    assert np.abs(np.diff(sddd)).max() <= j * np.pi * dt / law.durations[law.durations > 0].min() * 1.01 + 1e-12
+    assert (
+        np.abs(np.diff(sddd)).max()
+        <= j * np.pi * dt / law.durations[law.durations > 0].min() * 1.01 + 1e-12
+    )
     # Each derivative is the time derivative of the one before.
     for f, df in ((s, sd), (sd, sdd), (sdd, sddd)):
         scale = max(np.abs(df).max(), 1e-12)

@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
-from conftest import random_flange_path, rotation_log
 from scipy.spatial.transform import Rotation
 
 from offline_prog.trajectory import plan_workspace_trajectory, tait_bryan_xyz
+
+from conftest import random_flange_path, rotation_log
 
 SPEED = 0.1
 LIMITS = {"v_max": SPEED, "a_max": 1.0, "j_max": 10.0}
@@ -49,9 +50,13 @@ def test_tait_bryan_xyz_convention_and_unwrap(rng):
     angles = np.cumsum(rng.normal(scale=0.3, size=(400, 3)), axis=0)
     angles[:, 1] = np.clip(angles[:, 1], -1.4, 1.4)
     R = Rotation.from_euler("XYZ", angles).as_matrix()  # intrinsic X-Y-Z: Rx·Ry·Rz
-    np.testing.assert_allclose(R[5], Rotation.from_euler("x", angles[5, 0]).as_matrix()
-                               @ Rotation.from_euler("y", angles[5, 1]).as_matrix()
-                               @ Rotation.from_euler("z", angles[5, 2]).as_matrix(), atol=1e-12)
+    np.testing.assert_allclose(
+        R[5],
+        Rotation.from_euler("x", angles[5, 0]).as_matrix()
+        @ Rotation.from_euler("y", angles[5, 1]).as_matrix()
+        @ Rotation.from_euler("z", angles[5, 2]).as_matrix(),
+        atol=1e-12,
+    )
     recovered = tait_bryan_xyz(R)
     offset = np.round((recovered[0] - angles[0]) / (2 * np.pi)) * 2 * np.pi
     np.testing.assert_allclose(recovered - offset, angles, atol=1e-9)

@@ -1,0 +1,101 @@
+"""Every demo cell plans end to end from the command line, and its trajectory.csv
+alone shows the fixed-TCP properties: the part point under the tool is on the path,
+the tool axes are the process frame, the TCP speed is the commanded speed."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from offline_prog.cell import load_cell, transform
+from offline_prog.plan import load_points
+from offline_prog.trajectory import CSV_COLUMNS
+
+from conftest import CELLS, REPO
+
+DEMO_CELLS = sorted(CELLS.glob("*.yaml"))
+
+
+@pytest.fixture(scope="module", params=DEMO_CELLS, ids=lambda p: p.stem)
+def planned(request, tmp_path_factory):
+    out = tmp_path_factory.mktemp(request.param.stem)
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(request.param), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+    )
+    assert done.returncode == 0, done.stderr
+    assert str(out) in done.stdout
+    with open(out / "trajectory.csv") as stream:
+        header = stream.readline().strip().split(",")
+    table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    report = json.loads((out / "report.json").read_text())
+    return request.param, header, table, report
+
+
+def test_header_and_sampling(planned):
+    cell_file, header, table, report = planned
+    assert header == CSV_COLUMNS
+    t = table[:, 0]
+    assert t[0] == 0.0 and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(np.diff(t)[:-1], 1 / 250.0, atol=1e-9)
+    assert t[-1] == pytest.approx(report["trajectory"]["duration_s"], abs=1e-6)
+    assert report["fit"]["max_error_mm"] <= report["fit"]["tolerance_mm"]
+
+
+def test_part_point_under_tcp_is_on_the_path(planned):
+    cell_file, header, table, report = planned
+    cell = load_cell(cell_file)
+    col = {name: i for i, name in enumerate(header)}
+    X_IT, X_PE = transform(cell.tool.X_IT), transform(cell.part.X_PE)
+    R_IE = Rotation.from_euler("XYZ", table[:, [col["alpha"], col["beta"], col["gamma"]]])
+    p_IE = table[:, [col["x"], col["y"], col["z"]]]
+    # p_PQ = X_PE · X_EI · p_IT: the part point at the TCP, from the CSV pose alone.
+    p_EQ = R_IE.inv().apply(X_IT.translation() - p_IE)
+    p_PQ = p_EQ @ X_PE.rotation().matrix().T + X_PE.translation()
+    given = load_points(cell_file, cell).p_PR
+    if cell.path.closed:
+        given = np.vstack([given, given[:1]])
+    fit_tol = report["fit"]["max_error_mm"] * 1e-3
+    # Distance to the given points' polyline, densified (spacing ≤ 1 mm, so the
+    # polyline's own sagitta is far below the fit tolerance).
+    dense = np.vstack(
+        [np.linspace(a, b, 20, endpoint=False) for a, b in zip(given[:-1], given[1:], strict=True)]
+    )
+    dist, _ = cKDTree(dense).query(p_PQ)
+    assert dist.max() <= fit_tol + 1e-4
+    # The tool's axes are [t n b]: T's x axis is the direction the part point moves
+    # along the path (opposite to the part's motion under the tool).
+    R_IP = R_IE * Rotation.from_matrix(X_PE.rotation().matrix().T)
+    tangent_I = R_IP.apply(np.gradient(p_PQ, axis=0))
+    moving = np.linalg.norm(tangent_I, axis=1) > 1e-7
+    tangent_I = tangent_I[moving] / np.linalg.norm(tangent_I[moving], axis=1, keepdims=True)
+    x_T = X_IT.rotation().matrix()[:, 0]
+    assert np.min(tangent_I @ x_T) > np.cos(np.deg2rad(1.0))
+
+
+def test_tcp_speed_is_the_commanded_speed(planned):
+    cell_file, header, table, report = planned
+    cell = load_cell(cell_file)
+    col = {name: i for i, name in enumerate(header)}
+    v = table[:, [col["vx"], col["vy"], col["vz"]]]
+    w = table[:, [col["wx"], col["wy"], col["wz"]]]
+    p_IE = table[:, [col["x"], col["y"], col["z"]]]
+    p_IT = transform(cell.tool.X_IT).translation()
+    v_tcp = np.linalg.norm(v + np.cross(w, p_IT - p_IE), axis=1)
+    np.testing.assert_allclose(v_tcp, table[:, col["tcp_speed"]], atol=1e-8)
+    speed = report["motion"]["top_speed_m_s"]
+    assert v_tcp.max() <= speed * (1 + 1e-8)
+    # σ̇ from the sigma column: cruise at the commanded speed within 0.05 %.
+    sigma_dot = np.diff(table[:, col["sigma"]]) / np.diff(table[:, col["t"]])
+    at_speed = table[:, col["tcp_speed"]] >= speed * (1 - 1e-9)
+    cruise = at_speed[:-1] & at_speed[1:]
+    assert cruise.sum() > 0.5 * len(sigma_dot)
+    assert np.abs(sigma_dot[cruise] - speed).max() <= 5e-4 * speed
+    assert report["trajectory"]["chord_speed_max_error_rel"] <= 5e-4
+    assert report["trajectory"]["tcp_speed_max_error_rel"] <= 1e-9
