@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     try:
         from offline_prog.cell import CellError
-        from offline_prog.outputs import report, write_outputs
+        from offline_prog.outputs import write_outputs
         from offline_prog.plan import plan_cell
 
         try:
@@ -80,11 +80,11 @@ def main(argv: list[str] | None = None) -> int:
                 plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
                 out = args.out or Path("out") / args.cell.stem
                 status.update("writing outputs")
-                files = write_outputs(plan, out)
+                files, report = write_outputs(plan, out)
         except CellError as error:
             errors.print(f"error: {error}", markup=False, highlight=False)
             return EXIT_BAD_INPUT
-        _summary(console, report(plan), files, time.perf_counter() - started)
+        _summary(console, report, files, time.perf_counter() - started)
         return 0
     except Exception as error:  # one line, never a traceback unless asked
         if args.debug:

@@ -137,10 +137,15 @@ def report(plan: Plan) -> dict:
     }
 
 
-def write_outputs(plan: Plan, out_dir: Path) -> dict[str, Path]:
-    """Write trajectory.csv and report.json into ``out_dir``; returns their paths."""
+def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
+    """Write trajectory.csv and report.json into ``out_dir``.
+
+    Returns:
+        The written files by name, and the report that went into report.json.
+    """
     out_dir = Path(out_dir)
     files = {"trajectory": out_dir / "trajectory.csv", "report": out_dir / "report.json"}
+    summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
-    write_atomic(files["report"], json.dumps(report(plan), indent=2) + "\n")
-    return files
+    write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
+    return files, summary
