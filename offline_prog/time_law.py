@@ -1,12 +1,17 @@
 """Rest-to-rest time law σ(t) with piecewise sin² jerk (paper §4, after Biagiotti
 & Melchiorri, "Trajectory Planning for Automatic Machines and Robots", 2008).
 
-The jerk is a sequence of seven segments: a positive sin² pulse, constant
-acceleration, a negative pulse, cruise at the top speed, and the mirror image
-to stop. A pulse of duration T_j and peak J changes the acceleration by J·T_j/2,
-so the jerk, acceleration and velocity are all continuous and bounded by the
-given limits. Short paths lower the top speed (and, if needed, the peak
-acceleration) so that the profile still comes to rest exactly at the end.
+The jerk is a sequence of segments: a positive sin² pulse, constant acceleration,
+a negative pulse, cruise at the top speed, and the mirror image to stop. A pulse
+of duration T_j and peak J changes the acceleration by J·T_j/2, so the jerk,
+acceleration and velocity are all continuous and bounded by the given limits.
+Short paths lower the top speed (and, if needed, the peak acceleration) so that
+the profile still comes to rest exactly at the end.
+
+Where the robot cannot hold the process speed (joint limits, see
+``joint_timing``), the speed is capped on stretches of the path: the profile
+then runs through plateaus, slowing down before a capped stretch and speeding
+up after it with the same sin² transitions (``sin2_plateau_law``).
 """
 
 from __future__ import annotations
@@ -25,8 +30,9 @@ class Sin2TimeLaw:
         length: path length to travel [m].
         v_max, a_max, j_max: the limits asked for [m/s, m/s², m/s³].
         v_peak: the top speed reached, v_peak ≤ v_max (lower on short paths).
-        signs: (7,) jerk sign per segment (+1, 0, −1).
-        durations: (7,) segment durations [s].
+        signs: (K,) jerk sign per segment (+1, 0, −1).
+        durations: (K,) segment durations [s].
+        plateaus: ((v, σ_start, σ_end), ...) the cruise speeds and where they hold.
     """
 
     length: float
@@ -36,6 +42,7 @@ class Sin2TimeLaw:
     v_peak: float
     signs: np.ndarray
     durations: np.ndarray
+    plateaus: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def duration(self) -> float:
@@ -49,9 +56,9 @@ class Sin2TimeLaw:
     def _segment_starts(self):
         """Start time and state (σ, σ̇, σ̈) of each segment."""
         starts = np.concatenate([[0.0], np.cumsum(self.durations)[:-1]])
-        state = np.zeros((7, 3))
+        state = np.zeros((len(self.durations), 3))
         s = v = a = 0.0
-        for i in range(7):
+        for i in range(len(self.durations)):
             state[i] = s, v, a
             s, v, a, _ = _pulse(
                 self.signs[i], self.durations[i], self.j_max, s, v, a, np.array([self.durations[i]])
@@ -63,7 +70,7 @@ class Sin2TimeLaw:
         """(σ, σ̇, σ̈, σ⃛) at times t (N,) [m, m/s, m/s², m/s³]; clamped outside."""
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
         starts, state = self._segment_starts()
-        seg = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, 6)
+        seg = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
         tau = t - starts[seg]
         s, v, a, j = _pulse(
             self.signs[seg],
@@ -102,9 +109,106 @@ def _acceleration_phase(v: float, a_max: float, j_max: float) -> tuple[float, fl
     return t_j, v / a_max - t_j
 
 
-def _acceleration_distance(v: float, a_max: float, j_max: float) -> float:
-    t_j, t_a = _acceleration_phase(v, a_max, j_max)
-    return 0.5 * v * (2.0 * t_j + t_a)
+def _transition_distance(v_a: float, v_b: float, a_max: float, j_max: float) -> float:
+    """Distance covered while changing speed from v_a to v_b [m]."""
+    t_j, t_a = _acceleration_phase(abs(v_b - v_a), a_max, j_max)
+    return 0.5 * (v_a + v_b) * (2.0 * t_j + t_a)
+
+
+def _check_limits(**values):
+    for name, value in values.items():
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"time law: {name} must be a positive number, got {value}")
+
+
+def sin2_plateau_law(
+    length: float,
+    caps: list[tuple[float, float, float]],
+    *,
+    a_max: float,
+    j_max: float,
+    v_max: float | None = None,
+) -> Sin2TimeLaw:
+    """Rest-to-rest sin² profile under piecewise-constant speed caps.
+
+    Args:
+        length: distance along the path [m].
+        caps: ((v, σ_start, σ_end), ...) contiguous stretches covering [0, length]
+            with the highest speed allowed on each [m/s].
+        a_max, j_max: limits of σ̈ and σ⃛.
+        v_max: the speed asked for (reported; default the highest cap).
+
+    Returns:
+        A Sin2TimeLaw whose speed never exceeds the cap of the stretch it is on:
+        it slows down before a lower cap and speeds up after it, always inside
+        the faster stretch. Stretches too short to reach their cap get a lower one.
+    """
+    _check_limits(length=length, a_max=a_max, j_max=j_max)
+    speeds = [float(v) for v, _, _ in caps]
+    edges = [float(caps[0][1])] + [float(end) for _, _, end in caps]
+    for v in speeds:
+        _check_limits(speed_cap=v)
+    v_max = max(speeds) if v_max is None else v_max
+
+    def need(i: int, v: float) -> float:
+        """Room plateau i needs at speed v for the transitions it hosts."""
+        before = speeds[i - 1] if i > 0 else 0.0
+        after = speeds[i + 1] if i + 1 < len(speeds) else 0.0
+        return (_transition_distance(before, v, a_max, j_max) if before < v else 0.0) + (
+            _transition_distance(v, after, a_max, j_max) if after < v else 0.0
+        )
+
+    while True:
+        # Merge neighbours with equal speed.
+        i = 0
+        while i + 1 < len(speeds):
+            if speeds[i] == speeds[i + 1]:
+                del speeds[i + 1], edges[i + 1]
+            else:
+                i += 1
+        short = [i for i in range(len(speeds)) if need(i, speeds[i]) > edges[i + 1] - edges[i]]
+        if not short:
+            break
+        i = max(short, key=lambda k: speeds[k])  # fix the fastest first
+        room = edges[i + 1] - edges[i]
+        lower = max(speeds[i - 1] if i > 0 else 0.0, speeds[i + 1] if i + 1 < len(speeds) else 0.0)
+        if need(i, lower) >= room and lower > 0.0:
+            speeds[i] = lower
+        else:
+            speeds[i] = brentq(
+                lambda v: need(i, v) - room, lower, speeds[i], xtol=1e-15, rtol=1e-15
+            )
+
+    signs, durations = [], []
+
+    def transition(v_a: float, v_b: float) -> None:
+        t_j, t_a = _acceleration_phase(abs(v_b - v_a), a_max, j_max)
+        sign = 1.0 if v_b > v_a else -1.0
+        signs.extend([sign, 0.0, -sign])
+        durations.extend([t_j, t_a, t_j])
+
+    for i, v in enumerate(speeds):
+        before = speeds[i - 1] if i > 0 else 0.0
+        after = speeds[i + 1] if i + 1 < len(speeds) else 0.0
+        if before < v:
+            transition(before, v)
+        cruise = edges[i + 1] - edges[i] - need(i, v)
+        signs.append(0.0)
+        durations.append(max(cruise, 0.0) / v)
+        if after < v:
+            transition(v, after)
+    keep = np.asarray(durations) > 0.0
+    plateaus = tuple((v, edges[i], edges[i + 1]) for i, v in enumerate(speeds))
+    return Sin2TimeLaw(
+        length,
+        v_max,
+        a_max,
+        j_max,
+        float(max(speeds)),
+        np.asarray(signs)[keep],
+        np.asarray(durations)[keep],
+        plateaus,
+    )
 
 
 def sin2_time_law(length: float, *, v_max: float, a_max: float, j_max: float) -> Sin2TimeLaw:
@@ -117,20 +221,5 @@ def sin2_time_law(length: float, *, v_max: float, a_max: float, j_max: float) ->
     Returns:
         The Sin2TimeLaw; its v_peak is below v_max when the path is too short.
     """
-    for name, value in (("length", length), ("v_max", v_max), ("a_max", a_max), ("j_max", j_max)):
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"time law: {name} must be a positive number, got {value}")
-    v_peak = v_max
-    if 2.0 * _acceleration_distance(v_max, a_max, j_max) > length:
-        v_peak = brentq(
-            lambda v: 2.0 * _acceleration_distance(v, a_max, j_max) - length,
-            0.0,
-            v_max,
-            xtol=1e-15,
-            rtol=1e-15,
-        )
-    t_j, t_a = _acceleration_phase(v_peak, a_max, j_max)
-    t_v = max(0.0, (length - 2.0 * _acceleration_distance(v_peak, a_max, j_max)) / v_peak)
-    signs = np.array([1, 0, -1, 0, -1, 0, 1], dtype=float)
-    durations = np.array([t_j, t_a, t_j, t_v, t_j, t_a, t_j])
-    return Sin2TimeLaw(length, v_max, a_max, j_max, float(v_peak), signs, durations)
+    _check_limits(length=length, v_max=v_max, a_max=a_max, j_max=j_max)
+    return sin2_plateau_law(length, [(v_max, 0.0, length)], a_max=a_max, j_max=j_max)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from offline_prog.time_law import sin2_time_law
+from offline_prog.time_law import sin2_plateau_law, sin2_time_law
 
 CASES = [  # length, v, a, j: long cruise, no constant-acceleration phase, short path
     (1.0, 0.1, 1.0, 10.0),
@@ -57,3 +57,49 @@ def test_cruise_duration_matches_distance():
 def test_rejects_bad_limits(bad):
     with pytest.raises(ValueError, match="positive"):
         sin2_time_law(1.0, v_max=bad, a_max=1.0, j_max=1.0)
+
+
+PLATEAU_CASES = [
+    [(0.1, 0.0, 0.4), (0.04, 0.4, 0.5), (0.1, 0.5, 1.0)],  # one slow stretch
+    [
+        (0.1, 0.0, 0.3),
+        (0.02, 0.3, 0.31),
+        (0.1, 0.31, 0.33),
+        (0.05, 0.33, 0.6),
+        (0.1, 0.6, 1.0),
+    ],  # a gap too short to speed up in between
+    [(0.03, 0.0, 0.05), (0.1, 0.05, 1.0)],  # capped right at the start
+    [(0.1, 0.0, 0.99), (0.01, 0.99, 1.0)],  # capped right at the end
+]
+
+
+@pytest.mark.parametrize("caps", PLATEAU_CASES)
+def test_plateau_law_respects_every_cap(caps):
+    law = sin2_plateau_law(1.0, caps, a_max=1.0, j_max=10.0, v_max=0.1)
+    t = np.linspace(0.0, law.duration, 100001)
+    s, sd, sdd, sddd = law(t)
+    assert s[-1] == 1.0 and sd[-1] == 0.0 and sd[0] == 0.0
+    assert np.all(np.diff(s) >= -1e-15)
+    assert np.abs(sdd).max() <= 1.0 * (1 + 1e-9)
+    assert np.abs(sddd).max() <= 10.0 * (1 + 1e-9)
+    for v, start, end in caps:
+        inside = (s >= start) & (s <= end)
+        assert sd[inside].max() <= v * (1 + 1e-9)
+    # Continuous velocity and acceleration (no steps beyond what one sample allows).
+    dt = t[1] - t[0]
+    assert np.abs(np.diff(sd)).max() <= 1.0 * dt * 1.01
+    assert np.abs(np.diff(sdd)).max() <= 10.0 * dt * 1.01
+    # It does reach the process speed somewhere when there is room.
+    assert law.v_peak == pytest.approx(0.1)
+
+
+def test_plateau_law_slows_only_where_needed():
+    caps = [(0.1, 0.0, 0.45), (0.05, 0.45, 0.55), (0.1, 0.55, 1.0)]
+    law = sin2_plateau_law(1.0, caps, a_max=1.0, j_max=10.0)
+    t = np.linspace(0.0, law.duration, 100001)
+    s, sd, _, _ = law(t)
+    # Full speed up to shortly before the slow stretch and again shortly after.
+    at_full = sd >= 0.1 * (1 - 1e-9)
+    assert at_full[(s > 0.05) & (s < 0.4)].all()
+    assert at_full[(s > 0.6) & (s < 0.95)].all()
+    assert [round(v, 9) for v, _, _ in law.plateaus] == [0.1, 0.05, 0.1]
