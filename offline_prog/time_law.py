@@ -176,7 +176,11 @@ def sin2_plateau_law(
             speeds[i] = lower
         else:
             speeds[i] = brentq(
-                lambda v: need(i, v) - room, lower, speeds[i], xtol=1e-15, rtol=1e-15
+                lambda v, i=i, room=room: need(i, v) - room,
+                lower,
+                speeds[i],
+                xtol=1e-15,
+                rtol=1e-15,
             )
 
     signs, durations = [], []
