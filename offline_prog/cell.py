@@ -36,6 +36,10 @@ class RobotConfig:
 class ToolConfig:
     X_IT: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
     name: str = "tool"
+    # A tool symmetric about one of T's axes (nozzle, torch) may turn about it by up to
+    # this angle to keep the robot inside its limits; y is the pressing direction n.
+    free_rotation_deg: float = 0.0
+    symmetry_axis: str = "y"
 
 
 @dataclasses.dataclass

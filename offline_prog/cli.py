@@ -52,6 +52,19 @@ def _summary(console: Console, report: dict, files: dict, seconds: float) -> Non
         f"{traj['n_samples']} samples, speed error "
         f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
     )
+    robot = report["robot_motion"]
+    reductions = robot["speed_reductions"]
+    console.print(
+        f"  robot     branch {robot['branch']}, min joint-limit margin "
+        f"{robot['min_joint_limit_margin_deg']:.1f}°, largest joint step "
+        f"{robot['largest_joint_step']['step_deg']:.3f}°, "
+        + (
+            f"speed lowered on {len(reductions)} stretch(es), down to "
+            f"{min(r['speed_m_s'] for r in reductions) * 1e3:.1f} mm/s"
+            if reductions
+            else "process speed held everywhere"
+        )
+    )
     cusps = report["cusps"]
     console.print(
         f"  cusps     {len(cusps)}"

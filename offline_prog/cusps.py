@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 
+from offline_prog.arrays import true_runs
 from offline_prog.bspline_fit import fit_on_knots, open_knots
 from offline_prog.constants import CUSP_MIN_FLANGE_RATIO, CUSP_PEAK_RATIO
 from offline_prog.fixed_tcp import FlangePath, FlangeSamples
@@ -39,12 +40,6 @@ class Cusp:
     angular_rate_rad_per_m: float
 
 
-def _regions(mask: np.ndarray) -> list[np.ndarray]:
-    """Index runs where mask is True."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-    return [np.arange(a, b) for a, b in zip(edges[::2], edges[1::2], strict=True)]
-
-
 def find_cusps(flange: FlangePath) -> list[Cusp]:
     """Scan the flange path on a fine s grid and report cusps and speed peaks.
 
@@ -57,10 +52,13 @@ def find_cusps(flange: FlangePath) -> list[Cusp]:
     f = flange(s)
     ratio = np.linalg.norm(f.dp_IE, axis=1)
     rate = np.linalg.norm(f.w_s, axis=1)
-    events = [(r[np.argmin(ratio[r])], "cusp") for r in _regions(ratio < CUSP_MIN_FLANGE_RATIO)]
+    events = [
+        (a + int(np.argmin(ratio[a:b])), "cusp")
+        for a, b in true_runs(ratio < CUSP_MIN_FLANGE_RATIO)
+    ]
     events += [
-        (r[np.argmax(ratio[r])], "speed_peak")
-        for r in _regions(ratio > CUSP_PEAK_RATIO * np.median(ratio))
+        (a + int(np.argmax(ratio[a:b])), "speed_peak")
+        for a, b in true_runs(ratio > CUSP_PEAK_RATIO * np.median(ratio))
     ]
     cusps = []
     for i, kind in sorted(events):

@@ -37,15 +37,25 @@ def write_atomic(target: Path, text: str) -> None:
         raise
 
 
+def csv_columns(n_joints: int) -> list[str]:
+    """CSV_COLUMNS then q1..qN [rad] and qd1..qdN [rad/s] in the URDF's joint order."""
+    return [
+        *CSV_COLUMNS,
+        *(f"q{i + 1}" for i in range(n_joints)),
+        *(f"qd{i + 1}" for i in range(n_joints)),
+    ]
+
+
 def trajectory_csv(plan: Plan) -> str:
-    """CSV text: header CSV_COLUMNS, one row per sample, SI units (s, m, rad)."""
+    """CSV text: header csv_columns, one row per sample, SI units (s, m, rad)."""
     buffer = io.StringIO()
+    joints = plan.joints
     np.savetxt(
         buffer,
-        plan.trajectory.table(),
+        np.hstack([plan.trajectory.table(), joints.q, joints.qd]),
         delimiter=",",
         fmt="%.10g",
-        header=",".join(CSV_COLUMNS),
+        header=",".join(csv_columns(joints.q.shape[1])),
         comments="",
     )
     return buffer.getvalue()
@@ -76,6 +86,54 @@ def speed_checks(plan: Plan) -> dict[str, float]:
         "tcp_speed_max_error_rel": float(np.abs(measured - commanded).max() / v_peak),
         "chord_speed_max_error_rel": float(chord_error),
         "cruise_samples": int(cruise.sum()),
+    }
+
+
+def _merged(stretches):
+    """Contiguous (σ_start, σ_end, speed) stretches joined, keeping the lowest speed."""
+    out = []
+    for start, end, speed in stretches:
+        if out and start <= out[-1][1] + 1e-9:
+            out[-1] = (out[-1][0], end, min(out[-1][2], speed))
+        else:
+            out.append((start, end, speed))
+    return out
+
+
+def robot_report(plan: Plan) -> dict:
+    """Branch, joint-limit margins, joint steps, singularities and speed reductions."""
+    robot, joints = plan.robot, plan.joints
+    retiming, top = joints.retiming, plan.cell.motion.speed
+    joint, sigma, step = joints.largest_step
+    use_speed = np.abs(joints.qd) / robot.qd_max
+    use_accel = np.abs(joints.qdd) / robot.qdd_max
+    return {
+        "model": robot.name,
+        "joint_names": list(robot.joint_names),
+        "branch": joints.branch,
+        "feasible_branches": [b.branch for b in joints.branches if b.feasible],
+        "tool_rotation_deg": float(np.rad2deg(plan.tool_rotation_rad)),
+        "joint_limit_margin_deg": np.rad2deg(joints.margin_rad).round(3).tolist(),
+        "min_joint_limit_margin_deg": float(np.rad2deg(joints.margin_rad.min())),
+        "largest_joint_step": {
+            "joint": joint + 1,
+            "sigma_m": sigma,
+            "step_deg": float(np.rad2deg(step)),
+        },
+        "max_joint_speed_use": use_speed.max(axis=0).round(4).tolist(),
+        "max_joint_acceleration_use": use_accel.max(axis=0).round(4).tolist(),
+        "singularities": joints.singularities,
+        "speed_reductions": [
+            {
+                "sigma_start_m": a,
+                "sigma_end_m": b,
+                "speed_m_s": v,
+                "reduction_percent": 100.0 * (1.0 - v / top),
+            }
+            for a, b, v in _merged(retiming.reductions)
+        ],
+        "ramp_acceleration_scale": retiming.a_scale,
+        "cycle_time_without_joint_limits_s": plan.nominal_duration_s,
     }
 
 
@@ -131,6 +189,7 @@ def report(plan: Plan) -> dict:
             "max_angular_speed_rad_s": float(np.linalg.norm(tr.w_IE_I, axis=1).max()),
             **speed_checks(plan),
         },
+        "robot_motion": robot_report(plan),
         "cusps": [c.__dict__ for c in plan.cusps],
         "cusp_smoothing": smoothing,
         "timings_s": plan.timings_s,

@@ -158,7 +158,7 @@ def sin2_plateau_law(
             _transition_distance(v, after, a_max, j_max) if after < v else 0.0
         )
 
-    while True:
+    for _ in range(10_000):  # speeds only decrease, so this settles
         # Merge neighbours with equal speed.
         i = 0
         while i + 1 < len(speeds):
@@ -166,7 +166,11 @@ def sin2_plateau_law(
                 del speeds[i + 1], edges[i + 1]
             else:
                 i += 1
-        short = [i for i in range(len(speeds)) if need(i, speeds[i]) > edges[i + 1] - edges[i]]
+        short = [
+            i
+            for i in range(len(speeds))
+            if need(i, speeds[i]) > (edges[i + 1] - edges[i]) * (1 + 1e-9)
+        ]
         if not short:
             break
         i = max(short, key=lambda k: speeds[k])  # fix the fastest first
@@ -174,7 +178,7 @@ def sin2_plateau_law(
         lower = max(speeds[i - 1] if i > 0 else 0.0, speeds[i + 1] if i + 1 < len(speeds) else 0.0)
         if need(i, lower) >= room and lower > 0.0:
             speeds[i] = lower
-        else:
+        else:  # the highest speed whose transitions fit (slightly below, for rounding)
             speeds[i] = brentq(
                 lambda v, i=i, room=room: need(i, v) - room,
                 lower,
@@ -182,6 +186,8 @@ def sin2_plateau_law(
                 xtol=1e-15,
                 rtol=1e-15,
             )
+    else:
+        raise RuntimeError("sin2_plateau_law: plateau speeds did not settle")
 
     signs, durations = [], []
 

@@ -58,6 +58,7 @@ class WorkspaceTrajectory:
         tcp_speed: (N,) speed of the part point under the TCP relative to the tool
             [m/s], from the rigid-body velocity of the part.
         law: the time law; reference: "tcp" or "flange".
+        sigma: (N,) the time law's parameter σ(t) (= s for the tcp reference) [m].
     """
 
     t: np.ndarray
@@ -73,6 +74,7 @@ class WorkspaceTrajectory:
     tcp_speed: np.ndarray
     law: Sin2TimeLaw
     reference: str
+    sigma: np.ndarray
 
     @property
     def duration(self) -> float:
@@ -103,40 +105,48 @@ def sample_times(duration: float, rate_hz: float) -> np.ndarray:
     return t
 
 
-def plan_workspace_trajectory(
-    flange: FlangePath,
-    *,
-    v_max: float,
-    a_max: float,
-    j_max: float,
-    reference: str = "tcp",
-    rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
-) -> WorkspaceTrajectory:
-    """Time the flange path with the sin² law and sample it (paper §4).
+class TimeLawParameter:
+    """The time law's path parameter σ and its map to the TCP arc length s.
+
+    "tcp": σ = s (the process speed is held at the tool). "flange": σ = λ, the
+    arc length along the flange path, with s(λ) from the true arc-length map.
 
     Args:
         flange: the flange path X_IE(s).
-        v_max, a_max, j_max: limits of σ̇, σ̈, σ⃛ [m/s, m/s², m/s³].
-        reference: "tcp" (σ = s, the process speed at the tool) or "flange"
-            (σ = λ, the speed of the flange origin).
-        rate_hz: sample rate [Hz].
+        reference: "tcp" or "flange".
     """
-    if reference == "tcp":
-        law = sin2_time_law(flange.length, v_max=v_max, a_max=a_max, j_max=j_max)
-        t = sample_times(law.duration, rate_hz)
-        s, s_dot, s_ddot, _ = law(t)
-    elif reference == "flange":
-        s_knots = flange.path.map.s_of_u(flange.path.fitted.breakpoints)
-        lam_map = flange_arc_length(flange, s_knots)
-        law = sin2_time_law(lam_map.length, v_max=v_max, a_max=a_max, j_max=j_max)
-        t = sample_times(law.duration, rate_hz)
-        lam, lam_dot, lam_ddot, _ = law(t)
-        s, ds, dds = lam_map.u_of_s(lam, order=2)
-        s_dot = ds * lam_dot
-        s_ddot = dds * lam_dot**2 + ds * lam_ddot
-    else:
-        raise ValueError(f"speed_reference must be 'tcp' or 'flange', got {reference!r}")
 
+    def __init__(self, flange, reference: str = "tcp"):
+        if reference not in ("tcp", "flange"):
+            raise ValueError(f"speed_reference must be 'tcp' or 'flange', got {reference!r}")
+        self.reference = reference
+        self._map = None
+        if reference == "flange":
+            s_knots = flange.path.map.s_of_u(flange.path.fitted.breakpoints)
+            self._map = flange_arc_length(flange, s_knots)
+        self.length = flange.length if self._map is None else self._map.length
+
+    def s(self, sigma: np.ndarray) -> list[np.ndarray]:
+        """[s, ds/dσ, d²s/dσ²] at σ (N,), each (N,)."""
+        sigma = np.asarray(sigma, dtype=float)
+        if self._map is None:
+            return [sigma, np.ones_like(sigma), np.zeros_like(sigma)]
+        return self._map.u_of_s(sigma, order=2)
+
+
+def sample_workspace_trajectory(
+    flange,
+    parameter: TimeLawParameter,
+    law: Sin2TimeLaw,
+    *,
+    rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
+) -> WorkspaceTrajectory:
+    """Sample the flange path timed by ``law`` over σ (paper §4, eq. 9)."""
+    t = sample_times(law.duration, rate_hz)
+    sigma, sigma_dot, sigma_ddot, _ = law(t)
+    s, ds, dds = parameter.s(sigma)
+    s_dot = ds * sigma_dot
+    s_ddot = dds * sigma_dot**2 + ds * sigma_ddot
     f = flange(s)
     v_IE = f.dp_IE * s_dot[:, None]
     a_IE = f.ddp_IE * (s_dot**2)[:, None] + f.dp_IE * s_ddot[:, None]
@@ -158,5 +168,29 @@ def plan_workspace_trajectory(
         rpy_IE=tait_bryan_xyz(f.R_IE),
         tcp_speed=np.linalg.norm(v_IQ, axis=1),
         law=law,
-        reference=reference,
+        reference=parameter.reference,
+        sigma=sigma,
     )
+
+
+def plan_workspace_trajectory(
+    flange,
+    *,
+    v_max: float,
+    a_max: float,
+    j_max: float,
+    reference: str = "tcp",
+    rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
+) -> WorkspaceTrajectory:
+    """Time the flange path with the sin² law and sample it (paper §4).
+
+    Args:
+        flange: the flange path X_IE(s).
+        v_max, a_max, j_max: limits of σ̇, σ̈, σ⃛ [m/s, m/s², m/s³].
+        reference: "tcp" (σ = s, the process speed at the tool) or "flange"
+            (σ = λ, the speed of the flange origin).
+        rate_hz: sample rate [Hz].
+    """
+    parameter = TimeLawParameter(flange, reference)
+    law = sin2_time_law(parameter.length, v_max=v_max, a_max=a_max, j_max=j_max)
+    return sample_workspace_trajectory(flange, parameter, law, rate_hz=rate_hz)

@@ -17,14 +17,14 @@ robot:
   model: kuka_kr16_2
   X_IB: {translation: [0, 0, 0], rotation: !Rpy {deg: [0, 0, 0]}}
 tool:
-  X_IT: {translation: [1.0, 0, 0.6], rotation: !Rpy {deg: [-90, 0, 0]}}
+  X_IT: {translation: [1.0, 0, 0.5], rotation: !Rpy {deg: [90, 0, 0]}}
 part:
-  X_PE: {translation: [0, 0, -0.1], rotation: !Rpy {deg: [0, 0, 0]}}
+  X_PE: {translation: [0, 0, 0.1], rotation: !Rpy {deg: [180, 0, 0]}}
 path:
   points: path.csv
   units: mm
   closed: false
-  normal: [0, 0, -1]
+  normal: [0, 0, 1]
 motion:
   speed: 0.1
   max_acceleration: 1.0
@@ -54,14 +54,23 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ("speed: 0.1", "speed: .nan", "motion.speed", "not a finite number"),
     ("speed: 0.1", "speed: -0.1", "motion.speed", "must be > 0"),
     ("speed: 0.1", "speed: fast", "motion.speed", "expected float"),
-    ("[1.0, 0, 0.6]", "[1.0, 0]", "tool.X_IT.translation", "3 numbers"),
-    ("[1.0, 0, 0.6]", "[1.0, .nan, 0.6]", "tool.X_IT.translation", "NaN"),
-    ("!Rpy {deg: [-90, 0, 0]}", "{deg: [-90, 0, 0]}", "tool.X_IT.rotation", "!Rpy"),
+    ("[1.0, 0, 0.5]", "[1.0, 0]", "tool.X_IT.translation", "3 numbers"),
+    ("[1.0, 0, 0.5]", "[1.0, .nan, 0.5]", "tool.X_IT.translation", "NaN"),
+    ("!Rpy {deg: [90, 0, 0]}", "{deg: [90, 0, 0]}", "tool.X_IT.rotation", "!Rpy"),
+    ("name: test", "name: test\ntool_typo: {}", "tool_typo", "unknown key"),
+    ("X_IT: {", "free_rotation_deg: 270\n  X_IT: {", "tool.free_rotation_deg", "within"),
+    ("X_IT: {", "symmetry_axis: w\n  X_IT: {", "tool.symmetry_axis", "use x, y or z"),
     ("model: kuka_kr16_2", "model: no_such_robot", "robot.model", "not a robot folder"),
     ("closed: false", "closed: maybe", "path.closed", "expected bool"),
-    ("  normal: [0, 0, -1]\n", "", "path.normal", "exactly one way"),
-    ("normal: [0, 0, -1]", "normal: [1, 0, 0]", "path.normal", "tangent"),
-    ("normal: [0, 0, -1]", "normal: [0, 0, 0]", "path.normal", "zero vector"),
+    ("  normal: [0, 0, 1]\n", "", "path.normal", "exactly one way"),
+    ("normal: [0, 0, 1]", "normal: [1, 0, 0]", "path.normal", "tangent"),
+    ("normal: [0, 0, 1]", "normal: [0, 0, 0]", "path.normal", "zero vector"),
+    (
+        "max_jerk: 10.0",
+        "max_jerk: 10.0\n  cusp_smoothing_mm: 0",
+        "motion.cusp_smoothing_mm",
+        "must be > 0",
+    ),
     ("units: mm", "units: mm\n  degree: 3", "path.degree", "< 5"),
     ("  closed: false", "  closed: false\n  dxf: a.dxf", "path", "exactly one of"),
     ("path:\n", "path:\n  analytic: {kind: spiral}\n", "path", "exactly one of"),

@@ -12,7 +12,10 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from offline_prog.cell import load_cell, transform
-from offline_prog.plan import load_points
+from offline_prog.inputs import load_points
+from offline_prog.drake_cell import build_drake_cell
+from offline_prog.outputs import csv_columns
+from offline_prog.robot_model import load_robot
 from offline_prog.trajectory import CSV_COLUMNS
 
 from conftest import CELLS, REPO
@@ -40,7 +43,8 @@ def planned(request, tmp_path_factory):
 
 def test_header_and_sampling(planned):
     cell_file, header, table, report = planned
-    assert header == CSV_COLUMNS
+    assert header == csv_columns(6)
+    assert header[: len(CSV_COLUMNS)] == CSV_COLUMNS
     t = table[:, 0]
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(np.diff(t)[:-1], 1 / 250.0, atol=1e-9)
@@ -91,11 +95,49 @@ def test_tcp_speed_is_the_commanded_speed(planned):
     np.testing.assert_allclose(v_tcp, table[:, col["tcp_speed"]], atol=1e-8)
     speed = report["motion"]["top_speed_m_s"]
     assert v_tcp.max() <= speed * (1 + 1e-8)
-    # σ̇ from the sigma column: cruise at the commanded speed within 0.05 %.
+    assert table[:, col["tcp_speed"]].max() <= speed * (1 + 1e-9)
+    # σ from positions alone (chord per time step) matches the TCP speed within 0.05 %.
     sigma_dot = np.diff(table[:, col["sigma"]]) / np.diff(table[:, col["t"]])
+    mid_speed = 0.5 * (table[1:, col["tcp_speed"]] + table[:-1, col["tcp_speed"]])
+    moving = mid_speed > 0.1 * speed
+    dt = np.diff(table[:, col["t"]])[moving]
+    midpoint_rule = dt**2 * cell.motion.max_jerk / 8  # chord vs endpoint-mean difference
+    assert np.all(np.abs(sigma_dot[moving] - mid_speed[moving]) <= 5e-4 * speed + midpoint_rule)
+    # The process speed is held over long stretches (lowered only where the joints
+    # need it, see the report's speed reductions).
     at_speed = table[:, col["tcp_speed"]] >= speed * (1 - 1e-9)
-    cruise = at_speed[:-1] & at_speed[1:]
-    assert cruise.sum() > 0.5 * len(sigma_dot)
-    assert np.abs(sigma_dot[cruise] - speed).max() <= 5e-4 * speed
+    assert at_speed.mean() >= 0.4
     assert report["trajectory"]["chord_speed_max_error_rel"] <= 5e-4
     assert report["trajectory"]["tcp_speed_max_error_rel"] <= 1e-9
+
+
+def test_joint_columns_drive_the_flange_along_the_planned_poses(planned):
+    """Drake's FK of the URDF at q1..q6 reproduces the planned flange pose (what the
+    controller will do is what the preview shows), within the joint limits."""
+    cell_file, header, table, report = planned
+    cell = load_cell(cell_file)
+    col = {name: i for i, name in enumerate(header)}
+    robot = load_robot(cell.robot.model)
+    drake = build_drake_cell(
+        robot,
+        X_IB=transform(cell.robot.X_IB),
+        X_IT=transform(cell.tool.X_IT),
+        X_PE=transform(cell.part.X_PE),
+    )
+    q = table[:, [col[f"q{i}"] for i in range(1, 7)]]
+    qd = table[:, [col[f"qd{i}"] for i in range(1, 7)]]
+    assert np.all(q >= robot.q_lower) and np.all(q <= robot.q_upper)
+    assert np.all(np.abs(qd) <= robot.qd_max * (1 + 1e-6))
+    rows = np.linspace(0, len(table) - 1, 60).astype(int)
+    for i in rows:
+        X_IE = drake.X_IE(q[i])
+        p_csv = table[i, [col["x"], col["y"], col["z"]]]
+        R_csv = Rotation.from_euler("XYZ", table[i, [col["alpha"], col["beta"], col["gamma"]]])
+        assert np.linalg.norm(X_IE.translation() - p_csv) <= 1e-8
+        R_err = Rotation.from_matrix(X_IE.rotation().matrix()) * R_csv.inv()
+        assert R_err.magnitude() <= 1e-8
+    # qd is the time derivative of q (central differences, interior samples).
+    t = table[:, col["t"]]
+    fd = (q[2:] - q[:-2]) / (t[2:] - t[:-2])[:, None]
+    assert np.abs(fd - qd[1:-1]).max() <= 1e-3 * max(np.abs(qd).max(), 1e-3)
+    assert report["robot_motion"]["min_joint_limit_margin_deg"] > 0
