@@ -13,13 +13,14 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from scipy.interpolate import CubicHermiteSpline
 
 from offline_prog.constants import ARC_LENGTH_TOLERANCE_M
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
-SpeedFunction = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray | None]]
-"""u (N,) ↦ (g, dg/du, d²g/du²) with g = |dr/du| > 0; the last may be None."""
+SpeedFunction = Callable[..., tuple]
+"""(u (N,), order) ↦ (g, dg/du, d²g/du²)[: order + 1] with g = |dr/du| > 0."""
 
 
 class ArcLengthMap:
@@ -50,8 +51,13 @@ class ArcLengthMap:
         cell_lengths = self._integral(self._grid[:-1], self._grid[1:])
         self._cumulative = np.concatenate([[0.0], np.cumsum(cell_lengths)])
         self.length = float(self._cumulative[-1])
-        g_min = float(speed(self._grid)[0].min())
-        self.min_speed = g_min
+        g_grid = speed(self._grid, 0)[0]
+        self.min_speed = float(g_grid.min())
+        # Initial guess for Newton: cubic Hermite u(s) with the exact slopes du/ds = 1/g,
+        # so that one or two Newton steps reach machine precision.
+        self._guess = None
+        if self.min_speed > 0.0:
+            self._guess = CubicHermiteSpline(self._cumulative, self._grid, 1.0 / g_grid)
 
     @property
     def u_min(self) -> float:
@@ -65,7 +71,7 @@ class ArcLengthMap:
         """(N,) ∫_a^b g by 8-point Gauss–Legendre, vectorized over intervals."""
         half = 0.5 * (b - a)
         nodes = (0.5 * (a + b))[:, None] + half[:, None] * _GL_X
-        g = self.speed(nodes.ravel())[0].reshape(nodes.shape)
+        g = self.speed(nodes.ravel(), 0)[0].reshape(nodes.shape)
         return half * (g @ _GL_W)
 
     def s_of_u(self, u: np.ndarray) -> np.ndarray:
@@ -92,17 +98,26 @@ class ArcLengthMap:
             [u, du/ds, d²u/ds², d³u/ds³][: order + 1], each (N,).
         """
         s = self.wrap(s)
-        u = np.interp(s, self._cumulative, self._grid)
+        if self._guess is None:
+            u = np.interp(s, self._cumulative, self._grid)
+        else:
+            u = np.clip(self._guess(s), self.u_min, self.u_max)
         for _ in range(8):
             error = self.s_of_u(u) - s
             if np.max(np.abs(error), initial=0.0) < ARC_LENGTH_TOLERANCE_M:
                 break
-            u = np.clip(u - error / self.speed(u)[0], self.u_min, self.u_max)
-        g, g1, g2 = self.speed(u)
-        out = [u, 1.0 / g, -g1 / g**3]
+            u = np.clip(u - error / self.speed(u, 0)[0], self.u_min, self.u_max)
+        g_derivatives = self.speed(u, min(order, 3) - 1) if order > 0 else ()
+        out = [u]
+        if order >= 1:
+            g = g_derivatives[0]
+            out.append(1.0 / g)
+        if order >= 2:
+            out.append(-g_derivatives[1] / g**3)
         if order >= 3:
+            g1, g2 = g_derivatives[1], g_derivatives[2]
             out.append(-g2 / g**4 + 3.0 * g1**2 / g**5)
-        return out[: order + 1]
+        return out
 
 
 def compose_derivatives(c: list[np.ndarray], u: list[np.ndarray]) -> list[np.ndarray]:
@@ -130,10 +145,16 @@ def compose_derivatives(c: list[np.ndarray], u: list[np.ndarray]) -> list[np.nda
 def curve_speed(derivatives: Callable[[np.ndarray, int], np.ndarray]) -> SpeedFunction:
     """SpeedFunction g = |c'|, g' = c'·c''/g, g'' = (|c''|² + c'·c''' − g'²)/g."""
 
-    def speed(u: np.ndarray):
-        c1, c2, c3 = derivatives(u, 1), derivatives(u, 2), derivatives(u, 3)
+    def speed(u: np.ndarray, order: int = 2):
+        c1 = derivatives(u, 1)
         g = np.linalg.norm(c1, axis=1)
+        if order == 0:
+            return (g,)
+        c2 = derivatives(u, 2)
         g1 = np.einsum("ij,ij->i", c1, c2) / g
+        if order == 1:
+            return g, g1
+        c3 = derivatives(u, 3)
         g2 = (np.einsum("ij,ij->i", c2, c2) + np.einsum("ij,ij->i", c1, c3) - g1**2) / g
         return g, g1, g2
 
@@ -152,10 +173,18 @@ class ArcLengthPath:
         self.closed = fitted.closed
         self.map = ArcLengthMap(curve_speed(fitted), fitted.breakpoints, periodic=fitted.closed)
         self.length = self.map.length
+        self._last: tuple[np.ndarray, list[np.ndarray]] | None = None
 
     def parameter(self, s: np.ndarray, order: int = 3) -> list[np.ndarray]:
-        """[u, u', u'', u'''] of the fitted spline at arc length s."""
-        return self.map.u_of_s(s, order)
+        """[u, u', u'', u'''][: order + 1] of the fitted spline at arc length s.
+
+        The flange path, the process frames and the normal field ask for the same
+        s in turn; the last answer is kept so that the Newton solve runs once.
+        """
+        s = np.asarray(s, dtype=float)
+        if self._last is None or not np.array_equal(self._last[0], s):
+            self._last = (s.copy(), self.map.u_of_s(s, 3))
+        return self._last[1][: order + 1]
 
     def __call__(self, s: np.ndarray, order: int = 3) -> list[np.ndarray]:
         u = self.parameter(s, max(order, 1))

@@ -103,7 +103,10 @@ class BranchPath:
         q_minus, q_plus = self.q(center - h, q0), self.q(center + h, q0)
         dq = (q_plus - q_minus) / (2 * h)
         ddq = (q_plus - 2 * q0 + q_minus) / h**2
-        q = self.q(sigma, q0)
+        shifted = sigma != center  # only within h of the path's ends
+        q = q0.copy()
+        if shifted.any():
+            q[shifted] = self.q(sigma[shifted], q0[shifted])
         return JointRates(sigma, q, dq + ddq * (sigma - center)[:, None], ddq)
 
 

@@ -35,10 +35,12 @@ def tait_bryan_xyz(R: np.ndarray) -> np.ndarray:
 def flange_arc_length(flange: FlangePath, s_breakpoints: np.ndarray) -> ArcLengthMap:
     """λ(s) = ∫ |dp_IE/ds| ds: arc length along the flange path as a function of s."""
 
-    def speed(s: np.ndarray):
+    def speed(s: np.ndarray, order: int = 1):
         f = flange(s)
         g = np.linalg.norm(f.dp_IE, axis=1)
-        return g, np.einsum("ij,ij->i", f.dp_IE, f.ddp_IE) / g, None
+        if order == 0:
+            return (g,)
+        return g, np.einsum("ij,ij->i", f.dp_IE, f.ddp_IE) / g
 
     return ArcLengthMap(speed, s_breakpoints, periodic=False)
 

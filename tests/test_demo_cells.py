@@ -12,8 +12,8 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from offline_prog.cell import load_cell, transform
-from offline_prog.inputs import load_points
 from offline_prog.drake_cell import build_drake_cell
+from offline_prog.inputs import load_points
 from offline_prog.outputs import csv_columns
 from offline_prog.robot_model import load_robot
 from offline_prog.trajectory import CSV_COLUMNS
