@@ -68,7 +68,9 @@ def best_turns(q: np.ndarray, lower: np.ndarray, upper: np.ndarray):
         offsets: (B, 6) multiples of 2π to add [rad]; margins: (B, 6) the smallest
         distance of each shifted joint path to its limits [rad].
     """
-    q_min, q_max = np.nanmin(q, axis=1), np.nanmax(q, axis=1)  # (B, 6)
+    with np.errstate(invalid="ignore"):  # branches with no solution at all stay NaN
+        q_min = np.nanmin(np.where(np.isnan(q), np.inf, q), axis=1)  # (B, 6)
+        q_max = np.nanmax(np.where(np.isnan(q), -np.inf, q), axis=1)
     shifts = 2.0 * np.pi * TURN_CANDIDATES  # (K,)
     margin = np.minimum(
         q_min[..., None] + shifts - lower[:, None], upper[:, None] - q_max[..., None] - shifts

@@ -1,0 +1,85 @@
+"""Joint trajectory of whole cells: a closed contour's full turn fits the wrist,
+a symmetric tool's free rotation rescues a pose the robot cannot reach otherwise,
+the Drake plant agrees with the plan."""
+
+import numpy as np
+import pytest
+from conftest import CELLS
+
+from offline_prog.drake_cell import build_drake_cell
+from offline_prog.plan import PlanInfeasibleError, plan_cell
+
+WELD = (
+    (CELLS / "weld_seam_irb2400.yaml").read_text().replace("dxf: data/", f"dxf: {CELLS / 'data'}/")
+)
+TORCH_POSE = "X_IT: {translation: [1.1, 0.0, 0.9], rotation: !Rpy {deg: [-90, 0, 0]}}"
+
+
+@pytest.fixture(scope="module")
+def seal_plan():
+    return plan_cell(CELLS / "seal_plate_kr16.yaml")
+
+
+def test_closed_contour_turns_the_wrist_once_within_its_limits(seal_plan):
+    q = seal_plan.joints.q
+    robot = seal_plan.robot
+    assert np.all(q >= robot.q_lower) and np.all(q <= robot.q_upper)
+    # The part turns once about the vertical nozzle: A1 and A6 together turn 2π.
+    turn = (q[-1] - q[0])[[0, 5]]
+    assert abs(abs(turn[0] - turn[1]) - 2 * np.pi) < 1e-6 or abs(abs(turn[1]) - 2 * np.pi) < 0.2
+    assert np.ptp(q[:, 5]) > np.pi  # more than half a turn on A6
+    # Closed: the robot ends where it started, modulo full turns.
+    np.testing.assert_allclose(np.angle(np.exp(1j * (q[-1] - q[0]))), 0.0, atol=1e-6)
+
+
+def test_joint_path_is_continuous(seal_plan):
+    joint, sigma, step = seal_plan.joints.largest_step
+    qd_max, dt = seal_plan.robot.qd_max, 1 / seal_plan.cell.motion.sample_rate_hz
+    assert step <= qd_max[joint] * dt  # no jump beyond what the joint speed allows
+    assert np.abs(np.diff(seal_plan.joints.q, axis=0)).max() == pytest.approx(step)
+
+
+def test_drake_plant_places_the_part_on_the_tool(seal_plan):
+    cell = seal_plan.cell
+    from offline_prog.cell import transform
+
+    drake = build_drake_cell(
+        seal_plan.robot,
+        X_IB=transform(cell.robot.X_IB),
+        X_IT=transform(cell.tool.X_IT),
+        X_PE=transform(cell.part.X_PE),
+    )
+    plant = drake.plant
+    context = plant.CreateDefaultContext()
+    part = plant.GetBodyByName("part")
+    tool = plant.GetBodyByName("tool")
+    traj = seal_plan.trajectory
+    for i in np.linspace(0, len(traj.t) - 1, 25).astype(int):
+        plant.SetPositions(context, drake.robot, seal_plan.joints.q[i])
+        X_IP = plant.EvalBodyPoseInWorld(context, part)
+        X_IT = plant.EvalBodyPoseInWorld(context, tool)
+        # The path point under the TCP, through the plant: X_IP · p_PF(σ) = p_IT.
+        p_I = X_IP @ traj.flange.p_PF[i]
+        assert np.linalg.norm(p_I - X_IT.translation()) <= 1e-9
+
+
+def test_free_rotation_rescues_a_pose_out_of_the_joint_limits(tmp_path):
+    turned = WELD.replace(TORCH_POSE, TORCH_POSE.replace("[-90, 0, 0]", "[-90, 0, -90]"))
+    assert turned != WELD
+    fixed = tmp_path / "turned.yaml"
+    fixed.write_text(turned)
+    with pytest.raises(PlanInfeasibleError, match="joint limit on axis 5"):
+        plan_cell(fixed)
+    free = tmp_path / "free.yaml"
+    free.write_text(
+        turned.replace("  name: welding_torch", "  name: welding_torch\n  free_rotation_deg: 60")
+    )
+    plan = plan_cell(free)
+    assert 0 < abs(plan.tool_rotation_rad) <= np.deg2rad(60) + 1e-12
+    assert plan.joints.margin_rad.min() > 0
+    # The torch axis (y of T, the pressing direction) still meets the surface normal.
+    R_IE = plan.trajectory.flange.R_IE
+    R_PE = plan.flange.X_PE.rotation().matrix()
+    n_I = (R_IE @ R_PE.T) @ np.array([0.0, 0.0, -1.0])  # the seam's normal, into the part
+    y_T = plan.flange.X_IT.rotation().matrix()[:, 1]
+    np.testing.assert_allclose(n_I, np.broadcast_to(y_T, n_I.shape), atol=1e-9)
