@@ -4,10 +4,11 @@ the Drake plant agrees with the plan."""
 
 import numpy as np
 import pytest
-from conftest import CELLS
 
 from offline_prog.drake_cell import build_drake_cell
 from offline_prog.plan import PlanInfeasibleError, plan_cell
+
+from conftest import CELLS
 
 WELD = (
     (CELLS / "weld_seam_irb2400.yaml").read_text().replace("dxf: data/", f"dxf: {CELLS / 'data'}/")

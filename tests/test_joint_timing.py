@@ -36,7 +36,7 @@ def test_slows_down_only_near_the_fast_stretch():
     # Lowered once, around σ = 0.5 m; full process speed elsewhere (away from ramps).
     assert len(result.reductions) >= 1
     for start, end, v in result.reductions:
-        assert 0.35 < start and end < 0.65 and v < 0.2
+        assert start > 0.35 and end < 0.65 and v < 0.2
     _, sd, sdd, sddd = result.law(t)
     far = (sigma > 0.1) & (sigma < 0.3) | (sigma > 0.7) & (sigma < 0.9)
     assert np.all(sd[far] >= 0.2 * (1 - 1e-9))

@@ -3,12 +3,13 @@ failures that say where and why."""
 
 import numpy as np
 import pytest
-from conftest import CELLS
 from pydrake.math import RigidTransform
 
 from offline_prog.path_ik import base_poses, best_turns, branch_results, choose_branch
 from offline_prog.plan import PlanInfeasibleError, plan_cell
 from offline_prog.robot_model import load_robot
+
+from conftest import CELLS
 
 ROBOTS = ["ur10e", "kuka_kr16_2", "abb_irb2400"]
 
