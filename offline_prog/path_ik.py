@@ -23,6 +23,7 @@ from offline_prog.robot_model import RobotModel
 MAX_JOINT_STEP_RAD = np.deg2rad(10.0)
 # Candidate turns k in q + 2πk for joints with more than one turn of range.
 TURN_CANDIDATES = np.arange(-2, 3)
+TWO_PI = 2.0 * np.pi
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,12 +86,15 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
     solutions = np.swapaxes(robot.inverse(X_BE), 0, 1)  # (8, N, 6)
     reachable = ~np.isnan(solutions).any(axis=-1)  # (8, N)
     filled = np.where(reachable[..., None], solutions, 0.0)
-    q = np.unwrap(filled, axis=1)
+    # Unwrap along the path: each step taken as its equivalent in [−π, π).
+    step = np.diff(filled, axis=1)
+    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
+    q = np.concatenate([filled[:, :1], filled[:, :1] + np.cumsum(step, axis=1)], axis=1)
     offsets, margins = best_turns(
         np.where(reachable[..., None], q, np.nan), robot.q_lower, robot.q_upper
     )
     q = q + offsets[:, None, :]
-    steps = np.abs(np.diff(q, axis=1)).max(axis=-1)  # (8, N−1)
+    steps = np.abs(step).max(axis=-1)  # (8, N−1)
     results = []
     for b in range(8):
         margin = float(margins[b].min())

@@ -1,0 +1,162 @@
+"""Benchmark: plan the demo cells stage by stage, and compare path IK with references.
+
+Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]``
+
+All figures come from the same process on the same machine, so the ratios
+hold even where the absolute numbers drift. Path IK is compared on one flange
+path of ``--samples`` poses (the demo cell's own path, resampled):
+
+- offline_prog: all eight analytic solutions per pose, branch unwrapping, 2π
+  start choice, joint-limit and continuity checks (``path_ik``), vectorized;
+- Drake InverseKinematics, one solve per sample seeded with the previous one
+  (``drake_ik.solve_path``, the obvious baseline), on the first --drake-samples;
+- py-opw-kinematics (Rust) ``batch_inverse`` on the same poses (OPW robots only).
+
+Each reports samples per second and the max pose error of its solution (FK of
+the returned joints against the target, by this package's analytic FK, which
+tests tie to Drake's FK of the URDF to 1e-15).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+
+from offline_prog.cell import transform
+from offline_prog.drake_cell import build_drake_cell
+from offline_prog.drake_ik import solve_path, solve_pose
+from offline_prog.path_ik import base_poses, branch_results, choose_branch
+from offline_prog.plan import plan_cell
+
+CELLS = Path(__file__).resolve().parents[1] / "cells"
+
+
+def best_of(repeats: int, function):
+    """(smallest wall time [s], last result) over ``repeats`` calls."""
+    best, result = np.inf, None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = function()
+        best = min(best, time.perf_counter() - start)
+    return best, result
+
+
+def pose_errors(X_target: np.ndarray, X_got: np.ndarray) -> tuple[float, float]:
+    """Max position [m] and angle [rad] error between (N, 4, 4) pose arrays."""
+    from scipy.spatial.transform import Rotation
+
+    distance = np.linalg.norm(X_target[:, :3, 3] - X_got[:, :3, 3], axis=1)
+    R = np.swapaxes(X_target[:, :3, :3], 1, 2) @ X_got[:, :3, :3]
+    ok = ~np.isnan(R).any(axis=(1, 2))
+    angle = Rotation.from_matrix(R[ok]).magnitude()  # accurate near 0, unlike arccos
+    return float(np.nanmax(distance)), float(angle.max())
+
+
+def bench_stages(cells: list[Path]) -> None:
+    print("== planning the demo cells (stage times, best of 3) ==")
+    for file in cells:
+        total, plan = best_of(3, lambda file=file: plan_cell(file))
+        stages = ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in plan.timings_s.items())
+        print(
+            f"{file.stem:24s} {len(plan.trajectory.t):6d} samples  total {total:.3f} s  ({stages})"
+        )
+
+
+def py_opw_robot(robot):
+    try:
+        import py_opw_kinematics as py_opw
+    except ImportError:
+        return None
+    p = robot.params
+    model = py_opw.KinematicModel(
+        a1=p.a1,
+        a2=p.a2,
+        b=p.b,
+        c1=p.c1,
+        c2=p.c2,
+        c3=p.c3,
+        c4=p.c4,
+        offsets=p.offsets,
+        flip_axes=tuple(s < 0 for s in p.sign_corrections),
+    )
+    return py_opw.Robot(model, degrees=False)
+
+
+def bench_path_ik(file: Path, n_samples: int, n_drake: int) -> None:
+    plan = plan_cell(file)
+    robot, cell = plan.robot, plan.cell
+    X_IB = transform(cell.robot.X_IB)
+    f = plan.flange(np.linspace(0.0, plan.flange.length, n_samples))
+    X_BE = base_poses(X_IB, f.p_IE, f.R_IE)
+    print(f"\n== path IK, {file.stem} ({robot.name}), {n_samples} poses ==")
+
+    seconds, chosen = best_of(5, lambda: choose_branch(branch_results(robot, X_BE)))
+    ours_rate = n_samples / seconds
+    errors = pose_errors(X_BE, robot.forward(chosen.q))
+    print(
+        f"offline_prog path IK : {seconds * 1e3:8.2f} ms  {ours_rate:12.0f} samples/s  "
+        f"max error {errors[0]:.1e} m / {errors[1]:.1e} rad  (all branches, limits, 2π start)"
+    )
+
+    drake = build_drake_cell(
+        robot, X_IB=X_IB, X_IT=transform(cell.tool.X_IT), X_PE=transform(cell.part.X_PE)
+    )
+    n = min(n_drake, n_samples)
+    start = time.perf_counter()
+    result = solve_path(drake, f.p_IE[:n], f.R_IE[:n], chosen.q[0])
+    drake_seconds = time.perf_counter() - start
+    drake_rate = n / drake_seconds
+    drake_errors = pose_errors(X_BE[:n], robot.forward(result.q))
+    print(
+        f"Drake IK per sample  : {drake_seconds / n * 1e3:8.3f} ms/sample "
+        f"{drake_rate:10.0f} samples/s  max error {drake_errors[0]:.1e} m / "
+        f"{drake_errors[1]:.1e} rad  ({int(result.success.sum())}/{n} solved)"
+    )
+    print(f"  ratio offline_prog / Drake (program reused): {ours_rate / drake_rate:8.0f}x")
+    n_fresh = min(100, n)
+    start = time.perf_counter()
+    q_seed = chosen.q[0]
+    for i in range(n_fresh):  # the obvious baseline: a new InverseKinematics per sample
+        q_seed, _ = solve_pose(drake, RigidTransform(RotationMatrix(f.R_IE[i]), f.p_IE[i]), q_seed)
+    fresh_rate = n_fresh / (time.perf_counter() - start)
+    print(
+        f"Drake IK, new program per sample: {1e3 / fresh_rate:8.3f} ms/sample "
+        f"{fresh_rate:10.0f} samples/s  ratio offline_prog / it: {ours_rate / fresh_rate:6.0f}x"
+    )
+
+    other = py_opw_robot(robot) if robot.family == "opw" else None
+    if other is None:
+        print("py-opw-kinematics    : not applicable (UR kinematics) or not installed")
+        return
+    from scipy.spatial.transform import RigidTransform as ScipyTransform
+
+    poses = ScipyTransform.from_matrix(X_BE)
+    opw_seconds, q_opw = best_of(5, lambda: other.batch_inverse(poses, current_joints=chosen.q[0]))
+    q_opw = np.asarray(q_opw, dtype=float)
+    opw_rate = n_samples / opw_seconds
+    opw_errors = pose_errors(X_BE, robot.forward(q_opw))
+    print(
+        f"py-opw-kinematics    : {opw_seconds * 1e3:8.2f} ms  {opw_rate:12.0f} samples/s  "
+        f"max error {opw_errors[0]:.1e} m / {opw_errors[1]:.1e} rad  (batch_inverse, "
+        "nearest solution only)"
+    )
+    print(f"  per-sample cost offline_prog / py-opw-kinematics: {opw_rate / ours_rate:6.2f}x")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=5000)
+    parser.add_argument("--drake-samples", type=int, default=300)
+    args = parser.parse_args()
+    cells = sorted(CELLS.glob("*.yaml"))
+    bench_stages(cells)
+    for file in cells:
+        bench_path_ik(file, args.samples, args.drake_samples)
+
+
+if __name__ == "__main__":
+    main()
