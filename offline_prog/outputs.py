@@ -6,35 +6,19 @@ place, so a crash never leaves a half-written file that looks complete.
 
 from __future__ import annotations
 
-import contextlib
 import datetime
 import io
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog import __version__
+from offline_prog.atomic import write_atomic
+from offline_prog.cell import transform
+from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
 from offline_prog.trajectory import CSV_COLUMNS
-
-
-def write_atomic(target: Path, text: str) -> None:
-    """Write ``text`` to ``target`` via a temporary file and an atomic rename."""
-    target.parent.mkdir(parents=True, exist_ok=True)
-    handle, temp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(handle, "w", newline="") as stream:
-            stream.write(text)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temp)
-        raise
 
 
 def csv_columns(n_joints: int) -> list[str]:
@@ -196,6 +180,46 @@ def report(plan: Plan) -> dict:
     }
 
 
+def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
+    X = np.zeros((len(p), 4, 4))
+    X[:, :3, :3], X[:, :3, 3], X[:, 3, 3] = R, p, 1.0
+    return X
+
+
+def program_data(plan: Plan, summary: dict) -> ProgramData:
+    """The plan as the program writers need it (poses in the robot base B)."""
+    cell, joints, traj = plan.cell, plan.joints, plan.trajectory
+    X_IB = transform(cell.robot.X_IB)
+    X_BI = X_IB.inverse().GetAsMatrix4()
+    X_BE = X_BI @ _poses(traj.flange.p_IE, traj.flange.R_IE)
+    return ProgramData(
+        cell_name=cell.name or plan.cell_file.stem,
+        cell_file=str(plan.cell_file),
+        robot=plan.robot.name,
+        tool=cell.tool.name,
+        part=cell.part.name,
+        process_speed_m_s=cell.motion.speed,
+        speed_reference=traj.reference,
+        cycle_time_s=traj.duration,
+        feasible=True,
+        failure="",
+        joint_names=tuple(plan.robot.joint_names),
+        generated=summary["generated"],
+        t=traj.t,
+        sigma=traj.s,
+        q=joints.q,
+        qd=joints.qd,
+        X_BE=X_BE,
+        X_PF=_poses(traj.flange.p_PF, traj.flange.R_PF),
+        X_BT=X_BI @ plan.flange.X_IT.GetAsMatrix4(),
+        X_EP=plan.flange.X_PE.inverse().GetAsMatrix4(),
+        tcp_speed=traj.tcp_speed,
+        q_lower=plan.robot.q_lower,
+        q_upper=plan.robot.q_upper,
+        qd_max=plan.robot.qd_max,
+    )
+
+
 def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     """Write trajectory.csv and report.json into ``out_dir``.
 
@@ -207,4 +231,5 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
+    files["plan"] = program_data(plan, summary).save(out_dir)
     return files, summary

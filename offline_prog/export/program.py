@@ -1,0 +1,115 @@
+"""ProgramData: what a controller program needs from a plan, saved with the plan.
+
+Frames (paper letters): B robot base (URDF base_link), E flange (tool0), P part,
+F process frame on the path, T fixed tool. All poses are 4×4 arrays in SI units;
+the writers convert to each vendor's units and angle conventions at the edge.
+``plan.npz`` in the plan folder holds it, so ``offline-prog export`` re-exports
+without re-planning.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+
+PLAN_FILE = "plan.npz"
+_ARRAYS = (
+    "t",
+    "sigma",
+    "q",
+    "qd",
+    "X_BE",
+    "X_PF",
+    "X_BT",
+    "X_EP",
+    "tcp_speed",
+    "q_lower",
+    "q_upper",
+    "qd_max",
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class ProgramData:
+    """A finished plan, as the program writers see it.
+
+    Attributes:
+        cell_name, cell_file, robot, tool, part: names for the program header.
+        process_speed_m_s: the commanded TCP speed [m/s]; speed_reference: tcp | flange.
+        cycle_time_s: planned duration [s].
+        feasible: the plan passed every check; failure: why not ("" if feasible).
+        joint_names: the six URDF joint names, in q's column order.
+        t: (N,) time [s]; sigma: (N,) arc length on the processing path [m].
+        q: (N, 6) joint positions [rad]; qd: (N, 6) joint speeds [rad/s].
+        X_BE: (N, 4, 4) flange E in the robot base B.
+        X_PF: (N, 4, 4) process frame F (the tool's pose on the part) in P.
+        X_BT: (4, 4) the fixed tool frame T in B (with any free rotation applied).
+        X_EP: (4, 4) the part frame P in the flange frame E.
+        tcp_speed: (N,) speed of the path point under the TCP [m/s].
+        q_lower, q_upper, qd_max: (6,) joint limits [rad, rad/s].
+        generated: ISO time the plan was made.
+    """
+
+    cell_name: str
+    cell_file: str
+    robot: str
+    tool: str
+    part: str
+    process_speed_m_s: float
+    speed_reference: str
+    cycle_time_s: float
+    feasible: bool
+    failure: str
+    joint_names: tuple[str, ...]
+    generated: str
+    t: np.ndarray
+    sigma: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    X_BE: np.ndarray
+    X_PF: np.ndarray
+    X_BT: np.ndarray
+    X_EP: np.ndarray
+    tcp_speed: np.ndarray
+    q_lower: np.ndarray
+    q_upper: np.ndarray
+    qd_max: np.ndarray
+
+    def save(self, folder: Path) -> Path:
+        """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
+        import os
+        import tempfile
+
+        meta = {
+            f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in _ARRAYS
+        }
+        meta["joint_names"] = list(self.joint_names)
+        target = Path(folder) / PLAN_FILE
+        target.parent.mkdir(parents=True, exist_ok=True)
+        handle, temp = tempfile.mkstemp(dir=target.parent, suffix=".npz.tmp")
+        with os.fdopen(handle, "wb") as stream:
+            np.savez_compressed(
+                stream, meta=json.dumps(meta), **{name: getattr(self, name) for name in _ARRAYS}
+            )
+        os.replace(temp, target)
+        return target
+
+    @classmethod
+    def load(cls, folder: Path) -> ProgramData:
+        """Read ``folder/plan.npz``.
+
+        Raises:
+            ValueError: one line naming the file when it is missing or unreadable.
+        """
+        file = Path(folder) / PLAN_FILE
+        try:
+            with np.load(file) as data:
+                meta = json.loads(str(data["meta"]))
+                arrays = {name: np.asarray(data[name]) for name in _ARRAYS}
+        except (OSError, KeyError, ValueError) as error:
+            raise ValueError(f"{file}: not a plan folder ({error})") from None
+        meta["joint_names"] = tuple(meta["joint_names"])
+        return cls(**meta, **arrays)
