@@ -40,6 +40,7 @@ NEAR_SINGULAR = {
     "wrist": np.sin(np.deg2rad(5.0)),
     "elbow": np.sin(np.deg2rad(5.0)),
     "shoulder": 0.03,
+    "jacobian": 0.01,  # smallest singular value of the flange Jacobian (Drake IK robots)
 }
 
 
@@ -93,6 +94,10 @@ class BranchPath:
         """(N, 6) the branch's solution at σ, taken as the 2π-equivalent nearest q_near."""
         raw = self.robot.inverse(self.poses(sigma))[:, self.branch]
         return q_near + wrap_to_pi(raw - q_near)
+
+    def singularity_distances(self, q: np.ndarray, sigma: np.ndarray) -> dict:
+        """Wrist, elbow and shoulder distances (``path_ik.singularity_distances``)."""
+        return singularity_distances(self.robot, q, self.poses(sigma))
 
     def rates(self, sigma: np.ndarray, q_near: np.ndarray) -> JointRates:
         """q, q′, q″ at σ by central differences of the exact IK (error O(h²))."""
@@ -164,7 +169,7 @@ def plan_joint_trajectory(
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
     Args:
-        robot: the robot record (analytic IK).
+        robot: the robot record (analytic IK; Drake IK for family "drake").
         X_IB: robot base in I.
         flange: the flange path X_IE(s).
         parameter: σ ↦ s for the time law's speed reference.
@@ -173,13 +178,19 @@ def plan_joint_trajectory(
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(2001, int(np.ceil(length / GRID_SPACING_M)) + 1))
-    path_of = lambda b: BranchPath(robot, X_IB, flange, parameter, b)  # noqa: E731
-    results = branch_results(robot, path_of(0).poses(grid))
-    chosen = choose_branch(results)
+    if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
+        from offline_prog.drake_path import DrakeIkPath
+
+        path = DrakeIkPath(robot, X_IB, flange, parameter)
+        chosen = path.choose(grid)
+        results = [chosen]
+    else:
+        results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
+        chosen = choose_branch(results)
+        path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
         raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason)
-    path = path_of(chosen.branch)
     rates = path.rates(grid, chosen.q)
     retiming = retime(rates, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
     if not retiming.feasible:
@@ -208,7 +219,7 @@ def plan_joint_trajectory(
         )
     steps = np.abs(np.diff(q, axis=0))
     i, j = np.unravel_index(np.argmax(steps), steps.shape)
-    distances = singularity_distances(robot, q, path.poses(sigma))
+    distances = path.singularity_distances(q, sigma)
     singular = {}
     for kind, d in distances.items():
         k = int(np.argmin(d))
@@ -216,8 +227,8 @@ def plan_joint_trajectory(
         stretches = [(float(sigma[a]), float(sigma[b - 1])) for a, b in near]
         # Wrist and elbow distances are |sin| of an angle: report that angle.
         value, unit = (
-            (float(d[k]), "m")
-            if kind == "shoulder"
+            (float(d[k]), "m" if kind == "shoulder" else "m/rad")
+            if kind in ("shoulder", "jacobian")
             else (float(np.rad2deg(np.arcsin(min(d[k], 1.0)))), "deg")
         )
         singular[kind] = {

@@ -31,6 +31,7 @@ _TOP_KEYS = {"family", "urdf", "joint_names", "kinematics", "limits"}
 _KINEMATIC_KEYS = {
     "opw": ("a1", "a2", "b", "c1", "c2", "c3", "c4", "offsets_deg", "sign_corrections"),
     "ur": ("d1", "a2", "a3", "d4", "d5", "d6"),
+    "drake": (),  # no closed form: joint paths come from Drake InverseKinematics
 }
 _LIMIT_KEYS = ("position_deg", "velocity_deg_s", "acceleration_deg_s2")
 
@@ -41,8 +42,9 @@ class RobotModel:
 
     Attributes:
         name: Folder name under ``robots/``, e.g. ``"kuka_kr16_2"``.
-        family: ``"opw"`` or ``"ur"``: which analytic kinematics applies.
-        params: Kinematic parameter record of that family.
+        family: ``"opw"`` or ``"ur"``: which analytic kinematics applies; ``"drake"``
+            for a robot without a closed form (Drake InverseKinematics only).
+        params: Kinematic parameter record of that family (None for ``"drake"``).
         joint_names: The six URDF revolute joints, base to flange.
         q_lower: (6,) lower joint position limits [rad].
         q_upper: (6,) upper joint position limits [rad].
@@ -53,7 +55,7 @@ class RobotModel:
 
     name: str
     family: str
-    params: OpwParameters | UrParameters
+    params: OpwParameters | UrParameters | None
     joint_names: tuple[str, ...]
     q_lower: np.ndarray
     q_upper: np.ndarray
@@ -109,8 +111,9 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     except yaml.YAMLError as error:
         raise ValueError(f"{path}: not valid YAML: {' '.join(str(error).split())}") from None
     check = _Checker(path)
-    check.keys(record, "", required=_TOP_KEYS - {"urdf"}, allowed=_TOP_KEYS)
-    family = record["family"]
+    family = record.get("family") if isinstance(record, dict) else None
+    optional = {"urdf", "kinematics"} if family == "drake" else {"urdf"}
+    check.keys(record, "", required=_TOP_KEYS - optional, allowed=_TOP_KEYS)
     if family not in _KINEMATIC_KEYS:
         check.fail("family", family, f"one of {sorted(_KINEMATIC_KEYS)}")
     urdf_name = record.get("urdf", f"{name}.urdf")
@@ -138,7 +141,9 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     return RobotModel(
         name=name,
         family=family,
-        params=_kinematic_params(check, family, record["kinematics"]),
+        params=None
+        if family == "drake"
+        else _kinematic_params(check, family, record["kinematics"]),
         joint_names=tuple(names),
         q_lower=_frozen(np.radians(position[:, 0])),
         q_upper=_frozen(np.radians(position[:, 1])),
