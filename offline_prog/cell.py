@@ -27,6 +27,21 @@ def required():
 
 
 @dataclasses.dataclass
+class ShapeConfig:
+    """A named collision/visual shape, posed in its owner's frame (I for obstacles,
+    T for the tool, P for the part). Sizes in mm (the keys say so)."""
+
+    name: str = required()
+    shape: str = required()  # box | cylinder | sphere | capsule | mesh
+    size_mm: list[float] | None = None  # box: [x, y, z]
+    radius_mm: float | None = None  # sphere, cylinder, capsule
+    length_mm: float | None = None  # cylinder, capsule: along the shape's z
+    mesh: str | None = None  # STL/OBJ/PLY/GLB, relative to the cell file
+    mesh_units: str = "m"
+    pose: Transform = dataclasses.field(default_factory=Transform)
+
+
+@dataclasses.dataclass
 class RobotConfig:
     model: str = required()  # folder name in robots/
     X_IB: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
@@ -40,6 +55,7 @@ class ToolConfig:
     # this angle to keep the robot inside its limits; y is the pressing direction n.
     free_rotation_deg: float = 0.0
     symmetry_axis: str = "y"
+    geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in T
 
 
 @dataclasses.dataclass
@@ -48,6 +64,7 @@ class PartConfig:
     name: str = "part"
     mesh: str | None = None  # STL/OBJ/PLY in P, relative to the cell file
     mesh_units: str = "m"
+    geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
 
 
 @dataclasses.dataclass
@@ -87,7 +104,8 @@ class MotionConfig:
     max_jerk: float = required()  # m/s³
     speed_reference: str = "tcp"  # tcp | flange
     sample_rate_hz: float = 250.0
-    cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation
+    cusp_smoothing_mm: float | None = None
+    clearance: float = 0.005  # m: closest allowed approach of any checked pair  # re-fit the flange path within this deviation
 
 
 @dataclasses.dataclass
@@ -99,6 +117,9 @@ class Cell:
     motion: MotionConfig = dataclasses.field(default_factory=MotionConfig, metadata=REQUIRED)
     name: str = ""
     description: str = ""
+    obstacles: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in I
+    # Pairs of shape names whose contact is intended (the tool tip on the part).
+    allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
 
 
 class CellError(ValueError):
@@ -165,6 +186,20 @@ def _check_value(file, key, raw, schema):
         return _check_transform(file, key, raw)
     if dataclasses.is_dataclass(schema):
         return _check_mapping(file, key, raw, schema)
+    if (
+        origin is list
+        and args
+        and (
+            dataclasses.is_dataclass(args[0])
+            or typing.get_origin(args[0]) is list
+            or args[0] is str
+        )
+    ):
+        if not isinstance(raw, list):
+            raise CellError(file, key, f"expected a list, got {raw!r}")
+        for i, item in enumerate(raw):
+            _check_value(file, f"{key}[{i}]", item, args[0])
+        return
     if origin is list:
         if not (isinstance(raw, list) and all(map(_is_number, raw))):
             raise CellError(file, key, f"expected a list of numbers, got {raw!r}")

@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from rich.console import Console
 
 EXIT_BAD_INPUT = 2
@@ -30,7 +32,76 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument(
         "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
     )
+    export = commands.add_parser("export", help="re-export programs from a finished plan")
+    export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
+    export.add_argument(
+        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
+    )
+    export.add_argument(
+        "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"
+    )
+    export.add_argument(
+        "--force", action="store_true", help="export even if the plan failed (the header says so)"
+    )
+    export.add_argument(
+        "--style",
+        choices=["external_tcp", "flange"],
+        default=None,
+        help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
+    )
+    export.add_argument(
+        "--mode",
+        choices=["servoj", "movel"],
+        default=None,
+        help="URScript: joint trajectory (servoj) or movel poses",
+    )
+    export.add_argument(
+        "--chord-tol-mm",
+        type=float,
+        default=None,
+        help="Cartesian point density: chordal tolerance [mm] (default 0.05)",
+    )
+    export.add_argument(
+        "--angle-tol-deg",
+        type=float,
+        default=None,
+        help="Cartesian point density: orientation tolerance [deg] (default 0.1)",
+    )
+    export.add_argument(
+        "--line-limit",
+        type=int,
+        default=None,
+        help="split programs longer than this (KRL 1400, RAPID 5000)",
+    )
     return parser
+
+
+def _export_options(args) -> dict:
+    """Library keyword arguments from the export flags that apply to the format."""
+    options = {}
+    if args.chord_tol_mm is not None and args.format != "csv":
+        options["chord_tol_m"] = args.chord_tol_mm * 1e-3
+    if args.angle_tol_deg is not None and args.format != "csv":
+        options["angle_tol_rad"] = float(np.deg2rad(args.angle_tol_deg))
+    if args.style is not None and args.format == "krl":
+        options["style"] = args.style
+    if args.mode is not None and args.format == "urscript":
+        options["mode"] = args.mode
+    if args.line_limit is not None and args.format in ("krl", "rapid"):
+        options["line_limit"] = args.line_limit
+    return options
+
+
+def _run_export(args, console: Console) -> None:
+    from offline_prog.export.formats import export
+    from offline_prog.export.program import ProgramData
+
+    data = ProgramData.load(args.plan_dir)
+    out = args.out or args.plan_dir / "programs"
+    files = export(data, args.format, out, force=args.force, **_export_options(args))
+    for file in files:
+        console.print(f"  {args.format:<9} {file}")
+    console.print(f"exported {len(files)} file(s) from {args.plan_dir}")
 
 
 def _summary(console: Console, report: dict, files: dict, seconds: float) -> None:
@@ -88,6 +159,18 @@ def main(argv: list[str] | None = None) -> int:
         from offline_prog.outputs import write_outputs
         from offline_prog.plan import plan_cell
 
+        from offline_prog.export.formats import ExportRefusedError
+
+        if args.command == "export":
+            try:
+                _run_export(args, console)
+                return 0
+            except ExportRefusedError as error:
+                errors.print(f"error: {args.plan_dir}: {error}", markup=False, highlight=False)
+                return EXIT_BAD_INPUT
+            except ValueError as error:
+                errors.print(f"error: {error}", markup=False, highlight=False)
+                return EXIT_BAD_INPUT
         try:
             with errors.status("planning") as status:
                 plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))

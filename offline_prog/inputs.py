@@ -75,6 +75,48 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "tool.symmetry_axis", f"{cell.tool.symmetry_axis!r} (use x, y or z)")
     if motion.cusp_smoothing_mm is not None and not motion.cusp_smoothing_mm > 0:
         raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
+    if not motion.clearance >= 0:
+        raise _error(file, "motion.clearance", f"must be ≥ 0 m, got {motion.clearance}")
+    _check_shapes(file, cell)
+
+
+def _check_shapes(file: Path, cell: Cell) -> None:
+    """Shape names unique, mesh files present, allowed contacts naming known shapes."""
+    owners = [
+        ("part.geometry", cell.part.geometry),
+        ("tool.geometry", cell.tool.geometry),
+        ("obstacles", cell.obstacles),
+    ]
+    names = {cell.part.name} if cell.part.mesh else set()
+    for key, shapes in owners:
+        for i, shape in enumerate(shapes):
+            where = f"{key}[{i}]"
+            if shape.name in names:
+                raise _error(file, f"{where}.name", f"{shape.name!r} is used twice")
+            names.add(shape.name)
+            if shape.shape not in ("box", "cylinder", "sphere", "capsule", "mesh"):
+                raise _error(
+                    file,
+                    f"{where}.shape",
+                    f"{shape.shape!r} (use box, cylinder, sphere, capsule or mesh)",
+                )
+            if shape.mesh_units not in path_sources.UNIT_SCALE:
+                raise _error(file, f"{where}.mesh_units", f"{shape.mesh_units!r} (use m or mm)")
+            if shape.shape == "mesh" and not (shape.mesh and (file.parent / shape.mesh).is_file()):
+                raise _error(
+                    file, f"{where}.mesh", f"file {file.parent / (shape.mesh or '')} does not exist"
+                )
+    for i, pair in enumerate(cell.allowed_contact):
+        if len(pair) != 2:
+            raise _error(file, f"allowed_contact[{i}]", f"expected [name, name], got {pair}")
+        for name in pair:
+            if name not in names:
+                raise _error(
+                    file,
+                    f"allowed_contact[{i}]",
+                    f"{name!r} is not a shape of the "
+                    f"cell (have: {', '.join(sorted(names)) or 'none'})",
+                )
 
 
 def _analytic_points(file: Path, cell: Cell) -> path_sources.PathPoints:

@@ -58,6 +58,38 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ("[1.0, 0, 0.5]", "[1.0, .nan, 0.5]", "tool.X_IT.translation", "NaN"),
     ("!Rpy {deg: [90, 0, 0]}", "{deg: [90, 0, 0]}", "tool.X_IT.rotation", "!Rpy"),
     ("name: test", "name: test\ntool_typo: {}", "tool_typo", "unknown key"),
+    (
+        "name: test",
+        "name: test\nobstacles: [{name: a, shape: cone}]",
+        "obstacles[0].shape",
+        "use box",
+    ),
+    (
+        "name: test",
+        "name: test\nobstacles: [{name: a, shape: box, size_mm: [1, 1, 1]}, "
+        "{name: a, shape: sphere, radius_mm: 1}]",
+        "obstacles[1].name",
+        "used twice",
+    ),
+    (
+        "name: test",
+        "name: test\nobstacles: [{name: a, shape: mesh, mesh: nope.stl}]",
+        "obstacles[0].mesh",
+        "does not exist",
+    ),
+    (
+        "name: test",
+        "name: test\nallowed_contact: [[tip, plate]]",
+        "allowed_contact[0]",
+        "not a shape",
+    ),
+    (
+        "name: test",
+        "name: test\nobstacles: [{name: a, shape: box, size_mm: [1, .nan, 1]}]",
+        "obstacles[0].size_mm",
+        "NaN",
+    ),
+    ("max_jerk: 10.0", "max_jerk: 10.0\n  clearance: -1.0", "motion.clearance", "must be ≥ 0"),
     ("X_IT: {", "free_rotation_deg: 270\n  X_IT: {", "tool.free_rotation_deg", "within"),
     ("X_IT: {", "symmetry_axis: w\n  X_IT: {", "tool.symmetry_axis", "use x, y or z"),
     ("model: kuka_kr16_2", "model: no_such_robot", "robot.model", "not a robot folder"),

@@ -1,0 +1,127 @@
+"""Universal Robots URScript: the planned joint trajectory streamed with servoj.
+
+Plain URScript has no remote TCP, so the plan's joint trajectory is resampled to
+the controller period (0.002 s on e-Series) with cubic Hermite interpolation of
+q and q̇ and sent with one ``servoj`` per period. As an option, ``movel`` poses
+of the part frame P (set as the TCP with ``set_tcp``) are written instead, in
+the controller's base frame, which is the URDF ``base_link`` turned π about z.
+URScript units: metres, radians, seconds; poses ``p[x, y, z, rx, ry, rz]`` with a
+rotation vector.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline
+from scipy.spatial.transform import Rotation
+
+from offline_prog.atomic import write_atomic
+from offline_prog.export.density import select_points
+from offline_prog.export.header import header_lines
+from offline_prog.export.program import ProgramData
+
+E_SERIES_PERIOD_S = 0.002
+SERVOJ_LOOKAHEAD_S = 0.1
+SERVOJ_GAIN = 300
+START_SPEED_RAD_S = 0.5  # movej to the start
+START_ACCEL_RAD_S2 = 1.0
+# The controller's base frame C in the URDF base_link B: turned π about z.
+X_BC = np.diag([-1.0, -1.0, 1.0, 1.0])
+
+
+@dataclasses.dataclass(frozen=True)
+class UrScriptResult:
+    file: Path
+    n_commands: int
+    period_s: float
+
+
+def resample_joints(data: ProgramData, period_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t (M,), q (M, 6)) on the controller period, by cubic Hermite on q and q̇."""
+    spline = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)
+    t = np.arange(0.0, data.t[-1], period_s)
+    t = np.append(t, data.t[-1]) if data.t[-1] - t[-1] > 1e-9 else t
+    return t, spline(t)
+
+
+def _list(values: np.ndarray, digits: int = 7) -> str:
+    return "[" + ", ".join(f"{v:.{digits}f}" for v in values) + "]"
+
+
+def _pose(X: np.ndarray) -> str:
+    rotvec = Rotation.from_matrix(X[:3, :3]).as_rotvec()
+    return "p" + _list(np.concatenate([X[:3, 3], rotvec]))
+
+
+def urscript_text(
+    data: ProgramData,
+    *,
+    name: str = "offline_prog",
+    mode: str = "servoj",
+    period_s: float = E_SERIES_PERIOD_S,
+    chord_tol_m: float = 0.05e-3,
+    angle_tol_rad: float = np.deg2rad(0.1),
+    forced: bool = False,
+) -> tuple[str, int]:
+    """The program text and its number of motion commands.
+
+    Args:
+        mode: "servoj" (the joint trajectory at the controller period) or "movel"
+            (the part frame as TCP, LIN poses chosen within the tolerances).
+    """
+    conventions = [
+        "Units: m, rad, s. Joint order: " + ", ".join(data.joint_names) + ".",
+        f"Mode: {mode}. "
+        + (
+            f"servoj every {period_s} s (joint trajectory resampled from the plan)."
+            if mode == "servoj"
+            else "movel poses of the part frame (set_tcp) in the controller base frame "
+            "(URDF base_link turned pi about z), rotation vectors."
+        ),
+    ]
+    lines = [f"# {line}" for line in header_lines(data, conventions=conventions, forced=forced)]
+    lines.append(f"def {name}():")
+    q0 = data.q[0]
+    lines.append(f"  movej({_list(q0)}, a={START_ACCEL_RAD_S2}, v={START_SPEED_RAD_S})")
+    if mode == "servoj":
+        _, q = resample_joints(data, period_s)
+        lines += [
+            f"  servoj({_list(row)}, t={period_s}, lookahead_time={SERVOJ_LOOKAHEAD_S}, "
+            f"gain={SERVOJ_GAIN})"
+            for row in q[1:]
+        ]
+        lines.append("  stopj(2.0)")
+        count = len(q) - 1
+    elif mode == "movel":
+        X_CB = np.linalg.inv(X_BC)
+        lines.append(f"  set_tcp({_pose(data.X_EP)})")  # the part frame P in the flange
+        X_CP = X_CB @ data.X_BE @ data.X_EP
+        chosen = select_points(
+            data.X_PF[:, :3, 3],
+            data.X_PF[:, :3, :3],
+            chord_tol_m=chord_tol_m,
+            angle_tol_rad=angle_tol_rad,
+        ).indices
+        for i in chosen[1:]:
+            lines.append(
+                f"  movel({_pose(X_CP[i])}, a=1.0, v={max(data.tcp_speed[i], 1e-4):.5f}, "
+                f"r={min(chord_tol_m, 0.001):.5f})"
+            )
+        count = len(chosen) - 1
+    else:
+        raise ValueError(f"URScript mode must be 'servoj' or 'movel', got {mode!r}")
+    lines.append("end")
+    lines.append(f"{name}()")
+    return "\n".join(lines) + "\n", count
+
+
+def write_urscript(data: ProgramData, out_dir: Path, **options) -> UrScriptResult:
+    """Write ``out_dir/<name>.script`` (see urscript_text for the options)."""
+    name = options.get("name", "offline_prog")
+    text, count = urscript_text(data, **options)
+    file = Path(out_dir) / f"{name}.script"
+    write_atomic(file, text)
+    return UrScriptResult(file, count, options.get("period_s", E_SERIES_PERIOD_S))
