@@ -104,8 +104,8 @@ class MotionConfig:
     max_jerk: float = required()  # m/s³
     speed_reference: str = "tcp"  # tcp | flange
     sample_rate_hz: float = 250.0
-    cusp_smoothing_mm: float | None = None
-    clearance: float = 0.005  # m: closest allowed approach of any checked pair  # re-fit the flange path within this deviation
+    cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation
+    clearance: float = 0.005  # m: closest allowed approach of any checked pair
 
 
 @dataclasses.dataclass

@@ -13,7 +13,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from rich.console import Console
 
 EXIT_BAD_INPUT = 2
@@ -156,10 +155,9 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     try:
         from offline_prog.cell import CellError
+        from offline_prog.export.formats import ExportRefusedError
         from offline_prog.outputs import write_outputs
         from offline_prog.plan import plan_cell
-
-        from offline_prog.export.formats import ExportRefusedError
 
         if args.command == "export":
             try:
