@@ -16,6 +16,7 @@ import numpy as np
 from offline_prog import __version__
 from offline_prog.atomic import write_atomic
 from offline_prog.cell import transform
+from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
 from offline_prog.trajectory import CSV_COLUMNS
@@ -231,5 +232,9 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
-    files["plan"] = program_data(plan, summary).save(out_dir)
+    data = program_data(plan, summary)
+    files["plan"] = data.save(out_dir)
+    for fmt in default_formats(data.robot):
+        for file in export(data, fmt, out_dir / PROGRAMS_DIR):
+            files[f"{fmt}:{file.name}"] = file
     return files, summary

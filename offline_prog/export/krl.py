@@ -1,0 +1,378 @@
+"""KUKA KRL for KSS 8: the plan as ``name.src`` + ``name.dat`` (numbered parts if long).
+
+Styles. ``external_tcp``: ``$IPO_MODE=#TCP``, ``$BASE`` = the fixed tool T in ``$WORLD``
+(KSS keeps a fixed tool as a base), ``$TOOL`` = the part P in ``$FLANGE`` (the
+robot-carried workpiece is the "tool"); each LIN point is a pose between P and T, written
+as ``tcp_pose_convention`` says. The controller then moves the fixed TCP in straight lines
+across the part, which is what ``select_points`` assumes for the process frames X_PF.
+``flange``: ``$IPO_MODE=#BASE``, ``$BASE=$NULLFRAME``, the same ``$TOOL``; the points are
+X_BP, refined until the part, interpolated linearly in B, carries the path under the
+nozzle within the tolerances.
+
+Frames besides I, B, E, P, F, T: K = KUKA's ``$FLANGE``, z out of the flange. It is the
+URDF ``tool0`` E (kuka_experimental marks ``tool0`` as "the $FLANGE coordinate system in
+KUKA KRC controllers"; KUKA tool data put straight tools along flange z); ``X_KE`` keeps
+that assumption in one place. B = ``base_link`` = ``$ROBROOT`` (kuka_experimental
+``base``), taken as ``$WORLD`` (the robot at the world origin, KSS's default).
+
+Edge units: X, Y, Z [mm]; A, B, C [deg] with R = Rz(A)·Ry(B)·Rx(C) (KUKA Z-Y′-X″);
+E6AXIS A1..A6 = q [deg] (robots/kuka_* URDFs carry KUKA's joint signs and zeros);
+``$VEL.CP`` [m/s]; ``$APO.CDIS`` [mm]. Status and Turn: see ``status_turn``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import textwrap
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from offline_prog.atomic import write_atomic
+from offline_prog.export.density import (
+    DEFAULT_ANGLE_TOL_RAD,
+    DEFAULT_CHORD_TOL_M,
+    segment_deviation,
+    select_points,
+)
+from offline_prog.export.header import header_lines
+from offline_prog.export.program import ProgramData
+from offline_prog.kinematics_opw import OpwParameters, wrap_to_pi
+from offline_prog.robot_model import RobotModel, load_robot
+
+X_KE = np.eye(4)  # URDF tool0 E in KUKA's $FLANGE K: the same frame (module docstring)
+STYLES = ("external_tcp", "flange")
+# "X_TP": the point is P in T, flange = $BASE:POS:inv($TOOL), KSS's rule for every
+# Cartesian position (POS = $TOOL in $BASE). "X_PF": the point is T in P (the process
+# frame), flange = $BASE:inv(POS):inv($TOOL).
+TCP_POSE_CONVENTIONS = ("X_TP", "X_PF")
+MAX_NAME_CHARS = 24  # KRL names (KSS 8 KRL quick guide)
+MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
+VEL_CP_STEP_M_S = 1e-4  # $VEL.CP is floored to 0.1 mm/s: never above the plan
+VEL_CP_MIN_M_S = 1e-3
+ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
+PTP_VEL_PERCENT, PTP_ACC_PERCENT = 20, 50  # the joint move to the approach pose [%]
+_GRID = 64  # flange style: nozzle curve samples per LIN segment
+_ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
+_MAIN = """DEF {name}( )
+{ext};FOLD INI
+BAS(#INITMOV,0)
+;ENDFOLD (INI)
+$BASE={base}
+$TOOL=PART_ON_FLANGE
+$IPO_MODE={ipo}
+$ORI_TYPE=#VAR
+$ADVANCE=3
+BAS(#VEL_PTP,{ptp_vel})
+BAS(#ACC_PTP,{ptp_acc})
+$VEL.ORI1={ori:.0f}
+$VEL.ORI2={ori:.0f}
+$APO.CDIS={cdis:.3f}
+; Approach: PTP (joints) to {approach:g} mm off the path start, then LIN onto the path
+PTP XAPPROACH
+$VEL.CP={v:.4f}
+LIN XP1
+; Process start
+{process}
+; Process end. Retract {approach:g} mm
+$VEL.CP={v:.4f}
+LIN XRETRACT
+END"""
+
+
+@dataclasses.dataclass(frozen=True)
+class KrlResult:
+    """Files written (main .src/.dat, then name_1.src/.dat, ...), the process LIN points
+    (``indices`` (n_points,) into the plan's samples, first and last included), and the
+    largest deviation [m, rad] of any plan sample from the controller's interpolation."""
+
+    files: list[Path]
+    n_points: int
+    indices: np.ndarray
+    max_chord_m: float
+    max_angle_rad: float
+
+
+def kuka_abc_deg(R: np.ndarray) -> np.ndarray:
+    """(N, 3) KUKA A, B, C [deg] of (N, 3, 3) rotations: R = Rz(A)·Ry(B)·Rx(C), B in
+    [-90, 90]; at B = ±90° (gimbal lock) C = 0."""
+    cos_b = np.hypot(R[:, 0, 0], R[:, 1, 0])
+    lock = cos_b < 1e-9
+    a = np.where(lock, np.arctan2(-R[:, 0, 1], R[:, 1, 1]), np.arctan2(R[:, 1, 0], R[:, 0, 0]))
+    c = np.where(lock, 0.0, np.arctan2(R[:, 2, 1], R[:, 2, 2]))
+    return np.rad2deg(np.stack([a, np.arctan2(-R[:, 2, 0], cos_b), c], axis=1))
+
+
+def status_turn(params: OpwParameters, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """KUKA Status and Turn (N,) of joint vectors q (N, 6) [rad].
+
+    Status bit 0: the wrist centre lies behind the A1 axis (x < 0 in the frame turned with
+    A1: overhead area). Bit 1: A3 on the elbow-up side of the stretched arm, i.e. the
+    wrist centre above the A2-A3 line (A3 >= -atan2(a2, c3) = -2.99° on the KR 16-2).
+    Bit 2: A5 < 0. Turn bit i: A(i+1) < 0. Computed with the OPW paper angles theta.
+    Sources: KSS manuals as quoted on robot-forum.com (bit 0); KRL data written by KSS
+    pairs S 2 with A3 > 0, A5 >= 0 and S 6 with A5 < 0 (bits 1, 2); Beckhoff/ISG's KUKA-style
+    Status & Turn (bit 1: wrist in front of the A2-A3 line; Turn).
+    """
+    theta = q * np.asarray(params.sign_corrections) - np.asarray(params.offsets)
+    psi3, k = np.arctan2(params.a2, params.c3), np.hypot(params.a2, params.c3)
+    x_wrist = (
+        params.c2 * np.sin(theta[:, 1]) + k * np.sin(theta[:, 1] + theta[:, 2] + psi3) + params.a1
+    )
+    status = (x_wrist < 0) + 2 * (theta[:, 2] + psi3 >= 0) + 4 * (q[:, 4] < 0)
+    return status.astype(int), ((q < 0) * (1 << np.arange(6))).sum(axis=1)
+
+
+def _num(value: float, digits: int) -> str:
+    text = f"{value:.{digits}f}"
+    return text[1:] if float(text) == 0.0 and text.startswith("-") else text
+
+
+def _frame(X: np.ndarray) -> str:
+    """``X .., Y .., Z .., A .., B .., C ..`` of a pose (4, 4) [m] in mm and degrees."""
+    values = [_num(v, 4) for v in X[:3, 3] * 1e3] + [
+        _num(v, 5) for v in kuka_abc_deg(X[None, :3, :3])[0]
+    ]
+    return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))
+
+
+def _nozzle_deviation(X_BP, X_BT, X_PF, i: int, j: int) -> tuple[float, float]:
+    """Flange style: largest distance [m] / angle [rad] of the plan's X_PF[i..j] from the
+    tool frame's curve on the part while the controller interpolates X_BP from i to j
+    (position linear, orientation slerp, one parameter)."""
+    if j - i < 2:
+        return 0.0, 0.0
+    lam = np.linspace(0.0, 1.0, _GRID + 1)
+    rotvec = Rotation.from_matrix(X_BP[i, :3, :3].T @ X_BP[j, :3, :3]).as_rotvec()
+    R_BP = X_BP[i, :3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
+    p_BP = X_BP[i, :3, 3] + lam[:, None] * (X_BP[j, :3, 3] - X_BP[i, :3, 3])
+    p_PT = np.einsum("nji,nj->ni", R_BP, X_BT[:3, 3] - p_BP)  # (G+1, 3) tool origin in P
+    a, d = p_PT[:-1], np.diff(p_PT, axis=0)
+    inner = X_PF[i + 1 : j, :3, 3]
+    u = np.clip(np.einsum("kgc,gc->kg", inner[:, None] - a, d) / (d * d).sum(1).clip(1e-30), 0, 1)
+    gap = np.linalg.norm(inner[:, None] - a - u[..., None] * d, axis=2)  # (K, G)
+    near = gap.argmin(axis=1)
+    R_PT = np.swapaxes(R_BP[near], 1, 2) @ X_BT[:3, :3]
+    angle = Rotation.from_matrix(np.swapaxes(R_PT, 1, 2) @ X_PF[i + 1 : j, :3, :3]).magnitude()
+    return float(gap.min(axis=1).max()), float(angle.max())
+
+
+def _process_points(data: ProgramData, style: str, chord_tol_m: float, angle_tol_rad: float):
+    """Chosen sample indices and the worst deviation [m, rad] (see KrlResult)."""
+    p, R = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
+    chosen = select_points(p, R, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
+    if style == "external_tcp":
+        return chosen.indices, chosen.max_chord_m, chosen.max_angle_rad
+    X_BP = data.X_BE @ data.X_EP
+    indices, worst = [int(chosen.indices[0])], np.zeros(2)
+    stack = list(zip(chosen.indices[1:], chosen.indices[:-1], strict=True))[::-1]
+    while stack:  # split each LIN segment until the nozzle curve on P fits as well
+        j, i = (int(v) for v in stack.pop())
+        deviation = np.maximum(
+            segment_deviation(p, R, i, j), _nozzle_deviation(X_BP, data.X_BT, data.X_PF, i, j)
+        )
+        if j - i > 1 and (deviation[0] > chord_tol_m or deviation[1] > angle_tol_rad):
+            stack += [(j, (i + j) // 2), ((i + j) // 2, i)]
+            continue
+        indices.append(j)
+        worst = np.maximum(worst, deviation)
+    return np.asarray(indices), float(worst[0]), float(worst[1])
+
+
+def _joints_near(robot: RobotModel, X_BE, q_ref, data: ProgramData, what: str) -> np.ndarray:
+    """The IK solution (6,) [rad] for X_BE (4, 4) nearest q_ref, within the joint limits."""
+    q = robot.inverse(X_BE[None])[0]
+    q = q_ref + wrap_to_pi(q - q_ref)  # each joint's 2π-equivalent nearest q_ref
+    ok = ~np.isnan(q).any(axis=1) & np.all((q >= data.q_lower) & (q <= data.q_upper), axis=1)
+    if not ok.any():
+        raise ValueError(f"write_krl: the {what} pose is out of reach (approach_m too large?)")
+    return q[ok][np.abs(q[ok] - q_ref).max(axis=1).argmin()]
+
+
+def _vel_cp(speed_m_s: float) -> float:
+    return max(np.floor(speed_m_s / VEL_CP_STEP_M_S + 1e-6) * VEL_CP_STEP_M_S, VEL_CP_MIN_M_S)
+
+
+def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
+    """``$VEL.CP`` and ``LIN`` lines to XP2..XPn, in parts of at most line_limit lines.
+
+    $VEL.CP of a segment is the highest planned speed [m/s] on it, floored to 0.1 mm/s
+    (written when it changes and at the start of every part); the last LIN stops exactly.
+    """
+    parts, v_now = [[]], None
+    for m in range(1, len(idx)):
+        v = _vel_cp(speed[idx[m - 1] : idx[m] + 1].max())
+        lin = f"LIN {names[m]}" + (" C_DIS" if m < len(idx) - 1 else "")
+        block = [f"$VEL.CP={v:.4f}", lin] if v != v_now else [lin]
+        if parts[-1] and len(parts[-1]) + len(block) > line_limit:
+            parts.append([])
+            block = [f"$VEL.CP={v:.4f}", lin]
+        parts[-1] += block
+        v_now = v
+    return parts
+
+
+def _conventions(style: str, convention: str, n: int, chord_tol_m, angle_tol_rad) -> list[str]:
+    """Header lines stating units, frames and conventions (the caller appends the
+    achieved deviation to the second last)."""
+    if style == "flange":
+        points = "Style flange: $IPO_MODE=#BASE, $BASE=$NULLFRAME ($ROBROOT), $TOOL = part P in "
+        points += "$FLANGE; points: pose of P in $ROBROOT."
+    else:
+        points = "Style external_tcp: $IPO_MODE=#TCP, $BASE = fixed tool T in $ROBROOT, $TOOL = "
+        points += "part P in $FLANGE; points: " + (
+            "pose of P in T (X_TP), flange = $BASE:POS:inv($TOOL)."
+            if convention == "X_TP"
+            else "pose of T in P (X_PF), flange = $BASE:inv(POS):inv($TOOL)."
+        )
+    return [
+        "KRL for KSS 8. X, Y, Z in mm; A, B, C in deg, R = Rz(A)*Ry(B)*Rx(C) (Z-Y'-X''); "
+        "$VEL.CP in m/s; $APO.CDIS in mm.",
+        "E6AXIS A1..A6 = URDF joints 1..6 in deg (KUKA signs and zeros). $WORLD = $ROBROOT = "
+        "URDF base_link (check on the controller). $FLANGE = URDF tool0 (z out of the flange).",
+        points,
+        "Status: bit0 wrist centre behind A1 (overhead), bit1 wrist centre above the A2-A3 line "
+        "(elbow up), bit2 A5 < 0. Turn: bit i set when A(i+1) < 0.",
+        f"{n} process points: chord <= {chord_tol_m * 1e3:g} mm, orientation <= "
+        f"{np.rad2deg(angle_tol_rad):g} deg",
+        "Not set here: $LOAD (gripper + part), process I/O. Approach and retract moves are not "
+        "collision-checked.",
+    ]
+
+
+def _comments(lines: list[str]) -> list[str]:
+    ascii_lines = [line.encode("ascii", "replace").decode() for line in lines]
+    return ["; " + part for line in ascii_lines for part in textwrap.wrap(line, 100) or [""]]
+
+
+def _check(name: str, style: str, convention: str, line_limit: int, tolerances) -> None:
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or len(name) > MAX_NAME_CHARS - 4:
+        raise ValueError(f"write_krl: name {name!r} is not a KRL name of <= 20 characters")
+    if style not in STYLES or convention not in TCP_POSE_CONVENTIONS:
+        raise ValueError(
+            f"write_krl: style {style!r} / tcp_pose_convention {convention!r} "
+            f"not in {STYLES} / {TCP_POSE_CONVENTIONS}"
+        )
+    if line_limit < 2 or min(tolerances) <= 0:
+        raise ValueError("write_krl: expected line_limit >= 2 and tolerances > 0")
+
+
+def write_krl(
+    data: ProgramData,
+    out_dir: Path,
+    *,
+    name: str = "offline_prog",
+    style: str = "external_tcp",
+    chord_tol_m: float = DEFAULT_CHORD_TOL_M,
+    angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
+    line_limit: int = 1400,
+    tcp_pose_convention: str = "X_TP",
+    approach_m: float = 0.02,
+    blend_m: float = 0.001,
+    forced: bool = False,
+) -> KrlResult:
+    """Write the KRL program for a plan (see the module docstring for the frames).
+
+    The main program sets the frames, moves PTP (E6AXIS, joint solution nearest the
+    plan's start) to the approach pose ``approach_m`` off the path start against the
+    process normal (y of F), goes LIN onto the path, runs the process LIN points
+    (``C_DIS`` with ``$APO.CDIS`` = blend_m; ``$VEL.CP`` see ``_process_lines``: the TCP
+    speed, or the part-origin speed in the flange style) and retracts LIN by
+    ``approach_m``. Process lines beyond ``line_limit`` go to ``name_1``, ``name_2``, ...
+    (own .src/.dat each), called in order from the main program.
+
+    Args:
+        data: the plan; its robot must be an OPW arm with KUKA joint conventions.
+        out_dir: folder for the files (created).
+        name: KRL program name (<= 20 characters, leaving room for ``_<k>``).
+        style: "external_tcp" ($IPO_MODE #TCP) or "flange" (#BASE, dense X_BP points).
+        chord_tol_m, angle_tol_rad: allowed deviation of the plan from the LIN path [m, rad].
+        line_limit: most process lines in one .src before splitting.
+        tcp_pose_convention: "X_TP" (default, P in T) or "X_PF" (T in P), external_tcp only.
+        approach_m, blend_m: approach/retract distance and C_DIS blend distance [m].
+        forced: the plan failed and is exported anyway (the header says so).
+
+    Raises:
+        ValueError: a bad argument, a non-OPW robot, or an unreachable approach/retract.
+    """
+    _check(name, style, tcp_pose_convention, line_limit, (chord_tol_m, angle_tol_rad))
+    robot = load_robot(data.robot)
+    if robot.family != "opw":
+        raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
+    idx, max_chord, max_angle = _process_points(data, style, chord_tol_m, angle_tol_rad)
+    off = np.eye(4)
+    off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
+    X_PF_off = data.X_PF[[0, -1]] @ off  # approach, retract
+    X_BE_off = data.X_BT @ np.linalg.inv(X_PF_off) @ np.linalg.inv(data.X_EP)
+    q_approach = _joints_near(robot, X_BE_off[0], data.q[0], data, "approach")
+    q_retract = _joints_near(robot, X_BE_off[1], data.q[-1], data, "retract")
+    X_PF = np.concatenate([data.X_PF[idx], X_PF_off[1:]])  # the process points, retract
+    X_BE = np.concatenate([data.X_BE[idx], X_BE_off[1:]])
+    if style == "flange":
+        poses, base, ipo = X_BE @ data.X_EP, "$NULLFRAME", "#BASE"
+        speed = np.linalg.norm(
+            np.gradient((data.X_BE @ data.X_EP)[:, :3, 3], data.t, axis=0), axis=1
+        )
+    else:
+        poses = np.linalg.inv(X_PF) if tcp_pose_convention == "X_TP" else X_PF
+        base, ipo, speed = "FIXED_TOOL", "#TCP", data.tcp_speed
+    status, turn = status_turn(robot.params, np.vstack([data.q[idx], q_retract]))
+    names = [f"XP{k + 1}" for k in range(len(idx))] + ["XRETRACT"]
+    decl = {
+        n: f"DECL E6POS {n}={{{_frame(X)},S {s},T {t}{_ZEROS}}}"
+        for n, X, s, t in zip(names, poses, status, turn, strict=True)
+    }
+    R = data.X_BE[:, :3, :3]
+    omega = Rotation.from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]).magnitude() / np.diff(data.t)
+    parts = _process_lines(names, idx, speed, line_limit)
+    subs = [f"{name}_{k + 1}" for k in range(len(parts))] if len(parts) > 1 else []
+    conventions = _conventions(style, tcp_pose_convention, len(idx), chord_tol_m, angle_tol_rad)
+    conventions[-2] += f" (achieved {max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg)."
+    head = _comments(header_lines(data, conventions=conventions, forced=forced))
+    src = _MAIN.format(
+        name=name,
+        ext="".join(f"EXT {sub}( )\n" for sub in subs),
+        base=base,
+        ipo=ipo,
+        ptp_vel=PTP_VEL_PERCENT,
+        ptp_acc=PTP_ACC_PERCENT,
+        ori=max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S),
+        cdis=blend_m * 1e3,
+        approach=approach_m * 1e3,
+        v=_vel_cp(data.process_speed_m_s),
+        process="\n".join([f"{sub}( )" for sub in subs] or parts[0]),
+    )
+    axes = ",".join(f"A{i + 1} {_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_approach)))
+    dat = [
+        f"DEFDAT {name}",
+        "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
+        f"DECL FRAME PART_ON_FLANGE={{{_frame(X_KE @ data.X_EP)}}}",
+        *([f"DECL FRAME FIXED_TOOL={{{_frame(data.X_BT)}}}"] if style != "flange" else []),
+        f"DECL E6AXIS XAPPROACH={{{axes}{_ZEROS}}}",
+        decl["XP1"],
+        decl["XRETRACT"],
+    ]
+    dat += [] if subs else [decl[n] for n in names[1:-1]]
+    files = _write(Path(out_dir), name, head + src.splitlines(), head + dat + ["ENDDAT"])
+    for k, (sub, lines) in enumerate(zip(subs, parts if subs else [], strict=True)):
+        part_head = head + [f"; Part {k + 1} of {len(subs)} of program {name}"]
+        points = [decl[line.split()[1]] for line in lines if line.startswith("LIN")]
+        files += _write(
+            Path(out_dir),
+            sub,
+            [*part_head, f"DEF {sub}( )", *lines, "END"],
+            [*part_head, f"DEFDAT {sub}", *points, "ENDDAT"],
+        )
+    return KrlResult(files, len(idx), idx, max_chord, max_angle)
+
+
+def _write(folder: Path, name: str, src: list[str], dat: list[str]) -> list[Path]:
+    """Write name.src and name.dat with CRLF line ends (as KSS writes them)."""
+    files = []
+    for ext, lines in (("src", src), ("dat", dat)):
+        assert max(len(line) for line in lines) <= MAX_LINE_CHARS
+        files.append(folder / f"{name}.{ext}")
+        write_atomic(files[-1], "\r\n".join(lines) + "\r\n")
+    return files
