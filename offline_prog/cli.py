@@ -1,7 +1,8 @@
 """Command line: ``offline-prog plan CELL.yaml --out DIR``.
 
 Thin by design: parse flags, call the library, print a short summary. Bad input
-ends with one line on stderr and exit code 2; an internal error with one line
+ends with one line on stderr and exit code 2; a plan that fails a check (a collision)
+writes its outputs, prints one line and exits with 1; an internal error with one line
 and exit code 3 (``--debug`` shows the traceback).
 """
 
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 from rich.console import Console
 
+EXIT_PLAN_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 
@@ -135,6 +137,18 @@ def _summary(console: Console, report: dict, files: dict, seconds: float) -> Non
             else "process speed held everywhere"
         )
     )
+    distance = report["min_distance_m"]
+    closest = report["closest_pair"]
+    console.print(
+        "  clearance "
+        + (
+            "no checked pairs"
+            if distance is None
+            else f"min distance {distance * 1e3:.1f} mm ({' vs '.join(closest['pair'])} at "
+            f"σ={closest['sigma_m']:.3f} m), "
+            + ("collision-free" if report["collision_free"] else "FAILS")
+        )
+    )
     cusps = report["cusps"]
     console.print(
         f"  cusps     {len(cusps)}"
@@ -179,6 +193,13 @@ def main(argv: list[str] | None = None) -> int:
             errors.print(f"error: {error}", markup=False, highlight=False)
             return EXIT_BAD_INPUT
         _summary(console, report, files, time.perf_counter() - started)
+        if not plan.feasible:  # outputs written so the user can see why; no programs
+            errors.print(
+                f"error: {args.cell}: {plan.failure} (see {files['collisions']})",
+                markup=False,
+                highlight=False,
+            )
+            return EXIT_PLAN_FAILED
         return 0
     except Exception as error:  # one line, never a traceback unless asked
         if args.debug:

@@ -16,6 +16,7 @@ import numpy as np
 from offline_prog import __version__
 from offline_prog.atomic import write_atomic
 from offline_prog.cell import transform
+from offline_prog.collision import write_collisions_json
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
@@ -122,6 +123,28 @@ def robot_report(plan: Plan) -> dict:
     }
 
 
+def collision_summary(plan: Plan) -> dict:
+    """report.json's collision keys: min_distance_m, collision_free, the closest pair."""
+    result = plan.collisions
+    closest = result.closest
+    return {
+        "collision_free": result.collision_free,
+        "min_distance_m": result.min_distance_m if np.isfinite(result.min_distance_m) else None,
+        "closest_pair": None
+        if closest is None
+        else {
+            "pair": [closest.a, closest.b],
+            "group": closest.group,
+            "sigma_m": closest.sigma_m,
+            "t_s": closest.t_s,
+            "distance_m": closest.distance_m,
+        },
+        "clearance_m": result.clearance_m,
+        "feasible": plan.feasible,
+        "failure": plan.failure,
+    }
+
+
 def report(plan: Plan) -> dict:
     """The machine-readable plan summary (SI units unless the key says otherwise)."""
     cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
@@ -175,6 +198,7 @@ def report(plan: Plan) -> dict:
             **speed_checks(plan),
         },
         "robot_motion": robot_report(plan),
+        **collision_summary(plan),
         "cusps": [c.__dict__ for c in plan.cusps],
         "cusp_smoothing": smoothing,
         "timings_s": plan.timings_s,
@@ -202,8 +226,8 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         process_speed_m_s=cell.motion.speed,
         speed_reference=traj.reference,
         cycle_time_s=traj.duration,
-        feasible=True,
-        failure="",
+        feasible=plan.feasible,
+        failure=plan.failure,
         joint_names=tuple(plan.robot.joint_names),
         generated=summary["generated"],
         t=traj.t,
@@ -228,12 +252,19 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
         The written files by name, and the report that went into report.json.
     """
     out_dir = Path(out_dir)
-    files = {"trajectory": out_dir / "trajectory.csv", "report": out_dir / "report.json"}
+    files = {
+        "trajectory": out_dir / "trajectory.csv",
+        "report": out_dir / "report.json",
+        "collisions": out_dir / "collisions.json",
+    }
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
+    write_collisions_json(plan.collisions, files["collisions"])
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
     data = program_data(plan, summary)
     files["plan"] = data.save(out_dir)
+    if not data.feasible:  # no program from a failed plan (offline-prog export --force can)
+        return files, summary
     for fmt in default_formats(data.robot):
         for file in export(data, fmt, out_dir / PROGRAMS_DIR):
             files[f"{fmt}:{file.name}"] = file

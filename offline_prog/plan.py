@@ -19,7 +19,10 @@ import numpy as np
 from offline_prog.arc_length import ArcLengthPath
 from offline_prog.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.cell import Cell, CellError, load_cell, transform
+from offline_prog.collision import CollisionResult, check_trajectory
 from offline_prog.cusps import Cusp, SmoothedFlangePath, find_cusps
+from offline_prog.drake_cell import build_cell_model
+from offline_prog.geometry import ShapeError
 from offline_prog.fixed_tcp import FlangePath
 from offline_prog.inputs import check_cell, load_points, normal_field
 from offline_prog.joint_plan import (
@@ -59,6 +62,17 @@ class Plan:
     joints: JointTrajectory
     nominal_duration_s: float
     tool_rotation_rad: float
+    collisions: CollisionResult
+
+    @property
+    def feasible(self) -> bool:
+        """Every check passed (collision-free at the clearance)."""
+        return self.collisions.collision_free
+
+    @property
+    def failure(self) -> str:
+        """Why the plan failed, one line ("" if it did not)."""
+        return self.collisions.message
 
 
 class PlanInfeasibleError(CellError):
@@ -184,7 +198,16 @@ def plan_cell(
         )
     except JointPlanError as error:
         raise PlanInfeasibleError(file, str(error)) from None
-    lap("joints")
+    lap("joints", "collision check")
+    try:
+        drake = build_cell_model(cell, file, robot)  # the tool at the cell's own X_IT
+    except ShapeError as error:
+        raise CellError(file, error.key, error.reason) from None
+    traj = joints.trajectory
+    collisions = check_trajectory(
+        drake, joints.q, traj.t, traj.sigma, clearance=cell.motion.clearance
+    )
+    lap("collision")
     return Plan(
         file,
         cell,
@@ -199,4 +222,5 @@ def plan_cell(
         joints,
         nominal.duration,
         rotation,
+        collisions,
     )

@@ -57,12 +57,16 @@ def test_servoj_stream_reproduces_the_plan(data, plan_dir):
 def test_hermite_resampling_matches_a_denser_plan(tmp_path):
     cell = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
     dense_cell = tmp_path / "dense.yaml"
-    dense_cell.write_text(cell.replace("max_jerk: 10.0", "max_jerk: 10.0\n  sample_rate_hz: 500")
-                          .replace("points: data/", f"points: {CELLS / 'data'}/"))
+    dense_cell.write_text(
+        cell.replace("max_jerk: 10.0", "max_jerk: 10.0\n  sample_rate_hz: 500").replace(
+            ": data/", f": {CELLS / 'data'}/"
+        )
+    )
     coarse = plan_cell(CELLS / "tape_cylinder_ur10e.yaml").joints
     dense = plan_cell(dense_cell)
     fake = dataclasses.make_dataclass("D", ["t", "q", "qd"])(
-        coarse.trajectory.t, coarse.q, coarse.qd)
+        coarse.trajectory.t, coarse.q, coarse.qd
+    )
     t, q = resample_joints(fake, 0.002)
     n = min(len(t), len(dense.trajectory.t))
     np.testing.assert_allclose(t[:n], dense.trajectory.t[:n], atol=1e-9)
@@ -103,8 +107,10 @@ def test_joint_csv_and_ros_json(data, plan_dir):
     np.testing.assert_allclose(table[:, 1:], data.q, atol=1e-9)
     message = json.loads((plan_dir / "programs" / "joint_trajectory.json").read_text())
     assert message["joint_names"] == list(data.joint_names)
-    t = [p["time_from_start"]["sec"] + p["time_from_start"]["nanosec"] * 1e-9
-         for p in message["points"]]
+    t = [
+        p["time_from_start"]["sec"] + p["time_from_start"]["nanosec"] * 1e-9
+        for p in message["points"]
+    ]
     np.testing.assert_allclose(t, data.t, atol=1e-9)
     assert all(0 <= p["time_from_start"]["nanosec"] < 1_000_000_000 for p in message["points"])
     np.testing.assert_allclose([p["positions"] for p in message["points"]], data.q, atol=1e-12)
@@ -132,6 +138,10 @@ def test_cli_export_refuses_a_failed_plan(data, tmp_path):
 
 
 def test_cli_export_of_a_folder_without_a_plan(tmp_path):
-    done = subprocess.run([sys.executable, "-m", "offline_prog", "export", str(tmp_path),
-                           "--format", "csv"], capture_output=True, text=True, cwd=REPO)
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "export", str(tmp_path), "--format", "csv"],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+    )
     assert done.returncode == 2 and "not a plan folder" in done.stderr

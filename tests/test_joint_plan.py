@@ -71,7 +71,7 @@ def test_free_rotation_rescues_a_pose_out_of_the_joint_limits(tmp_path):
     assert turned != WELD
     fixed = tmp_path / "turned.yaml"
     fixed.write_text(turned)
-    with pytest.raises(PlanInfeasibleError, match="joint limit on axis 5"):
+    with pytest.raises(PlanInfeasibleError, match="joint limit on axis [0-9]"):
         plan_cell(fixed)
     free = tmp_path / "free.yaml"
     free.write_text(
