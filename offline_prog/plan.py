@@ -22,8 +22,8 @@ from offline_prog.cell import Cell, CellError, load_cell, transform
 from offline_prog.collision import CollisionResult, check_trajectory
 from offline_prog.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.drake_cell import build_cell_model
-from offline_prog.geometry import ShapeError
 from offline_prog.fixed_tcp import FlangePath
+from offline_prog.geometry import ShapeError
 from offline_prog.inputs import check_cell, load_points, normal_field
 from offline_prog.joint_plan import (
     JointPlanError,
