@@ -9,6 +9,7 @@ and exit code 3 (``--debug`` shows the traceback).
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 import time
 from pathlib import Path
@@ -32,6 +33,19 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
     plan.add_argument(
         "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
+    )
+    plan.add_argument(
+        "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
+    )
+    plan.add_argument("--port", type=int, default=7000, help="MeshCat port for --preview")
+    preview = commands.add_parser("preview", help="plan a cell and show it in MeshCat")
+    preview.add_argument("cell", type=Path, help="work-cell YAML file")
+    preview.add_argument("--port", type=int, default=7000, help="MeshCat port (default 7000)")
+    preview.add_argument(
+        "--seconds",
+        type=float,
+        default=None,
+        help="keep the server this long (default: until Ctrl-C)",
     )
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
@@ -163,6 +177,29 @@ def _summary(console: Console, report: dict, files: dict, seconds: float) -> Non
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
 
 
+def _serve_preview(plan, args, console: Console) -> None:
+    """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    from offline_prog.preview import near_collision_mask, show_plan
+
+    params = MeshcatParams()
+    params.port = args.port
+    meshcat = Meshcat(params)
+    info = show_plan(plan, meshcat, near_collision=near_collision_mask(plan))
+    console.print(
+        f"MeshCat preview at [bold]{meshcat.web_url()}[/bold] "
+        f"({info['frames']} animation frames; Ctrl-C to stop)"
+    )
+    seconds = getattr(args, "seconds", None)
+    try:
+        deadline = None if seconds is None else time.monotonic() + seconds
+        while deadline is None or time.monotonic() < deadline:
+            time.sleep(0.2)
+    except KeyboardInterrupt:
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
@@ -171,7 +208,11 @@ def main(argv: list[str] | None = None) -> int:
         from offline_prog.cell import CellError
         from offline_prog.export.formats import ExportRefusedError
         from offline_prog.outputs import write_outputs
-        from offline_prog.plan import plan_cell
+        from offline_prog.plan import PlanInfeasibleError, plan_cell
+
+        # After pydrake's import (it sets the level): its INFO lines would break
+        # "one line on stderr".
+        logging.getLogger("drake").setLevel(logging.WARNING)
 
         if args.command == "export":
             try:
@@ -183,19 +224,29 @@ def main(argv: list[str] | None = None) -> int:
             except ValueError as error:
                 errors.print(f"error: {error}", markup=False, highlight=False)
                 return EXIT_BAD_INPUT
+        if args.command == "preview":
+            args.preview, args.out = True, None
         try:
             with errors.status("planning") as status:
                 plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
                 out = args.out or Path("out") / args.cell.stem
                 status.update("writing outputs")
-                files, report = write_outputs(plan, out)
+                if args.command == "plan":
+                    files, report = write_outputs(plan, out)
+        except PlanInfeasibleError as error:  # valid cell, but the robot cannot do it
+            errors.print(f"error: {error}", markup=False, highlight=False)
+            return EXIT_PLAN_FAILED
         except CellError as error:
             errors.print(f"error: {error}", markup=False, highlight=False)
             return EXIT_BAD_INPUT
-        _summary(console, report, files, time.perf_counter() - started)
+        if args.command == "plan":
+            _summary(console, report, files, time.perf_counter() - started)
+        if args.preview:
+            _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs
+            where = f" (see {files['collisions']})" if args.command == "plan" else ""
             errors.print(
-                f"error: {args.cell}: {plan.failure} (see {files['collisions']})",
+                f"error: {args.cell}: {plan.failure}{where}",
                 markup=False,
                 highlight=False,
             )

@@ -101,6 +101,7 @@ class DrakeCell:
     X_PE: RigidTransform
     labels: dict[GeometryId, GeometryLabel] = dataclasses.field(default_factory=dict)
     allowed_contact: list[tuple[str, str]] = dataclasses.field(default_factory=list)
+    visualizer: object = None  # MeshcatVisualizer when built with a Meshcat
 
     @property
     def frame_E(self):
@@ -205,6 +206,7 @@ def build_drake_cell(
     tool_shapes: Sequence[CellShape] = (),
     obstacles: Sequence[CellShape] = (),
     allowed_contact: Sequence[tuple[str, str]] = (),
+    meshcat=None,
 ) -> DrakeCell:
     """Build and finalize the cell's plant (paper §3: robot carries P past T).
 
@@ -218,6 +220,7 @@ def build_drake_cell(
         part_shapes, tool_shapes: CellShapes posed in P and T.
         obstacles: CellShapes posed in I (anchored to the world).
         allowed_contact: pairs of shape (or robot link) names not to check.
+        meshcat: a Meshcat to draw the cell in (adds a MeshcatVisualizer).
 
     Raises:
         ShapeError: a shape name used twice, or an unknown name in allowed_contact.
@@ -254,11 +257,20 @@ def build_drake_cell(
         for geometry_id in plant.GetCollisionGeometriesForBody(body):
             labels[geometry_id] = GeometryLabel("robot", body.name(), body.name())
     _filter(builder.scene_graph(), plant, labels, part, allowed_contact)
+    visualizer = None
+    if meshcat is not None:
+        from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
+
+        visualizer = MeshcatVisualizer.AddToBuilder(
+            builder.builder(), builder.scene_graph(), meshcat, MeshcatVisualizerParams()
+        )
     diagram = builder.Build()
-    return DrakeCell(diagram, plant, model, X_IB, X_IT, X_PE, labels, list(allowed_contact))
+    return DrakeCell(
+        diagram, plant, model, X_IB, X_IT, X_PE, labels, list(allowed_contact), visualizer
+    )
 
 
-def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel) -> DrakeCell:
+def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel, meshcat=None) -> DrakeCell:
     """The DrakeCell of a loaded cell file with all its shapes.
 
     The tool body sits at the cell's own X_IT: a free rotation of T about a symmetric
@@ -277,4 +289,5 @@ def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel) -> DrakeCel
         tool_shapes=geometry.tool,
         obstacles=geometry.obstacles,
         allowed_contact=geometry.allowed_contact,
+        meshcat=meshcat,
     )

@@ -20,6 +20,8 @@ from offline_prog.collision import write_collisions_json
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
+from offline_prog.preview import write_preview_html
+from offline_prog.report_html import write_report_html
 from offline_prog.trajectory import CSV_COLUMNS
 
 
@@ -263,9 +265,11 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
     data = program_data(plan, summary)
     files["plan"] = data.save(out_dir)
-    if not data.feasible:  # no program from a failed plan (offline-prog export --force can)
-        return files, summary
-    for fmt in default_formats(data.robot):
-        for file in export(data, fmt, out_dir / PROGRAMS_DIR):
-            files[f"{fmt}:{file.name}"] = file
+    if data.feasible:  # no program from a failed plan (offline-prog export --force can)
+        for fmt in default_formats(data.robot):
+            for file in export(data, fmt, out_dir / PROGRAMS_DIR):
+                files[f"{fmt}:{file.name}"] = file
+    files["preview"] = out_dir / "preview.html"
+    write_preview_html(plan, files["preview"])
+    files["report_html"] = write_report_html(out_dir)  # last: it lists the programs
     return files, summary

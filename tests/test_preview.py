@@ -1,0 +1,105 @@
+"""The MeshCat preview: a standalone preview.html that shows the robot and part in a
+real browser (software WebGL), an animation as long as the plan, and the preview
+command; plus a plan that fails its collision check."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from offline_prog.outputs import write_outputs
+from offline_prog.plan import plan_cell
+from offline_prog.preview import show_plan
+
+from browser import WEBGL_ARGS, require_chromium, screenshot
+from conftest import CELLS, REPO
+
+
+@pytest.fixture(scope="module")
+def seal(tmp_path_factory):
+    out = tmp_path_factory.mktemp("seal")
+    plan = plan_cell(CELLS / "seal_plate_kr16.yaml")
+    write_outputs(plan, out)
+    return plan, out
+
+
+def test_animation_has_the_plan_duration(seal):
+    from pydrake.geometry import Meshcat
+
+    plan, _ = seal
+    info = show_plan(plan, Meshcat())
+    # Frames 0 .. floor(T · fps): one per 1/fps of the plan, the last at its end.
+    expected = int(np.floor(plan.trajectory.duration * info["frames_per_second"])) + 1
+    assert info["frames"] == expected
+
+
+def test_preview_html_shows_the_cell_in_a_browser(seal, tmp_path):
+    require_chromium()
+    _, out = seal
+    page = out / "preview.html"
+    text = page.read_text()
+    assert "<script" in text and len(text) > 100_000  # MeshCat's viewer is inlined
+    png = screenshot(page, tmp_path / "preview.png", size=(1200, 800), extra=WEBGL_ARGS)
+    print(f"preview screenshot: {png}")
+    image = np.asarray(Image.open(png).convert("RGB")).astype(float)
+    assert image.std() > 20, "the 3D view is blank"
+    red, green, blue = image[..., 0], image[..., 1], image[..., 2]
+    orange = (red > 180) & (green > 60) & (green < 190) & (blue < 90)  # robot and plate
+    assert orange.mean() > 0.01, "no robot or part in view"
+    h, w = orange.shape
+    centre = orange[h // 4 : 3 * h // 4, w // 4 : 3 * w // 4]
+    assert centre.mean() > orange.mean(), "the camera is not framed on the cell"
+
+
+def test_preview_command_serves_and_exits(tmp_path):
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "preview",
+            str(CELLS / "tape_cylinder_ur10e.yaml"),
+            "--port",
+            "7077",
+            "--seconds",
+            "0",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "MeshCat preview at http://localhost:7077" in done.stdout
+
+
+def test_a_colliding_plan_writes_its_reports_but_no_program(tmp_path):
+    cell = (CELLS / "seal_plate_kr16.yaml").read_text()
+    # A block in the plate's plane, beside the nozzle: the plate sweeps through it.
+    blocked = cell.replace(
+        "obstacles:   # in I",
+        "obstacles:   # in I\n"
+        "  - {name: intruder, shape: box, size_mm: [20, 20, 20], "
+        "pose: {translation: [1.05, 0.05, 0.5025]}}",
+    )
+    assert blocked != cell
+    file = tmp_path / "blocked.yaml"
+    file.write_text(blocked)
+    out = tmp_path / "out"
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(file), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=300,
+    )
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "collision: plate vs intruder" in lines[0], lines
+    report = json.loads((out / "report.json").read_text())
+    assert report["collision_free"] is False and report["feasible"] is False
+    assert (out / "collisions.json").is_file() and (out / "preview.html").is_file()
+    assert not (out / "programs").exists()
