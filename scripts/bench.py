@@ -27,7 +27,8 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
 from offline_prog.cell import transform
-from offline_prog.drake_cell import build_drake_cell
+from offline_prog.collision import check_trajectory
+from offline_prog.drake_cell import build_cell_model, build_drake_cell
 from offline_prog.drake_ik import solve_path, solve_pose
 from offline_prog.path_ik import base_poses, branch_results, choose_branch
 from offline_prog.plan import plan_cell
@@ -63,6 +64,25 @@ def bench_stages(cells: list[Path]) -> None:
         stages = ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in plan.timings_s.items())
         print(
             f"{file.stem:24s} {len(plan.trajectory.t):6d} samples  total {total:.3f} s  ({stages})"
+        )
+
+
+def bench_collision(cells: list[Path]) -> None:
+    print("\n== collision check along the planned path (full cell geometry) ==")
+    for file in cells:
+        plan = plan_cell(file)
+        drake = build_cell_model(plan.cell, file, plan.robot)
+        traj, q = plan.trajectory, plan.joints.q
+        seconds, result = best_of(
+            3,
+            lambda drake=drake, traj=traj, q=q: check_trajectory(
+                drake, q, traj.t, traj.sigma, clearance=plan.cell.motion.clearance
+            ),
+        )
+        print(
+            f"{file.stem:24s} {len(q):6d} samples  {seconds * 1e3:7.1f} ms  "
+            f"{len(q) / seconds:10.0f} samples/s  min distance "
+            f"{result.min_distance_m * 1e3:.1f} mm"
         )
 
 
@@ -154,6 +174,7 @@ def main() -> None:
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
     bench_stages(cells)
+    bench_collision(cells)
     for file in cells:
         bench_path_ik(file, args.samples, args.drake_samples)
 
