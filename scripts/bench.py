@@ -20,6 +20,7 @@ tests tie to Drake's FK of the URDF to 1e-15).
 from __future__ import annotations
 
 import argparse
+import functools
 import time
 from pathlib import Path
 
@@ -73,12 +74,10 @@ def bench_collision(cells: list[Path]) -> None:
         plan = plan_cell(file)
         drake = build_cell_model(plan.cell, file, plan.robot)
         traj, q = plan.trajectory, plan.joints.q
-        seconds, result = best_of(
-            3,
-            lambda drake=drake, traj=traj, q=q: check_trajectory(
-                drake, q, traj.t, traj.sigma, clearance=plan.cell.motion.clearance
-            ),
+        check = functools.partial(
+            check_trajectory, drake, q, traj.t, traj.sigma, clearance=plan.cell.motion.clearance
         )
+        seconds, result = best_of(3, check)
         print(
             f"{file.stem:24s} {len(q):6d} samples  {seconds * 1e3:7.1f} ms  "
             f"{len(q) / seconds:10.0f} samples/s  min distance "
