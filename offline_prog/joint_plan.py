@@ -120,16 +120,17 @@ ROTATION_STEP_RAD = np.deg2rad(5.0)
 ROTATION_TRIAL_POINTS = 400
 
 
-def choose_tool_rotation(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y"):
-    """Best fixed turn φ ∈ [−bound, bound] of a symmetric tool about its axis.
+def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y"):
+    """Fixed turns φ ∈ [−bound, bound] of a symmetric tool about its axis, best first.
 
     The process frame is laid onto T·R_axis(φ) instead of T, which a tool
     symmetric about that axis cannot tell apart. A constant φ keeps the flange
-    path exactly as smooth as with φ = 0. The φ whose best branch has the largest
-    joint-limit margin wins (the smaller |φ| on ties).
+    path exactly as smooth as with φ = 0. Ranked by the joint-limit margin of each
+    φ's best branch (the smaller |φ| on ties); the collision check may move on to
+    the next.
 
     Returns:
-        (φ [rad], the FlangePath built with it).
+        [(φ [rad], the FlangePath built with it), ...], best first.
     """
     from pydrake.common.eigen_geometry import AngleAxis
     from pydrake.math import RigidTransform, RotationMatrix
@@ -140,16 +141,16 @@ def choose_tool_rotation(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, b
     count = int(np.ceil(bound_rad / ROTATION_STEP_RAD))
     angles = np.linspace(-bound_rad, bound_rad, 2 * count + 1) if count else np.zeros(1)
     s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
-    best = None
+    ranked = []
     for phi in sorted(angles, key=abs):
         X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
         flange = FlangePath(path, normal, X_IT=X_IT_phi, X_PE=X_PE)
         f = flange(s)
         result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)
-        if best is None or score > best[0]:
-            best = (score, phi, flange)
-    return float(best[1]), best[2]
+        ranked.append((score, -abs(phi), float(phi), flange))
+    ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)
+    return [(phi, flange) for _, _, phi, flange in ranked]
 
 
 def _time_at(law: Sin2TimeLaw, sigma: float) -> float:
@@ -165,6 +166,7 @@ def plan_joint_trajectory(
     nominal: Sin2TimeLaw,
     *,
     rate_hz: float,
+    branch: int | None = None,
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -175,6 +177,7 @@ def plan_joint_trajectory(
         parameter: σ ↦ s for the time law's speed reference.
         nominal: the process time law (before joint limits).
         rate_hz: output sample rate.
+        branch: use this analytic branch (if feasible) instead of the best one.
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(2001, int(np.ceil(length / GRID_SPACING_M)) + 1))
@@ -186,7 +189,7 @@ def plan_joint_trajectory(
         results = [chosen]
     else:
         results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
-        chosen = choose_branch(results)
+        chosen = choose_branch(results) if branch is None else results[branch]
         path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])

@@ -144,6 +144,7 @@ def collision_summary(plan: Plan) -> dict:
         "clearance_m": result.clearance_m,
         "feasible": plan.feasible,
         "failure": plan.failure,
+        "collision_avoidance": plan.avoidance,
     }
 
 

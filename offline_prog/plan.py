@@ -28,8 +28,8 @@ from offline_prog.inputs import check_cell, load_points, normal_field
 from offline_prog.joint_plan import (
     JointPlanError,
     JointTrajectory,
-    choose_tool_rotation,
     plan_joint_trajectory,
+    tool_rotations,
 )
 from offline_prog.path_sources import PathPoints
 from offline_prog.process_frames import NormalTangentError
@@ -63,6 +63,7 @@ class Plan:
     nominal_duration_s: float
     tool_rotation_rad: float
     collisions: CollisionResult
+    avoidance: dict | None = None  # what the collision avoidance tried and changed
 
     @property
     def feasible(self) -> bool:
@@ -73,6 +74,69 @@ class Plan:
     def failure(self) -> str:
         """Why the plan failed, one line ("" if it did not)."""
         return self.collisions.message
+
+
+# Collision avoidance: at most this many re-plans (tool rotations × branches).
+MAX_AVOIDANCE_ATTEMPTS = 12
+
+
+@dataclasses.dataclass
+class _Attempt:
+    """One joint plan and its collision check."""
+
+    rotation: float
+    flange: object
+    nominal: object
+    joints: JointTrajectory
+    collisions: CollisionResult
+
+
+def _avoid_collisions(first: _Attempt, rotations, attempt) -> tuple[_Attempt, dict]:
+    """Re-plan with the other tool rotations and configuration branches until one is
+    collision-free (cheap choices first; the process pose is held in every one).
+
+    Returns:
+        The collision-free attempt (else the one with the largest clearance) and a
+        record for the report: the samples that needed avoidance, what was tried and
+        what changed.
+    """
+    tried, best = 0, first
+    candidates = [
+        (first.rotation, first.flange, b.branch)
+        for b in first.joints.branches
+        if b.feasible and b.branch != first.joints.branch
+    ]
+    candidates += [(phi, flange, None) for phi, flange in rotations[1:]]
+    for phi, flange, branch in candidates:
+        if tried >= MAX_AVOIDANCE_ATTEMPTS:
+            break
+        tried += 1
+        try:
+            trial = attempt(phi, flange, branch)
+        except JointPlanError:
+            continue
+        if trial.collisions.min_distance_m > best.collisions.min_distance_m:
+            best = trial
+        if trial.collisions.collision_free:
+            break
+    sigma = first.joints.trajectory.sigma
+    needed = sorted(set(first.collisions.samples_in_collision))
+    change = []
+    if best.rotation != first.rotation:
+        change.append(
+            f"tool rotation {np.rad2deg(first.rotation):.1f}° → {np.rad2deg(best.rotation):.1f}°"
+        )
+    if best.joints.branch != first.joints.branch:
+        change.append(f"branch {first.joints.branch} → {best.joints.branch}")
+    record = {
+        "samples_that_needed_it": needed,
+        "sigma_m_that_needed_it": [float(sigma[i]) for i in needed if 0 <= i < len(sigma)],
+        "first_failure": first.collisions.message,
+        "attempts": tried,
+        "resolved": best.collisions.collision_free,
+        "change": ", ".join(change) or "none",
+    }
+    return best, record
 
 
 class PlanInfeasibleError(CellError):
@@ -158,9 +222,9 @@ def plan_cell(
     try:
         flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE)
         flange(np.linspace(0.0, path.length, 2001))  # frames defined everywhere?
-        rotation = 0.0
+        rotations = [(0.0, flange)]
         if cell.tool.free_rotation_deg > 0:
-            rotation, flange = choose_tool_rotation(
+            rotations = tool_rotations(
                 robot,
                 X_IB,
                 path,
@@ -170,14 +234,10 @@ def plan_cell(
                 bound_rad=np.deg2rad(cell.tool.free_rotation_deg),
                 axis=cell.tool.symmetry_axis,
             )
+        rotation, flange = rotations[0]
         cusps = find_cusps(flange)
     except NormalTangentError as error:
         raise CellError(file, "path.normal", str(error)) from None
-    if cell.motion.cusp_smoothing_mm is not None:
-        try:
-            flange = SmoothedFlangePath(flange, cell.motion.cusp_smoothing_mm * 1e-3)
-        except ValueError as error:
-            raise CellError(file, "motion.cusp_smoothing_mm", str(error)) from None
     motion = cell.motion
     if motion.speed_reference == "flange" and any(c.kind == "cusp" for c in cusps):
         first = next(c for c in cusps if c.kind == "cusp")
@@ -188,25 +248,42 @@ def plan_cell(
             f"cusp at σ = {first.sigma_m:.4f} m; use tcp or motion.cusp_smoothing_mm",
         )
     lap("frames", "joint trajectory within the robot's limits")
-    parameter = TimeLawParameter(flange, motion.speed_reference)
-    nominal = sin2_time_law(
-        parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
-    )
-    try:
-        joints = plan_joint_trajectory(
-            robot, X_IB, flange, parameter, nominal, rate_hz=motion.sample_rate_hz
-        )
-    except JointPlanError as error:
-        raise PlanInfeasibleError(file, str(error)) from None
-    lap("joints", "collision check")
     try:
         drake = build_cell_model(cell, file, robot)  # the tool at the cell's own X_IT
     except ShapeError as error:
         raise CellError(file, error.key, error.reason) from None
-    traj = joints.trajectory
-    collisions = check_trajectory(
-        drake, joints.q, traj.t, traj.sigma, clearance=cell.motion.clearance
-    )
+
+    def attempt(rotation: float, flange, branch: int | None = None) -> _Attempt:
+        if motion.cusp_smoothing_mm is not None:
+            try:
+                flange = SmoothedFlangePath(flange, motion.cusp_smoothing_mm * 1e-3)
+            except ValueError as error:
+                raise CellError(file, "motion.cusp_smoothing_mm", str(error)) from None
+        parameter = TimeLawParameter(flange, motion.speed_reference)
+        nominal = sin2_time_law(
+            parameter.length,
+            v_max=motion.speed,
+            a_max=motion.max_acceleration,
+            j_max=motion.max_jerk,
+        )
+        joints = plan_joint_trajectory(
+            robot, X_IB, flange, parameter, nominal, rate_hz=motion.sample_rate_hz, branch=branch
+        )
+        traj = joints.trajectory
+        collisions = check_trajectory(
+            drake, joints.q, traj.t, traj.sigma, clearance=motion.clearance
+        )
+        return _Attempt(rotation, flange, nominal, joints, collisions)
+
+    try:
+        chosen = attempt(rotation, flange)
+    except JointPlanError as error:
+        raise PlanInfeasibleError(file, str(error)) from None
+    lap("joints", "collision check")
+    avoidance = None
+    if not chosen.collisions.collision_free:
+        progress("collision avoidance: other tool rotations and branches")
+        chosen, avoidance = _avoid_collisions(chosen, rotations, attempt)
     lap("collision")
     return Plan(
         file,
@@ -214,13 +291,14 @@ def plan_cell(
         points,
         fitted,
         path,
-        flange,
-        joints.trajectory,
+        chosen.flange,
+        chosen.joints.trajectory,
         cusps,
         timings,
         robot,
-        joints,
-        nominal.duration,
-        rotation,
-        collisions,
+        chosen.joints,
+        chosen.nominal.duration,
+        chosen.rotation,
+        chosen.collisions,
+        avoidance,
     )

@@ -103,3 +103,27 @@ def test_a_colliding_plan_writes_its_reports_but_no_program(tmp_path):
     assert report["collision_free"] is False and report["feasible"] is False
     assert (out / "collisions.json").is_file() and (out / "preview.html").is_file()
     assert not (out / "programs").exists()
+
+
+def test_collision_avoidance_is_tried_and_reported(tmp_path):
+    """A cable duct touching the forearm: the planner re-plans with the other branches
+    and tool rotations (the process pose is held in all), keeps the one with the
+    most clearance, and the report says which samples needed it and what changed."""
+    cell = (CELLS / "weld_seam_irb2400.yaml").read_text().replace(": data/", f": {CELLS}/data/")
+    file = tmp_path / "duct.yaml"
+    file.write_text(
+        cell.replace(
+            "obstacles:   # in I",
+            "obstacles:   # in I\n"
+            "  - {name: cable_duct, shape: sphere, radius_mm: 40, "
+            "pose: {translation: [0.695, 0.05, 1.21]}}",
+        )
+    )
+    plan = plan_cell(file)
+    record = plan.avoidance
+    assert record is not None and record["attempts"] >= 1
+    assert record["first_failure"].startswith("collision: link_4 vs cable_duct")
+    assert record["samples_that_needed_it"] and record["sigma_m_that_needed_it"][0] >= 0
+    first_depth = float(record["first_failure"].split("depth ")[1].split(" mm")[0]) * 1e-3
+    assert plan.collisions.min_distance_m >= -first_depth - 1e-9  # never worse
+    assert plan.feasible == plan.collisions.collision_free == record["resolved"]

@@ -40,8 +40,10 @@ def export(
         )
     vendor = {"krl": "kuka", "rapid": "abb"}.get(fmt)
     if vendor and not data.robot.startswith(vendor):
-        raise ValueError(f"{fmt} is the {vendor.upper()} controller language; the plan's robot "
-                         f"is {data.robot} (use {', '.join(default_formats(data.robot))})")
+        raise ValueError(
+            f"{fmt} is the {vendor.upper()} controller language; the plan's robot "
+            f"is {data.robot} (use {', '.join(default_formats(data.robot))})"
+        )
     forced = not data.feasible
     out_dir = Path(out_dir)
     if fmt == "csv":
