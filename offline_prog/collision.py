@@ -39,6 +39,7 @@ from offline_prog.geometry import exact_distance, exact_shape, exact_shape_of_dr
 # A pair certified above clearance + this is not evaluated (its minimum is then over
 # the evaluated points only).
 PRUNE_MARGIN_M = 0.02
+PROFILE_POINTS = 400  # samples of the distance-over-time profile (report plot)
 # Drake (convex pieces) and FCL (original shapes) distances further apart are noted.
 EXACT_MISMATCH_TOL_M = 5e-4
 N_WORST_PAIRS = 5
@@ -366,3 +367,26 @@ def write_collisions_json(result: CollisionResult, path: Path) -> None:
     """Write the result as JSON (SI units; infinite distances as null), atomically."""
     text = json.dumps(_jsonable(dataclasses.asdict(result)), indent=2, ensure_ascii=False)
     write_atomic(Path(path), text + "\n")
+
+
+def distance_profile(
+    cell: DrakeCell, q: np.ndarray, t: np.ndarray, n_points: int = PROFILE_POINTS
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Smallest signed distance per pair group over time, for plots.
+
+    Args:
+        cell: the cell with its shapes; q: (N, 6) joint path [rad]; t: (N,) times [s].
+        n_points: how many evenly spaced samples to evaluate.
+
+    Returns:
+        (t_k (K,), {group: (K,) smallest Drake signed distance in that group [m]}).
+    """
+    pairs = _Pairs(cell)
+    index = np.unique(np.linspace(0, len(q) - 1, min(n_points, len(q))).astype(int))
+    profile = {group: np.full(len(index), np.inf) for group in sorted(set(pairs.groups))}
+    for k, i in enumerate(index):
+        pairs.set(q[i])
+        for g in range(len(pairs.ids)):
+            group = profile[pairs.groups[pairs.shape_of[g]]]
+            group[k] = min(group[k], pairs.distance(g))
+    return t[index], profile

@@ -125,6 +125,24 @@ def robot_report(plan: Plan) -> dict:
     }
 
 
+def clearance_csv(t: np.ndarray, profile: dict[str, np.ndarray]) -> str:
+    """``t_s,<group>_m,...``: the smallest distance per pair group over time [m]."""
+    buffer = io.StringIO()
+    groups = list(profile)
+    table = np.column_stack(
+        [t, *(np.where(np.isfinite(profile[g]), profile[g], np.nan) for g in groups)]
+    )
+    np.savetxt(
+        buffer,
+        table,
+        delimiter=",",
+        fmt="%.9g",
+        header=",".join(["t_s", *(f"{g}_m" for g in groups)]),
+        comments="",
+    )
+    return buffer.getvalue()
+
+
 def collision_summary(plan: Plan) -> dict:
     """report.json's collision keys: min_distance_m, collision_free, the closest pair."""
     result = plan.collisions
@@ -263,6 +281,9 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
     write_collisions_json(plan.collisions, files["collisions"])
+    if plan.clearance_profile is not None:
+        files["clearance"] = out_dir / "clearance.csv"
+        write_atomic(files["clearance"], clearance_csv(*plan.clearance_profile))
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
     data = program_data(plan, summary)
     files["plan"] = data.save(out_dir)

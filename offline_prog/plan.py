@@ -19,7 +19,7 @@ import numpy as np
 from offline_prog.arc_length import ArcLengthPath
 from offline_prog.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.cell import Cell, CellError, load_cell, transform
-from offline_prog.collision import CollisionResult, check_trajectory
+from offline_prog.collision import CollisionResult, check_trajectory, distance_profile
 from offline_prog.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.drake_cell import build_cell_model
 from offline_prog.fixed_tcp import FlangePath
@@ -64,6 +64,8 @@ class Plan:
     tool_rotation_rad: float
     collisions: CollisionResult
     avoidance: dict | None = None  # what the collision avoidance tried and changed
+    # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
+    clearance_profile: tuple | None = None
 
     @property
     def feasible(self) -> bool:
@@ -284,6 +286,8 @@ def plan_cell(
     if not chosen.collisions.collision_free:
         progress("collision avoidance: other tool rotations and branches")
         chosen, avoidance = _avoid_collisions(chosen, rotations, attempt)
+    traj = chosen.joints.trajectory
+    profile = distance_profile(drake, chosen.joints.q, traj.t)
     lap("collision")
     return Plan(
         file,
@@ -301,4 +305,5 @@ def plan_cell(
         chosen.rotation,
         chosen.collisions,
         avoidance,
+        profile,
     )

@@ -350,12 +350,19 @@ def _joint_figure(col, data: ProgramData, rates: bool) -> Figure:
     return fig
 
 
-def _distance_figure(col) -> Figure:
-    fig = Figure(figsize=(13, 2.8), layout="constrained")
+def _distance_figure(clearance: dict, report: dict) -> Figure:
+    """Smallest distance per pair group over time (clearance.csv), with the clearance."""
+    fig = Figure(figsize=(13, 3.2), layout="constrained")
     ax = fig.subplots()
-    ax.plot(col["t"], col["min_distance"] * 1e3, color=XYZ_COLORS[0])
+    t = clearance["t_s"]
+    for name, values in clearance.items():
+        if name != "t_s":
+            ax.plot(t, values * 1e3, label=name.removesuffix("_m"))
     ax.axhline(0.0, color="#c62828", ls="--", lw=1)
+    if report.get("clearance_m") is not None:
+        ax.axhline(report["clearance_m"] * 1e3, color="#ef6c00", ls=":", lw=1, label="clearance")
     ax.set(xlabel="time t [s]", ylabel="minimum distance [mm]")
+    ax.legend(loc="upper right", fontsize=8, ncols=4)
     return fig
 
 
@@ -430,7 +437,19 @@ def _views_figure(col, data: ProgramData) -> Figure:
     return fig
 
 
-def report_figures(report: dict, col, data: ProgramData) -> list[tuple[str, str]]:
+def read_clearance(plan_dir: Path) -> dict | None:
+    """clearance.csv by column ({"t_s": ..., "<group>_m": ...}), or None if absent."""
+    file = Path(plan_dir) / "clearance.csv"
+    if not file.is_file():
+        return None
+    names = file.read_text().splitlines()[0].split(",")
+    table = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2)
+    return {name: table[:, i] for i, name in enumerate(names)}
+
+
+def report_figures(
+    report: dict, col, data: ProgramData, clearance: dict | None = None
+) -> list[tuple[str, str]]:
     """(caption, base64 PNG) of every plot, in page order."""
     ref = report["motion"]["speed_reference"].replace("tcp", "TCP")
     plots = [
@@ -443,8 +462,9 @@ def report_figures(report: dict, col, data: ProgramData) -> list[tuple[str, str]
          lambda: _joint_figure(col, data, rates=False)),
         ("Joint velocities with their limits (dashed).",
          lambda: _joint_figure(col, data, rates=True)),
-        ("Minimum distance between the robot, part and cell over time.",
-         (lambda: _distance_figure(col)) if "min_distance" in col else None),
+        ("Minimum distance over time per pair group (robot, part, tool, obstacles), "
+         "against the required clearance.",
+         (lambda: _distance_figure(clearance, report)) if clearance else None),
         ("3D views: the part with its processing path and process frames, and the flange "
          "path in the cell.", lambda: _views_figure(col, data)),
     ]  # fmt: skip
@@ -480,7 +500,7 @@ def render_report_html(plan_dir: Path) -> str:
     figures = "".join(
         f'<figure><img alt="{_e(caption)}" src="data:image/png;base64,{png}">'
         f"<figcaption>{_e(caption)}</figcaption></figure>"
-        for caption, png in report_figures(report, col, data)
+        for caption, png in report_figures(report, col, data, read_clearance(plan_dir))
     )
     title = f"Plan report: {report.get('name') or plan_dir.name}"
     return (

@@ -120,3 +120,15 @@ def layout(page: Path, size: tuple[int, int] = WINDOW) -> dict:
         probe.unlink(missing_ok=True)
     start = dom.index('<pre id="layout">') + len('<pre id="layout">')
     return json.loads(html.unescape(dom[start : dom.index("</pre>", start)]))
+
+
+ARTIFACTS = Path(__file__).resolve().parent / "artifacts"
+
+
+def keep_artifact(png: Path, name: str) -> Path:
+    """Copy a screenshot to tests/artifacts/<name> (kept after the run; gitignored)."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    target = ARTIFACTS / name
+    shutil.copyfile(png, target)
+    print(f"screenshot kept: {target}")
+    return target

@@ -14,7 +14,7 @@ from offline_prog.outputs import write_outputs
 from offline_prog.plan import plan_cell
 from offline_prog.preview import show_plan
 
-from browser import WEBGL_ARGS, require_chromium, screenshot
+from browser import WEBGL_ARGS, keep_artifact, require_chromium, screenshot
 from conftest import CELLS, REPO
 
 
@@ -43,7 +43,7 @@ def test_preview_html_shows_the_cell_in_a_browser(seal, tmp_path):
     text = page.read_text()
     assert "<script" in text and len(text) > 100_000  # MeshCat's viewer is inlined
     png = screenshot(page, tmp_path / "preview.png", size=(1200, 800), extra=WEBGL_ARGS)
-    print(f"preview screenshot: {png}")
+    keep_artifact(png, "preview_seal_plate_kr16.png")
     image = np.asarray(Image.open(png).convert("RGB")).astype(float)
     assert image.std() > 20, "the 3D view is blank"
     red, green, blue = image[..., 0], image[..., 1], image[..., 2]

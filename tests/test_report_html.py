@@ -17,7 +17,7 @@ from offline_prog.atomic import write_atomic
 from offline_prog.plan import plan_cell
 from offline_prog.report_html import REPORT_FILE, lookup, render_report_html, write_report_html
 
-from browser import layout, require_chromium, screenshot
+from browser import keep_artifact, layout, require_chromium, screenshot
 from conftest import CELLS
 
 DEMO_CELLS = sorted(CELLS.glob("*.yaml"))
@@ -43,9 +43,8 @@ NUMBER = re.compile(r"^[−-]?\d[\d,]*(?:\.(\d+))?(?:e([+-]?\d+))?")
 
 
 def n_plots(plan_dir):
-    """Plots the page must show: five, and the distance plot when the CSV has it."""
-    header = (plan_dir / "trajectory.csv").read_text().partition("\n")[0].split(",")
-    return 5 + ("min_distance" in header)
+    """Plots the page must show: five, and the distance plot when clearance.csv exists."""
+    return 5 + (plan_dir / "clearance.csv").is_file()
 
 
 def make_plan_folder(cell_file, out):
@@ -193,14 +192,13 @@ def test_escaped_failed_plan_with_distance(tape_dir, tmp_path, collision):
     report["fit"]["max_error_mm"] = 0.25
     report.update(collision)
     (folder / "report.json").write_text(json.dumps(report))
-    table = np.loadtxt(folder / "trajectory.csv", delimiter=",", skiprows=1)
-    header = (folder / "trajectory.csv").read_text().splitlines()[0]
-    distance = 0.05 + 0.02 * np.cos(table[:, 0])
+    t = np.loadtxt(folder / "trajectory.csv", delimiter=",", skiprows=1)[:, 0]
+    distance = 0.05 + 0.02 * np.cos(t)
     np.savetxt(
-        folder / "trajectory.csv",
-        np.column_stack([table, distance]),
+        folder / "clearance.csv",
+        np.column_stack([t, distance, distance + 0.1]),
         delimiter=",",
-        header=header + ",min_distance",
+        header="t_s,part-obstacle_m,robot-self_m",
         comments="",
         fmt="%.10g",
     )
@@ -226,6 +224,7 @@ def test_browser_shows_the_plots(plan_dir, tmp_path_factory):
     require_chromium()
     file = write_report_html(plan_dir)
     png = screenshot(file, tmp_path_factory.mktemp("screens") / f"{plan_dir.name}.png")
+    keep_artifact(png, f"report_{plan_dir.name}.png")
     print(f"screenshot: {png}")
     boxes = layout(file)
     shot = matplotlib.image.imread(png)[..., :3]
