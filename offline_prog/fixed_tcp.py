@@ -63,6 +63,9 @@ class FlangePath:
         normal: the surface normal field on the part.
         X_IT: the fixed TCP frame T in I.
         X_PE: the flange frame E in the part frame P.
+        tool_turn: optional φ(s) ↦ (φ, φ′, φ″) (N,) each [rad, rad/m, rad/m²]: the
+            process frame is laid onto T·R_axis(φ(s)) (a tool symmetric about axis).
+        axis: (3,) unit axis of T for tool_turn.
     """
 
     def __init__(
@@ -72,11 +75,15 @@ class FlangePath:
         *,
         X_IT: RigidTransform,
         X_PE: RigidTransform,
+        tool_turn=None,
+        axis=(0.0, 1.0, 0.0),
     ):
         self.path = path
         self.normal = normal
         self.X_IT = X_IT
         self.X_PE = X_PE
+        self.tool_turn = tool_turn
+        self.axis = np.asarray(axis, dtype=float)
 
     @property
     def length(self) -> float:
@@ -102,16 +109,43 @@ class FlangePath:
             - 2.0 * np.einsum("nij,nj->ni", dR_TP, dp_PF)
             - np.einsum("nij,nj->ni", R_TP, ddp_PF)
         )
-        p_IE = p_IT + p_TE_T @ R_IT.T
-        dp_IE = dp_TE_T @ R_IT.T
-        ddp_IE = ddp_TE_T @ R_IT.T
+        # G = R_IT · R_axis(φ(s)): the tool frame the process frame is laid onto.
+        G, dG, ddG = self._tool_rotation(s, R_IT)
+        p_IE = p_IT + np.einsum("nij,nj->ni", G, p_TE_T)
+        dp_IE = np.einsum("nij,nj->ni", dG, p_TE_T) + np.einsum("nij,nj->ni", G, dp_TE_T)
+        ddp_IE = (
+            np.einsum("nij,nj->ni", ddG, p_TE_T)
+            + 2.0 * np.einsum("nij,nj->ni", dG, dp_TE_T)
+            + np.einsum("nij,nj->ni", G, ddp_TE_T)
+        )
 
         # R_IE = R_IT R_TP R_PE (paper eqs. 6, 8) and its derivatives.
-        R_IE = R_IT @ R_TP @ R_PE
-        dR_IE = R_IT @ dR_TP @ R_PE
-        ddR_IE = R_IT @ ddR_TP @ R_PE
+        M, dM, ddM = R_TP @ R_PE, dR_TP @ R_PE, ddR_TP @ R_PE
+        R_IE = G @ M
+        dR_IE = dG @ M + G @ dM
+        ddR_IE = ddG @ M + 2.0 * dG @ dM + G @ ddM
         # skew(w_s) = R' Rᵀ; its derivative is R'' Rᵀ + R' R'ᵀ.
         R_EI = np.swapaxes(R_IE, 1, 2)
         w_s = vee(dR_IE @ R_EI)
         dw_s = vee(ddR_IE @ R_EI + dR_IE @ np.swapaxes(dR_IE, 1, 2))
         return FlangeSamples(s, p_PF, R_PF, p_IE, dp_IE, ddp_IE, R_IE, w_s, dw_s)
+
+    def _tool_rotation(self, s: np.ndarray, R_IT: np.ndarray):
+        """(G, G′, G″), each (N, 3, 3): G = R_IT·exp(K φ(s)), K = skew(axis)."""
+        n = len(s)
+        if self.tool_turn is None:
+            G = np.broadcast_to(R_IT, (n, 3, 3))
+            zero = np.zeros((n, 3, 3))
+            return G, zero, zero
+        phi, dphi, ddphi = (np.asarray(v, dtype=float) for v in self.tool_turn(s))
+        a = self.axis
+        K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+        A = (
+            np.eye(3)
+            + np.sin(phi)[:, None, None] * K
+            + (1.0 - np.cos(phi))[:, None, None] * (K @ K)
+        )  # Rodrigues
+        G = R_IT @ A
+        dG = G @ K * dphi[:, None, None]
+        ddG = G @ (K @ K * (dphi**2)[:, None, None] + K * ddphi[:, None, None])
+        return G, dG, ddG

@@ -238,6 +238,11 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
     X_IB = transform(cell.robot.X_IB)
     X_BI = X_IB.inverse().GetAsMatrix4()
     X_BE = X_BI @ _poses(traj.flange.p_IE, traj.flange.R_IE)
+    # The physical tool T, and the part frames that sit on it: X_BE = X_BT X_PF⁻¹ X_EP⁻¹
+    # holds by construction, whatever rotation about a symmetric tool's axis was used.
+    X_BT = X_BI @ transform(cell.tool.X_IT).GetAsMatrix4()
+    X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
+    X_PF = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)
     return ProgramData(
         cell_name=cell.name or plan.cell_file.stem,
         cell_file=str(plan.cell_file),
@@ -256,9 +261,9 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         q=joints.q,
         qd=joints.qd,
         X_BE=X_BE,
-        X_PF=_poses(traj.flange.p_PF, traj.flange.R_PF),
-        X_BT=X_BI @ plan.flange.X_IT.GetAsMatrix4(),
-        X_EP=plan.flange.X_PE.inverse().GetAsMatrix4(),
+        X_PF=X_PF,
+        X_BT=X_BT,
+        X_EP=X_EP,
         tcp_speed=traj.tcp_speed,
         q_lower=plan.robot.q_lower,
         q_upper=plan.robot.q_upper,

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.arc_length import ArcLengthPath
+from offline_prog.avoidance import Attempt, avoid_collisions, turn_profile
 from offline_prog.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.cell import Cell, CellError, load_cell, transform
 from offline_prog.collision import CollisionResult, check_trajectory, distance_profile
@@ -76,69 +77,6 @@ class Plan:
     def failure(self) -> str:
         """Why the plan failed, one line ("" if it did not)."""
         return self.collisions.message
-
-
-# Collision avoidance: at most this many re-plans (tool rotations × branches).
-MAX_AVOIDANCE_ATTEMPTS = 12
-
-
-@dataclasses.dataclass
-class _Attempt:
-    """One joint plan and its collision check."""
-
-    rotation: float
-    flange: object
-    nominal: object
-    joints: JointTrajectory
-    collisions: CollisionResult
-
-
-def _avoid_collisions(first: _Attempt, rotations, attempt) -> tuple[_Attempt, dict]:
-    """Re-plan with the other tool rotations and configuration branches until one is
-    collision-free (cheap choices first; the process pose is held in every one).
-
-    Returns:
-        The collision-free attempt (else the one with the largest clearance) and a
-        record for the report: the samples that needed avoidance, what was tried and
-        what changed.
-    """
-    tried, best = 0, first
-    candidates = [
-        (first.rotation, first.flange, b.branch)
-        for b in first.joints.branches
-        if b.feasible and b.branch != first.joints.branch
-    ]
-    candidates += [(phi, flange, None) for phi, flange in rotations[1:]]
-    for phi, flange, branch in candidates:
-        if tried >= MAX_AVOIDANCE_ATTEMPTS:
-            break
-        tried += 1
-        try:
-            trial = attempt(phi, flange, branch)
-        except JointPlanError:
-            continue
-        if trial.collisions.min_distance_m > best.collisions.min_distance_m:
-            best = trial
-        if trial.collisions.collision_free:
-            break
-    sigma = first.joints.trajectory.sigma
-    needed = sorted(set(first.collisions.samples_in_collision))
-    change = []
-    if best.rotation != first.rotation:
-        change.append(
-            f"tool rotation {np.rad2deg(first.rotation):.1f}° → {np.rad2deg(best.rotation):.1f}°"
-        )
-    if best.joints.branch != first.joints.branch:
-        change.append(f"branch {first.joints.branch} → {best.joints.branch}")
-    record = {
-        "samples_that_needed_it": needed,
-        "sigma_m_that_needed_it": [float(sigma[i]) for i in needed if 0 <= i < len(sigma)],
-        "first_failure": first.collisions.message,
-        "attempts": tried,
-        "resolved": best.collisions.collision_free,
-        "change": ", ".join(change) or "none",
-    }
-    return best, record
 
 
 class PlanInfeasibleError(CellError):
@@ -255,7 +193,7 @@ def plan_cell(
     except ShapeError as error:
         raise CellError(file, error.key, error.reason) from None
 
-    def attempt(rotation: float, flange, branch: int | None = None) -> _Attempt:
+    def attempt(rotation: float, flange, branch: int | None = None) -> Attempt:
         if motion.cusp_smoothing_mm is not None:
             try:
                 flange = SmoothedFlangePath(flange, motion.cusp_smoothing_mm * 1e-3)
@@ -275,7 +213,7 @@ def plan_cell(
         collisions = check_trajectory(
             drake, joints.q, traj.t, traj.sigma, clearance=motion.clearance
         )
-        return _Attempt(rotation, flange, nominal, joints, collisions)
+        return Attempt(rotation, flange, nominal, joints, collisions)
 
     try:
         chosen = attempt(rotation, flange)
@@ -285,7 +223,37 @@ def plan_cell(
     avoidance = None
     if not chosen.collisions.collision_free:
         progress("collision avoidance: other tool rotations and branches")
-        chosen, avoidance = _avoid_collisions(chosen, rotations, attempt)
+        chosen, avoidance = avoid_collisions(chosen, rotations, attempt)
+    if not chosen.collisions.collision_free and cell.tool.free_rotation_deg > 0:
+        progress("collision avoidance: Drake IK with a minimum-distance constraint")
+        axis = np.eye(3)["xyz".index(cell.tool.symmetry_axis)]
+        turn = turn_profile(
+            drake,
+            path,
+            normal,
+            X_IT=X_IT,
+            s_plan=chosen.joints.trajectory.s,
+            q_plan=chosen.joints.q,
+            axis=axis,
+            bound_rad=np.deg2rad(cell.tool.free_rotation_deg),
+            clearance=motion.clearance,
+        )
+        if turn is not None:
+            turned = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=axis)
+            phi = turn(np.linspace(0.0, path.length, 200))[0]
+            try:
+                trial = attempt(float(phi[0]), turned)
+            except JointPlanError:
+                trial = None
+            avoidance["attempts"] += 1
+            if trial is not None and trial.collisions.collision_free:
+                chosen = trial
+                avoidance["resolved"] = True
+                avoidance["change"] = (
+                    "tool turned along the path (Drake IK with a minimum-distance "
+                    f"constraint): φ from {np.rad2deg(phi.min()):.1f}° to "
+                    f"{np.rad2deg(phi.max()):.1f}°"
+                )
     traj = chosen.joints.trajectory
     profile = distance_profile(drake, chosen.joints.q, traj.t)
     lap("collision")

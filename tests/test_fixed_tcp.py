@@ -67,3 +67,40 @@ def test_normal_parallel_to_tangent_is_rejected(rng):
     _, t, _, _ = flange.path(s)
     with pytest.raises(NormalTangentError, match="of the path tangent at s ="):
         process_frames(flange.path, constant_normal(-t[10]), s)
+
+
+def test_tool_turn_about_the_symmetry_axis(rng):
+    """With φ(s) about y of T the part point stays under the TCP, the normal stays on
+    the tool axis, and the analytic s-derivatives match finite differences."""
+    from offline_prog.fixed_tcp import FlangePath
+
+    base = random_flange_path(rng, closed=False)
+
+    def turn(s):
+        return 0.4 * np.sin(5 * s), 2.0 * np.cos(5 * s), -10.0 * np.sin(5 * s)
+
+    flange = FlangePath(base.path, base.normal, X_IT=base.X_IT, X_PE=base.X_PE, tool_turn=turn)
+    h = 1e-5
+    s = rng.uniform(2 * h, flange.length - 2 * h, 150)
+    f, lo, hi = flange(s), flange(s - h), flange(s + h)
+    R_IP = f.R_IE @ base.X_PE.rotation().matrix().T
+    p_IP = f.p_IE - np.einsum("nij,j->ni", R_IP, base.X_PE.translation())
+    np.testing.assert_allclose(
+        p_IP + np.einsum("nij,nj->ni", R_IP, f.p_PF),
+        np.broadcast_to(base.X_IT.translation(), f.p_PF.shape),
+        atol=1e-12,
+    )
+    y_T = base.X_IT.rotation().matrix()[:, 1]
+    np.testing.assert_allclose(
+        (R_IP @ f.R_PF)[:, :, 1], np.broadcast_to(y_T, (len(s), 3)), atol=1e-12
+    )
+    angle = np.arctan2(
+        np.cross(base.X_IT.rotation().matrix()[:, 0], (R_IP @ f.R_PF)[:, :, 0]) @ y_T,
+        (R_IP @ f.R_PF)[:, :, 0] @ base.X_IT.rotation().matrix()[:, 0],
+    )
+    np.testing.assert_allclose(angle, turn(s)[0], atol=1e-12)
+    assert np.abs((hi.p_IE - lo.p_IE) / (2 * h) - f.dp_IE).max() <= 1e-6 * np.abs(f.dp_IE).max()
+    assert np.abs((hi.dp_IE - lo.dp_IE) / (2 * h) - f.ddp_IE).max() <= 1e-5 * np.abs(f.ddp_IE).max()
+    w_fd = rotation_log(hi.R_IE @ np.swapaxes(lo.R_IE, 1, 2)) / (2 * h)
+    assert np.abs(w_fd - f.w_s).max() <= 1e-5 * np.abs(f.w_s).max()
+    assert np.abs((hi.w_s - lo.w_s) / (2 * h) - f.dw_s).max() <= 1e-5 * np.abs(f.dw_s).max()
