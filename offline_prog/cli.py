@@ -204,6 +204,12 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
     started = time.perf_counter()
+
+    def fail(message: str, code: int) -> int:
+        """One plain line on stderr (no rich markup), and the exit code."""
+        errors.print(message, markup=False, highlight=False)
+        return code
+
     try:
         from offline_prog.cell import CellError
         from offline_prog.export.formats import ExportRefusedError
@@ -219,11 +225,9 @@ def main(argv: list[str] | None = None) -> int:
                 _run_export(args, console)
                 return 0
             except ExportRefusedError as error:
-                errors.print(f"error: {args.plan_dir}: {error}", markup=False, highlight=False)
-                return EXIT_BAD_INPUT
+                return fail(f"error: {args.plan_dir}: {error}", EXIT_BAD_INPUT)
             except ValueError as error:
-                errors.print(f"error: {error}", markup=False, highlight=False)
-                return EXIT_BAD_INPUT
+                return fail(f"error: {error}", EXIT_BAD_INPUT)
         if args.command == "preview":
             args.preview, args.out = True, None
         try:
@@ -234,33 +238,23 @@ def main(argv: list[str] | None = None) -> int:
                 if args.command == "plan":
                     files, report = write_outputs(plan, out)
         except PlanInfeasibleError as error:  # valid cell, but the robot cannot do it
-            errors.print(f"error: {error}", markup=False, highlight=False)
-            return EXIT_PLAN_FAILED
+            return fail(f"error: {error}", EXIT_PLAN_FAILED)
         except CellError as error:
-            errors.print(f"error: {error}", markup=False, highlight=False)
-            return EXIT_BAD_INPUT
+            return fail(f"error: {error}", EXIT_BAD_INPUT)
         if args.command == "plan":
             _summary(console, report, files, time.perf_counter() - started)
         if args.preview:
             _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs
             where = f" (see {files['collisions']})" if args.command == "plan" else ""
-            errors.print(
-                f"error: {args.cell}: {plan.failure}{where}",
-                markup=False,
-                highlight=False,
-            )
-            return EXIT_PLAN_FAILED
+            return fail(f"error: {args.cell}: {plan.failure}{where}", EXIT_PLAN_FAILED)
         return 0
     except Exception as error:  # one line, never a traceback unless asked
         if args.debug:
             raise
-        errors.print(
-            f"internal error: {type(error).__name__}: {error} (rerun with --debug)",
-            markup=False,
-            highlight=False,
+        return fail(
+            f"internal error: {type(error).__name__}: {error} (rerun with --debug)", EXIT_INTERNAL
         )
-        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":
