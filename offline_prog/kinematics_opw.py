@@ -227,3 +227,22 @@ def inverse(params: OpwParameters, X_BE: np.ndarray) -> np.ndarray:
     q = wrap_to_pi((theta + np.asarray(params.offsets, dtype=float)) * sign)
     q[np.isnan(q).any(axis=-1)] = np.nan
     return q
+
+
+def py_opw_robot(params: OpwParameters):
+    """The same robot in ``py-opw-kinematics`` (an independent implementation, for
+    tests and benchmarks; radians). Raises ImportError when it is not installed."""
+    import py_opw_kinematics as py_opw
+
+    model = py_opw.KinematicModel(
+        a1=params.a1,
+        a2=params.a2,
+        b=params.b,
+        c1=params.c1,
+        c2=params.c2,
+        c3=params.c3,
+        c4=params.c4,
+        offsets=params.offsets,
+        flip_axes=tuple(s < 0 for s in params.sign_corrections),
+    )
+    return py_opw.Robot(model, degrees=False)

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
+from offline_prog import kinematics_opw
 from offline_prog.cell import transform
 from offline_prog.collision import check_trajectory
 from offline_prog.drake_cell import build_cell_model, build_drake_cell
@@ -86,23 +87,11 @@ def bench_collision(cells: list[Path]) -> None:
 
 
 def py_opw_robot(robot):
+    """py-opw-kinematics for an OPW robot, or None when it is not installed."""
     try:
-        import py_opw_kinematics as py_opw
+        return kinematics_opw.py_opw_robot(robot.params)
     except ImportError:
         return None
-    p = robot.params
-    model = py_opw.KinematicModel(
-        a1=p.a1,
-        a2=p.a2,
-        b=p.b,
-        c1=p.c1,
-        c2=p.c2,
-        c3=p.c3,
-        c4=p.c4,
-        offsets=p.offsets,
-        flip_axes=tuple(s < 0 for s in p.sign_corrections),
-    )
-    return py_opw.Robot(model, degrees=False)
 
 
 def bench_path_ik(file: Path, n_samples: int, n_drake: int) -> None:

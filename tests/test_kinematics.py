@@ -183,25 +183,15 @@ def test_ur_reach_matches_datasheet():
 
 @pytest.mark.parametrize("name", OPW_ROBOTS)
 def test_opw_matches_py_opw_kinematics(name):
-    py_opw = pytest.importorskip(
+    pytest.importorskip(
         "py_opw_kinematics", reason="independent OPW implementation: pip install py-opw-kinematics"
     )
     from scipy.spatial.transform import RigidTransform
 
+    from offline_prog.kinematics_opw import py_opw_robot
+
     robot = load_robot(name)
-    p = robot.params
-    model = py_opw.KinematicModel(
-        a1=p.a1,
-        a2=p.a2,
-        b=p.b,
-        c1=p.c1,
-        c2=p.c2,
-        c3=p.c3,
-        c4=p.c4,
-        offsets=p.offsets,
-        flip_axes=tuple(s < 0 for s in p.sign_corrections),
-    )
-    other = py_opw.Robot(model, degrees=False)
+    other = py_opw_robot(robot.params)
     q = random_joints(robot, N_SAMPLES, seed=3)
     X_BE = robot.forward(q)
     distance, angle = pose_errors(X_BE, other.batch_forward(q).as_matrix())
