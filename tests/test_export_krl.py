@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.krl import kuka_abc_deg, status_turn, write_krl
+from offline_prog.export.krl import write_krl
+from offline_prog.export.kuka import kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
 from offline_prog.outputs import write_outputs
 from offline_prog.plan import plan_cell
