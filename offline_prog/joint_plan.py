@@ -195,7 +195,11 @@ def plan_joint_trajectory(
         sigma = float(grid[chosen.sample])
         raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason)
     rates = path.rates(grid, chosen.q)
-    retiming = retime(rates, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
+    # Speed and acceleration limits hold for the controller's joints (a linear map).
+    controller = JointRates(
+        rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
+    )
+    retiming = retime(controller, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
     if not retiming.feasible:
         joint, sigma, use = retiming.worst
         raise JointPlanError(
@@ -211,11 +215,14 @@ def plan_joint_trajectory(
     q = final.q
     qd = final.dq * sd[:, None]
     qdd = final.ddq * (sd**2)[:, None] + final.dq * sdd[:, None]
-    margin = np.minimum(q.min(axis=0) - robot.q_lower, robot.q_upper - q.max(axis=0))
+    q_c = robot.controller_joints(q)
+    margin = np.minimum(q_c.min(axis=0) - robot.q_lower, robot.q_upper - q_c.max(axis=0))
     if margin.min() < 0:  # the grid missed a limit between its points
         joint = int(np.argmin(margin))
         i = int(
-            np.argmax((q[:, joint] < robot.q_lower[joint]) | (q[:, joint] > robot.q_upper[joint]))
+            np.argmax(
+                (q_c[:, joint] < robot.q_lower[joint]) | (q_c[:, joint] > robot.q_upper[joint])
+            )
         )
         raise JointPlanError(
             float(sigma[i]), float(trajectory.t[i]), f"joint limit on axis {joint + 1}"

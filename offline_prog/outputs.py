@@ -93,8 +93,8 @@ def robot_report(plan: Plan) -> dict:
     robot, joints = plan.robot, plan.joints
     retiming, top = joints.retiming, plan.cell.motion.speed
     joint, sigma, step = joints.largest_step
-    use_speed = np.abs(joints.qd) / robot.qd_max
-    use_accel = np.abs(joints.qdd) / robot.qdd_max
+    use_speed = np.abs(robot.controller_joints(joints.qd)) / robot.qd_max
+    use_accel = np.abs(robot.controller_joints(joints.qdd)) / robot.qdd_max
     return {
         "model": robot.name,
         "joint_names": list(robot.joint_names),
@@ -268,6 +268,7 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         q_lower=plan.robot.q_lower,
         q_upper=plan.robot.q_upper,
         qd_max=plan.robot.qd_max,
+        j23_coupled=plan.robot.j23_coupled,
     )
 
 

@@ -90,8 +90,11 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
     step = np.diff(filled, axis=1)
     step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
     q = np.concatenate([filled[:, :1], filled[:, :1] + np.cumsum(step, axis=1)], axis=1)
+    # Limits apply to the joints as the controller counts them (ABB: axis 3 = q2 + q3).
     offsets, margins = best_turns(
-        np.where(reachable[..., None], q, np.nan), robot.q_lower, robot.q_upper
+        robot.controller_joints(np.where(reachable[..., None], q, np.nan)),
+        robot.q_lower,
+        robot.q_upper,
     )
     q = q + offsets[:, None, :]
     steps = np.abs(step).max(axis=-1)  # (8, N−1)
@@ -121,8 +124,9 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
             continue
         if margin < 0:
             joint = int(np.argmin(margins[b]))
-            outside = (q[b, :, joint] < robot.q_lower[joint]) | (
-                q[b, :, joint] > robot.q_upper[joint]
+            q_c = robot.controller_joints(q[b])
+            outside = (q_c[:, joint] < robot.q_lower[joint]) | (
+                q_c[:, joint] > robot.q_upper[joint]
             )
             results.append(
                 BranchResult(

@@ -203,7 +203,7 @@ def verdict(report: dict, col: dict, data: ProgramData) -> tuple[list[str], list
         if tr[key] > SPEED_ERROR_MAX_REL:
             fail.append(f"speed not held: {key} = {tr[key]:.2g} > {SPEED_ERROR_MAX_REL:g}")
     for j in range(len(data.q_lower)):
-        q, qd = col[f"q{j + 1}"], col[f"qd{j + 1}"]
+        q, qd = data.controller_column(col, "q", j), data.controller_column(col, "qd", j)
         if (
             q.min() < data.q_lower[j] - JOINT_CHECK_TOL
             or q.max() > data.q_upper[j] + JOINT_CHECK_TOL

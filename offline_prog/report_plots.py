@@ -95,13 +95,22 @@ def _joint_figure(col, data: ProgramData, rates: bool) -> Figure:
     t, names = col["t"], data.joint_names
     for j, ax in enumerate(fig.subplots(2, 3, sharex=True).ravel()):
         if rates:
-            values, lower, upper = col[f"qd{j + 1}"], -data.qd_max[j], data.qd_max[j]
+            values, lower, upper = (
+                data.controller_column(col, "qd", j),
+                -data.qd_max[j],
+                data.qd_max[j],
+            )
         else:
-            values, lower, upper = col[f"q{j + 1}"], data.q_lower[j], data.q_upper[j]
+            values, lower, upper = (
+                data.controller_column(col, "q", j),
+                data.q_lower[j],
+                data.q_upper[j],
+            )
         ax.plot(t, np.rad2deg(values), color=XYZ_COLORS[0])
         for limit in (lower, upper):
             ax.axhline(np.rad2deg(limit), color="#c62828", ls="--", lw=1)
-        ax.set_title(f"J{j + 1} {names[j]}", fontsize=9)
+        coupled = " (controller: q2 + q3)" if data.j23_coupled and j == 2 else ""
+        ax.set_title(f"J{j + 1} {names[j]}{coupled}", fontsize=9)
         ax.set_ylabel("q̇ [°/s]" if rates else "q [°]")
         if j >= 3:
             ax.set_xlabel("time t [s]")

@@ -27,7 +27,7 @@ from offline_prog.kinematics_ur import UrParameters
 
 ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
 PARAMS_FILE = "robot.yaml"
-_TOP_KEYS = {"family", "urdf", "joint_names", "kinematics", "limits"}
+_TOP_KEYS = {"family", "urdf", "joint_names", "kinematics", "limits", "controller"}
 _KINEMATIC_KEYS = {
     "opw": ("a1", "a2", "b", "c1", "c2", "c3", "c4", "offsets_deg", "sign_corrections"),
     "ur": ("d1", "a2", "a3", "d4", "d5", "d6"),
@@ -62,6 +62,20 @@ class RobotModel:
     qd_max: np.ndarray
     qdd_max: np.ndarray
     urdf_path: Path
+    j23_coupled: bool = False
+
+    def controller_joints(self, q: np.ndarray) -> np.ndarray:
+        """(..., 6) the joint values the controller counts (and limits) from URDF q.
+
+        Equal to q, except on robots whose controller couples axis 3 to axis 2
+        (``controller: {j23_coupled: true}``, e.g. the ABB IRB 2400: axis 3 = q2 + q3).
+        Linear, so it maps joint speeds and accelerations the same way.
+        """
+        if not self.j23_coupled:
+            return q
+        out = np.array(q, dtype=float, copy=True)
+        out[..., 2] = q[..., 1] + q[..., 2]
+        return out
 
     def forward(self, q: np.ndarray) -> np.ndarray:
         """Flange poses X_BE (N, 4, 4) [m] for joint vectors q (N, 6) [rad]."""
@@ -112,7 +126,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         raise ValueError(f"{path}: not valid YAML: {' '.join(str(error).split())}") from None
     check = _Checker(path)
     family = record.get("family") if isinstance(record, dict) else None
-    optional = {"urdf", "kinematics"} if family == "drake" else {"urdf"}
+    optional = {"urdf", "kinematics", "controller"} if family == "drake" else {"urdf", "controller"}
     check.keys(record, "", required=_TOP_KEYS - optional, allowed=_TOP_KEYS)
     if family not in _KINEMATIC_KEYS:
         check.fail("family", family, f"one of {sorted(_KINEMATIC_KEYS)}")
@@ -150,7 +164,19 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         qd_max=_frozen(np.radians(velocity)),
         qdd_max=_frozen(np.radians(acceleration)),
         urdf_path=(folder / urdf_name).resolve(),
+        j23_coupled=_j23_coupled(check, record.get("controller")),
     )
+
+
+def _j23_coupled(check: _Checker, controller: Any) -> bool:
+    """The ``controller: {j23_coupled: bool}`` record (default False)."""
+    if controller is None:
+        return False
+    check.keys(controller, "controller", required=set(), allowed={"j23_coupled"})
+    value = controller.get("j23_coupled", False)
+    if not isinstance(value, bool):
+        check.fail("controller.j23_coupled", value, "true or false")
+    return value
 
 
 def _kinematic_params(

@@ -48,7 +48,8 @@ def test_recovers_the_branch_the_path_was_made_on(rng, name):
         assert chosen.margin_rad >= max(r.margin_rad for r in results if r.feasible)
         # Every feasible branch reproduces the poses and stays inside the limits.
         for r in (x for x in results if x.feasible):
-            assert np.all(r.q >= robot.q_lower) and np.all(r.q <= robot.q_upper)
+            q_c = robot.controller_joints(r.q)
+            assert np.all(q_c >= robot.q_lower) and np.all(q_c <= robot.q_upper)
             np.testing.assert_allclose(robot.forward(r.q), X_BE, atol=1e-9)
             assert np.abs(np.diff(r.q, axis=0)).max() < np.deg2rad(10)
 
@@ -95,3 +96,26 @@ def test_base_poses_compose_X_BI_X_IE(rng):
     for i, X in enumerate(X_IE):
         np.testing.assert_allclose(X_BE[i], (X_IB.inverse() @ X).GetAsMatrix4(), atol=1e-12)
     assert isinstance(X_IB, RigidTransform)
+
+
+def test_abb_axis_3_limits_apply_to_q2_plus_q3():
+    """The IRB 2400's controller counts axis 3 as q2 + q3 (J23 coupling): a path with
+    URDF q3 = −69° (outside ABB's −60°) but q2 + q3 = −40° is inside the limits."""
+    import dataclasses
+
+    robot = load_robot("abb_irb2400")
+    assert robot.j23_coupled
+    n = 50
+    q = np.tile([0.2, 0.5, -1.2, 0.3, 0.8, 0.2], (n, 1))
+    q[:, 0] += np.linspace(0.0, 0.1, n)
+    X_BE = robot.forward(q)
+
+    def generating(results):
+        return next(r for r in results
+                    if np.allclose(np.angle(np.exp(1j * (r.q - q))), 0.0, atol=1e-7))
+
+    coupled = generating(branch_results(robot, X_BE))
+    assert coupled.feasible
+    assert np.rad2deg(coupled.margin_rad) == pytest.approx(np.rad2deg(-0.7) + 60, abs=0.5)
+    uncoupled = generating(branch_results(dataclasses.replace(robot, j23_coupled=False), X_BE))
+    assert not uncoupled.feasible and uncoupled.reason == "joint limit on axis 3"

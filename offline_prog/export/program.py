@@ -49,7 +49,8 @@ class ProgramData:
         X_BT: (4, 4) the fixed tool frame T in B (with any free rotation applied).
         X_EP: (4, 4) the part frame P in the flange frame E.
         tcp_speed: (N,) speed of the path point under the TCP [m/s].
-        q_lower, q_upper, qd_max: (6,) joint limits [rad, rad/s].
+        q_lower, q_upper, qd_max: (6,) joint limits [rad, rad/s] of the controller's
+            joints (see j23_coupled).
         generated: ISO time the plan was made.
     """
 
@@ -77,6 +78,13 @@ class ProgramData:
     q_lower: np.ndarray
     q_upper: np.ndarray
     qd_max: np.ndarray
+    j23_coupled: bool = False  # the controller counts axis 3 as q2 + q3 (ABB IRB 2400)
+
+    def controller_column(self, col: dict, prefix: str, j: int) -> np.ndarray:
+        """Column ``<prefix><j+1>`` of a trajectory table as the controller counts it
+        (the joint limits apply to that): axis 3 is q2 + q3 on coupled robots."""
+        values = col[f"{prefix}{j + 1}"]
+        return values + col[f"{prefix}2"] if self.j23_coupled and j == 2 else values
 
     def save(self, folder: Path) -> Path:
         """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
