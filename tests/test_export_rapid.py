@@ -286,7 +286,7 @@ def test_bad_arguments_are_named(data, tmp_path):
     ]:
         with pytest.raises(ValueError, match=name):
             write_rapid(data, tmp_path, **kwargs)
-    with pytest.raises(ValueError, match="j23_coupled"):
+    with pytest.raises(ValueError, match="no robot folder named 'abb_unknown'"):
         write_rapid(dataclasses.replace(data, robot="abb_unknown"), tmp_path)
 
 

@@ -33,9 +33,6 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.program import ProgramData
 from offline_prog.robot_model import RobotModel, load_robot
 
-# Controller axis 3 = q2 + q3 (parallel linkage): ros-industrial/abb abb_irb2400_support,
-# launch/robot_interface_download_irb2400.launch (J23_coupled default true).
-J23_COUPLED = {"abb_irb2400": True}
 DEFAULT_APPROACH_M = 0.02  # approach / retract along -y of F (y = pressing direction n)
 START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ
 APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retract
@@ -191,14 +188,14 @@ def write_rapid(
     zone_mm), fine at the end; MoveL to the retract pose. All with ``tool\WObj:=wobj``.
 
     Args:
-        data: the plan, of an OPW robot listed in J23_COUPLED (or give j23_coupled).
+        data: the plan, of an OPW robot in robots/.
         out_dir: folder for the files.
         module: RAPID module name (letter first, then letters, digits, _).
         chord_tol_m, angle_tol_rad: LIN deviation allowed from the dense X_PF [m, rad].
         line_limit: most lines in one module file.
         zone_mm: corner zone of the process moves [mm] (0: fine everywhere).
         approach_m: approach / retract distance off the surface [m] (0 or out of reach: none).
-        j23_coupled: the controller's axis 3 is q2 + q3 (None: from J23_COUPLED).
+        j23_coupled: the controller's axis 3 is q2 + q3 (None: from the robot's record).
         forced: the plan failed and is exported anyway (the header says so).
 
     Raises:
@@ -208,10 +205,9 @@ def write_rapid(
         raise ValueError(f"module={module!r}: need a RAPID name of at most {NAME_MAX - 6} chars")
     if not (chord_tol_m > 0 and angle_tol_rad > 0 and zone_mm >= 0 and approach_m >= 0):
         raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0, zone_mm >= 0, approach_m >= 0")
-    if j23_coupled is None and data.robot not in J23_COUPLED:
-        raise ValueError(f"j23_coupled: unknown for robot {data.robot!r}; pass it")
-    j23 = J23_COUPLED[data.robot] if j23_coupled is None else j23_coupled
     robot = load_robot(data.robot)
+    # Controller axis 3 = q2 + q3 where robot.yaml says so (the IRB 2400's J2/J3 linkage).
+    j23 = robot.j23_coupled if j23_coupled is None else j23_coupled
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
     p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
