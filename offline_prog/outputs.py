@@ -61,13 +61,12 @@ def speed_checks(plan: Plan) -> dict[str, float]:
     """
     tr = plan.trajectory
     v_peak = tr.law.v_peak
+    _, v_law, _, _ = tr.law(tr.t)
     if tr.reference == "tcp":
         commanded, measured, points = tr.s_dot, tr.tcp_speed, tr.flange.p_PF
     else:
-        _, commanded, _, _ = tr.law(tr.t)
-        measured, points = np.linalg.norm(tr.v_IE, axis=1), tr.flange.p_IE
+        commanded, measured, points = v_law, np.linalg.norm(tr.v_IE, axis=1), tr.flange.p_IE
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1) / np.diff(tr.t)
-    _, v_law, _, _ = tr.law(tr.t)
     cruise = (v_law[:-1] >= v_peak * (1 - 1e-12)) & (v_law[1:] >= v_peak * (1 - 1e-12))
     chord_error = np.abs(chord[cruise] - v_peak).max() / v_peak if cruise.any() else 0.0
     return {
