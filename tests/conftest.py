@@ -62,6 +62,26 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
     return Rotation.from_matrix(R).as_rotvec()
 
 
+@pytest.fixture(scope="session")
+def planned_folder(tmp_path_factory):
+    """name ↦ (plan, folder): a demo cell planned once per session with all its outputs
+    (tests read the folder; they write anything of their own elsewhere)."""
+    from offline_prog.outputs import write_outputs
+    from offline_prog.plan import plan_cell
+
+    cache = {}
+
+    def get(name: str):
+        if name not in cache:
+            out = tmp_path_factory.mktemp(name)
+            plan = plan_cell(CELLS / f"{name}.yaml")
+            write_outputs(plan, out)
+            cache[name] = (plan, out)
+        return cache[name]
+
+    return get
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(0)

@@ -14,11 +14,7 @@ from scipy.spatial.transform import Rotation
 from offline_prog.export.krl import write_krl
 from offline_prog.export.kuka import kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
-from offline_prog.outputs import write_outputs
-from offline_prog.plan import plan_cell
 from offline_prog.robot_model import load_robot
-
-from conftest import CELLS
 
 POSITION_TOL_M = 0.01e-3  # round trip of every written pose
 ANGLE_TOL_DEG = 0.01
@@ -33,10 +29,8 @@ DECL = re.compile(r"^DECL (E6POS|E6AXIS|FRAME) (\w+)=\{(.*)\}$")
 
 
 @pytest.fixture(scope="module")
-def data(tmp_path_factory):
-    out = tmp_path_factory.mktemp("kr16")
-    write_outputs(plan_cell(CELLS / "seal_plate_kr16.yaml"), out)
-    return ProgramData.load(out)
+def data(planned_folder):
+    return ProgramData.load(planned_folder("seal_plate_kr16")[1])
 
 
 @pytest.fixture(scope="module")

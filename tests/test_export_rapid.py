@@ -15,11 +15,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from offline_prog.export.program import ProgramData
 from offline_prog.export.rapid import confdata, write_rapid
-from offline_prog.outputs import write_outputs
-from offline_prog.plan import plan_cell
 from offline_prog.robot_model import ROBOTS_DIR, load_robot
-
-from conftest import CELLS
 
 POSITION_TOL_MM, ANGLE_TOL_DEG, JOINT_TOL_DEG = 0.01, 0.01, 0.001
 ROUNDING_M = 1e-6  # written positions are rounded to 0.5 µm
@@ -124,10 +120,8 @@ def drake_cfx(q: np.ndarray) -> int:
 
 
 @pytest.fixture(scope="module")
-def data(tmp_path_factory):
-    out = tmp_path_factory.mktemp("abb")
-    write_outputs(plan_cell(CELLS / "weld_seam_irb2400.yaml"), out)
-    return ProgramData.load(out)
+def data(planned_folder):
+    return ProgramData.load(planned_folder("weld_seam_irb2400")[1])
 
 
 @pytest.fixture(scope="module")

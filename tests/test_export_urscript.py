@@ -14,7 +14,6 @@ from scipy.spatial.transform import Rotation
 from offline_prog.export.formats import ExportRefusedError, export
 from offline_prog.export.program import ProgramData
 from offline_prog.export.urscript import X_BC, resample_joints
-from offline_prog.outputs import write_outputs
 from offline_prog.plan import plan_cell
 
 from conftest import CELLS, REPO
@@ -23,10 +22,8 @@ NUMBER = r"-?\d+\.?\d*(?:[eE][-+]?\d+)?"
 
 
 @pytest.fixture(scope="module")
-def plan_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("ur")
-    write_outputs(plan_cell(CELLS / "tape_cylinder_ur10e.yaml"), out)
-    return out
+def plan_dir(planned_folder):
+    return planned_folder("tape_cylinder_ur10e")[1]
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +51,7 @@ def test_servoj_stream_reproduces_the_plan(data, plan_dir):
     assert np.all(q >= data.q_lower) and np.all(q <= data.q_upper)
 
 
-def test_hermite_resampling_matches_a_denser_plan(tmp_path):
+def test_hermite_resampling_matches_a_denser_plan(tmp_path, planned_folder):
     cell = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
     dense_cell = tmp_path / "dense.yaml"
     dense_cell.write_text(
@@ -62,7 +59,7 @@ def test_hermite_resampling_matches_a_denser_plan(tmp_path):
             ": data/", f": {CELLS / 'data'}/"
         )
     )
-    coarse = plan_cell(CELLS / "tape_cylinder_ur10e.yaml").joints
+    coarse = planned_folder("tape_cylinder_ur10e")[0].joints
     dense = plan_cell(dense_cell)
     fake = dataclasses.make_dataclass("D", ["t", "q", "qd"])(
         coarse.trajectory.t, coarse.q, coarse.qd

@@ -69,6 +69,14 @@ def drake_forward(robot: RobotModel, q: np.ndarray) -> np.ndarray:
     return X_BE
 
 
+def assert_solutions_reach(robot, solutions, valid, X_BE):
+    """Every existing solution (valid (N, 8)) of solutions (N, 8, 6) reaches its pose."""
+    X_solutions = robot.forward(solutions[valid])
+    distance, angle = pose_errors(X_solutions, np.repeat(X_BE, valid.sum(axis=1), axis=0))
+    assert distance.max() <= POSITION_TOL_M
+    assert angle.max() <= ANGLE_TOL_RAD
+
+
 @pytest.mark.parametrize("name", ROBOTS)
 def test_forward_matches_drake_urdf(name):
     robot = load_robot(name)
@@ -91,10 +99,7 @@ def test_inverse_round_trip(name):
     joint_error = np.abs(wrap_to_pi(solutions - q[:, None])).max(axis=-1)
     assert np.where(valid, joint_error, np.inf).min(axis=1).max() <= ANGLE_TOL_RAD
     # Every solution that exists reaches the pose.
-    X_solutions = robot.forward(solutions[valid])
-    distance, angle = pose_errors(X_solutions, np.repeat(X_BE, valid.sum(axis=1), axis=0))
-    assert distance.max() <= POSITION_TOL_M
-    assert angle.max() <= ANGLE_TOL_RAD
+    assert_solutions_reach(robot, solutions, valid, X_BE)
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -106,10 +111,7 @@ def test_inverse_at_wrist_singularity(name):
     solutions = robot.inverse(X_BE)
     valid = ~np.isnan(solutions).any(axis=-1)
     assert valid.any(axis=1).all()
-    X_solutions = robot.forward(solutions[valid])
-    distance, angle = pose_errors(X_solutions, np.repeat(X_BE, valid.sum(axis=1), axis=0))
-    assert distance.max() <= POSITION_TOL_M
-    assert angle.max() <= ANGLE_TOL_RAD
+    assert_solutions_reach(robot, solutions, valid, X_BE)
 
 
 @pytest.mark.parametrize("name", ROBOTS)

@@ -111,8 +111,9 @@ def test_abb_axis_3_limits_apply_to_q2_plus_q3():
     X_BE = robot.forward(q)
 
     def generating(results):
-        return next(r for r in results
-                    if np.allclose(np.angle(np.exp(1j * (r.q - q))), 0.0, atol=1e-7))
+        return next(
+            r for r in results if np.allclose(np.angle(np.exp(1j * (r.q - q))), 0.0, atol=1e-7)
+        )
 
     coupled = generating(branch_results(robot, X_BE))
     assert coupled.feasible

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from offline_prog.outputs import write_outputs
 from offline_prog.plan import plan_cell
 from offline_prog.preview import show_plan
 
@@ -19,11 +18,8 @@ from conftest import CELLS, REPO
 
 
 @pytest.fixture(scope="module")
-def seal(tmp_path_factory):
-    out = tmp_path_factory.mktemp("seal")
-    plan = plan_cell(CELLS / "seal_plate_kr16.yaml")
-    write_outputs(plan, out)
-    return plan, out
+def seal(planned_folder):
+    return planned_folder("seal_plate_kr16")
 
 
 def test_animation_has_the_plan_duration(seal):
