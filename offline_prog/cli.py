@@ -20,6 +20,7 @@ from rich.console import Console
 EXIT_PLAN_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
+EXIT_INTERRUPTED = 130  # Ctrl-C, as shells report SIGINT
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -181,7 +182,7 @@ def _serve_preview(plan, args, console: Console) -> None:
     """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
     from pydrake.geometry import Meshcat, MeshcatParams
 
-    from offline_prog.preview import near_collision_mask, show_plan
+    from offline_prog.viz.preview import near_collision_mask, show_plan
 
     params = MeshcatParams()
     params.port = args.port
@@ -200,6 +201,25 @@ def _serve_preview(plan, args, console: Console) -> None:
         pass
 
 
+def exit_code(error: BaseException, args) -> tuple[int, str]:
+    """The exit code and the one stderr line for an error: the one place that maps
+    errors to exit codes (README: "exit code")."""
+    from offline_prog.errors import InputError, PlanFailedError
+    from offline_prog.export.formats import ExportRefusedError
+
+    if isinstance(error, KeyboardInterrupt):
+        return EXIT_INTERRUPTED, "interrupted"
+    if isinstance(error, PlanFailedError):  # valid cell, but the robot cannot do it
+        return EXIT_PLAN_FAILED, f"error: {args.cell}: {error}"
+    if isinstance(error, ExportRefusedError):
+        return EXIT_BAD_INPUT, f"error: {args.plan_dir}: {error}"
+    if isinstance(error, InputError) or (
+        args.command == "export" and isinstance(error, ValueError)
+    ):
+        return EXIT_BAD_INPUT, f"error: {error}"
+    return EXIT_INTERNAL, f"internal error: {type(error).__name__}: {error} (rerun with --debug)"
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
@@ -211,36 +231,24 @@ def main(argv: list[str] | None = None) -> int:
         return code
 
     try:
-        from offline_prog.cell import CellError
-        from offline_prog.export.formats import ExportRefusedError
-        from offline_prog.outputs import write_outputs
-        from offline_prog.plan import PlanInfeasibleError, plan_cell
+        from offline_prog.plan import plan_cell
+        from offline_prog.results.plan_folder import write_outputs
 
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
         logging.getLogger("drake").setLevel(logging.WARNING)
 
         if args.command == "export":
-            try:
-                _run_export(args, console)
-                return 0
-            except ExportRefusedError as error:
-                return fail(f"error: {args.plan_dir}: {error}", EXIT_BAD_INPUT)
-            except ValueError as error:
-                return fail(f"error: {error}", EXIT_BAD_INPUT)
+            _run_export(args, console)
+            return 0
         if args.command == "preview":
             args.preview, args.out = True, None
-        try:
-            with errors.status("planning") as status:
-                plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
-                out = args.out or Path("out") / args.cell.stem
-                status.update("writing outputs")
-                if args.command == "plan":
-                    files, report = write_outputs(plan, out)
-        except PlanInfeasibleError as error:  # valid cell, but the robot cannot do it
-            return fail(f"error: {error}", EXIT_PLAN_FAILED)
-        except CellError as error:
-            return fail(f"error: {error}", EXIT_BAD_INPUT)
+        with errors.status("planning") as status:
+            plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
+            out = args.out or Path("out") / args.cell.stem
+            status.update("writing outputs")
+            if args.command == "plan":
+                files, report = write_outputs(plan, out)
         if args.command == "plan":
             _summary(console, report, files, time.perf_counter() - started)
         if args.preview:
@@ -249,12 +257,11 @@ def main(argv: list[str] | None = None) -> int:
             where = f" (see {files['collisions']})" if args.command == "plan" else ""
             return fail(f"error: {args.cell}: {plan.failure}{where}", EXIT_PLAN_FAILED)
         return 0
-    except Exception as error:  # one line, never a traceback unless asked
-        if args.debug:
+    except (Exception, KeyboardInterrupt) as error:  # one line, never a traceback unless asked
+        code, message = exit_code(error, args)
+        if code == EXIT_INTERNAL and args.debug:
             raise
-        return fail(
-            f"internal error: {type(error).__name__}: {error} (rerun with --debug)", EXIT_INTERNAL
-        )
+        return fail(message, code)
 
 
 if __name__ == "__main__":

@@ -20,3 +20,6 @@ DEFAULT_SAMPLE_RATE_HZ = 250.0
 # and a local peak above CUSP_PEAK_RATIO times the path median is a speed peak.
 CUSP_MIN_FLANGE_RATIO = 0.05
 CUSP_PEAK_RATIO = 3.0
+
+# Length units a cell file may use, in metres per unit.
+UNIT_SCALE = {"m": 1.0, "mm": 1e-3}

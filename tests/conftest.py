@@ -7,10 +7,10 @@ import pytest
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RigidTransform, RotationMatrix
 
-from offline_prog.arc_length import ArcLengthPath
-from offline_prog.bspline_fit import fit_bspline
-from offline_prog.fixed_tcp import FlangePath
-from offline_prog.process_frames import constant_normal
+from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.bspline_fit import fit_bspline
+from offline_prog.path.fixed_tcp import FlangePath
+from offline_prog.path.process_frames import constant_normal
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = REPO / "cells"
@@ -66,8 +66,8 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
 def planned_folder(tmp_path_factory):
     """name ↦ (plan, folder): a demo cell planned once per session with all its outputs
     (tests read the folder; they write anything of their own elsewhere)."""
-    from offline_prog.outputs import write_outputs
     from offline_prog.plan import plan_cell
+    from offline_prog.results.plan_folder import write_outputs
 
     cache = {}
 

@@ -11,12 +11,12 @@ import pytest
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from offline_prog.cell import load_cell, transform
-from offline_prog.drake_cell import build_drake_cell
-from offline_prog.inputs import load_points
-from offline_prog.outputs import csv_columns
-from offline_prog.robot_model import load_robot
-from offline_prog.trajectory import CSV_COLUMNS
+from offline_prog.config.cell import load_cell, transform
+from offline_prog.path.inputs import load_points
+from offline_prog.results.plan_folder import csv_columns
+from offline_prog.robot.model import load_robot
+from offline_prog.scene.drake_cell import build_drake_cell
+from offline_prog.timing.trajectory import CSV_COLUMNS
 
 from conftest import CELLS, REPO
 

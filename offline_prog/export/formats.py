@@ -7,8 +7,6 @@ from pathlib import Path
 from offline_prog.export.program import ProgramData
 
 FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
-# The controller language of each robot folder's vendor (by folder-name prefix).
-VENDOR_FORMAT = {"kuka": "krl", "abb": "rapid", "ur": "urscript"}
 PROGRAMS_DIR = "programs"
 
 
@@ -16,10 +14,9 @@ class ExportRefusedError(ValueError):
     """The plan failed; exporting it needs ``force``."""
 
 
-def default_formats(robot: str) -> list[str]:
-    """The robot's controller language plus the joint-trajectory files."""
-    vendor = next((fmt for prefix, fmt in VENDOR_FORMAT.items() if robot.startswith(prefix)), None)
-    return ([vendor] if vendor else []) + ["csv", "ros-json"]
+def default_formats(language: str | None) -> list[str]:
+    """The robot's controller language (robot.yaml) plus the joint-trajectory files."""
+    return ([language] if language else []) + ["csv", "ros-json"]
 
 
 def export(
@@ -38,11 +35,10 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    vendor = {"krl": "kuka", "rapid": "abb"}.get(fmt)
-    if vendor and not data.robot.startswith(vendor):
+    if fmt in ("krl", "rapid") and fmt != data.language:
         raise ValueError(
-            f"{fmt} is the {vendor.upper()} controller language; the plan's robot "
-            f"is {data.robot} (use {', '.join(default_formats(data.robot))})"
+            f"{fmt} is not the controller language of the plan's robot "
+            f"{data.robot} (use {', '.join(default_formats(data.language))})"
         )
     forced = not data.feasible
     out_dir = Path(out_dir)

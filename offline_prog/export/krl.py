@@ -34,14 +34,12 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.density import (
     DEFAULT_ANGLE_TOL_RAD,
     DEFAULT_CHORD_TOL_M,
-    segment_deviation,
-    select_points,
 )
 from offline_prog.export.header import header_lines
-from offline_prog.export.kuka import X_KE, kuka_abc_deg, status_turn
+from offline_prog.export.krl_points import process_points
+from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
-from offline_prog.kinematics_opw import wrap_to_pi
-from offline_prog.robot_model import RobotModel, load_robot
+from offline_prog.robot.model import load_robot
 
 STYLES = ("external_tcp", "flange")
 # "X_TP": the point is P in T, flange = $BASE:POS:inv($TOOL), KSS's rule for every
@@ -54,7 +52,6 @@ VEL_CP_STEP_M_S = 1e-4  # $VEL.CP is floored to 0.1 mm/s: never above the plan
 VEL_CP_MIN_M_S = 1e-3
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 20, 50  # the joint move to the approach pose [%]
-_GRID = 64  # flange style: nozzle curve samples per LIN segment
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
 _MAIN = """DEF {name}( )
 {ext};FOLD INI
@@ -106,59 +103,6 @@ def _frame(X: np.ndarray) -> str:
         _num(v, 5) for v in kuka_abc_deg(X[None, :3, :3])[0]
     ]
     return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))
-
-
-def _nozzle_deviation(X_BP, X_BT, X_PF, i: int, j: int) -> tuple[float, float]:
-    """Flange style: largest distance [m] / angle [rad] of the plan's X_PF[i..j] from the
-    tool frame's curve on the part while the controller interpolates X_BP from i to j
-    (position linear, orientation slerp, one parameter)."""
-    if j - i < 2:
-        return 0.0, 0.0
-    lam = np.linspace(0.0, 1.0, _GRID + 1)
-    rotvec = Rotation.from_matrix(X_BP[i, :3, :3].T @ X_BP[j, :3, :3]).as_rotvec()
-    R_BP = X_BP[i, :3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
-    p_BP = X_BP[i, :3, 3] + lam[:, None] * (X_BP[j, :3, 3] - X_BP[i, :3, 3])
-    p_PT = np.einsum("nji,nj->ni", R_BP, X_BT[:3, 3] - p_BP)  # (G+1, 3) tool origin in P
-    a, d = p_PT[:-1], np.diff(p_PT, axis=0)
-    inner = X_PF[i + 1 : j, :3, 3]
-    u = np.clip(np.einsum("kgc,gc->kg", inner[:, None] - a, d) / (d * d).sum(1).clip(1e-30), 0, 1)
-    gap = np.linalg.norm(inner[:, None] - a - u[..., None] * d, axis=2)  # (K, G)
-    near = gap.argmin(axis=1)
-    R_PT = np.swapaxes(R_BP[near], 1, 2) @ X_BT[:3, :3]
-    angle = Rotation.from_matrix(np.swapaxes(R_PT, 1, 2) @ X_PF[i + 1 : j, :3, :3]).magnitude()
-    return float(gap.min(axis=1).max()), float(angle.max())
-
-
-def _process_points(data: ProgramData, style: str, chord_tol_m: float, angle_tol_rad: float):
-    """Chosen sample indices and the worst deviation [m, rad] (see KrlResult)."""
-    p, R = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
-    chosen = select_points(p, R, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
-    if style == "external_tcp":
-        return chosen.indices, chosen.max_chord_m, chosen.max_angle_rad
-    X_BP = data.X_BE @ data.X_EP
-    indices, worst = [int(chosen.indices[0])], np.zeros(2)
-    stack = list(zip(chosen.indices[1:], chosen.indices[:-1], strict=True))[::-1]
-    while stack:  # split each LIN segment until the nozzle curve on P fits as well
-        j, i = (int(v) for v in stack.pop())
-        deviation = np.maximum(
-            segment_deviation(p, R, i, j), _nozzle_deviation(X_BP, data.X_BT, data.X_PF, i, j)
-        )
-        if j - i > 1 and (deviation[0] > chord_tol_m or deviation[1] > angle_tol_rad):
-            stack += [(j, (i + j) // 2), ((i + j) // 2, i)]
-            continue
-        indices.append(j)
-        worst = np.maximum(worst, deviation)
-    return np.asarray(indices), float(worst[0]), float(worst[1])
-
-
-def _joints_near(robot: RobotModel, X_BE, q_ref, data: ProgramData, what: str) -> np.ndarray:
-    """The IK solution (6,) [rad] for X_BE (4, 4) nearest q_ref, within the joint limits."""
-    q = robot.inverse(X_BE[None])[0]
-    q = q_ref + wrap_to_pi(q - q_ref)  # each joint's 2π-equivalent nearest q_ref
-    ok = ~np.isnan(q).any(axis=1) & np.all((q >= data.q_lower) & (q <= data.q_upper), axis=1)
-    if not ok.any():
-        raise ValueError(f"write_krl: the {what} pose is out of reach (approach_m too large?)")
-    return q[ok][np.abs(q[ok] - q_ref).max(axis=1).argmin()]
 
 
 def _vel_cp(speed_m_s: float) -> float:
@@ -271,13 +215,13 @@ def write_krl(
     robot = load_robot(data.robot)
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
-    idx, max_chord, max_angle = _process_points(data, style, chord_tol_m, angle_tol_rad)
+    idx, max_chord, max_angle = process_points(data, style, chord_tol_m, angle_tol_rad)
     off = np.eye(4)
     off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
     X_PF_off = data.X_PF[[0, -1]] @ off  # approach, retract
     X_BE_off = data.X_BT @ np.linalg.inv(X_PF_off) @ np.linalg.inv(data.X_EP)
-    q_approach = _joints_near(robot, X_BE_off[0], data.q[0], data, "approach")
-    q_retract = _joints_near(robot, X_BE_off[1], data.q[-1], data, "retract")
+    q_approach = joints_near(robot, X_BE_off[0], data.q[0], data, "approach")
+    q_retract = joints_near(robot, X_BE_off[1], data.q[-1], data, "retract")
     X_PF = np.concatenate([data.X_PF[idx], X_PF_off[1:]])  # the process points, retract
     X_BE = np.concatenate([data.X_BE[idx], X_BE_off[1:]])
     if style == "flange":

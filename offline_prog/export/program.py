@@ -79,6 +79,7 @@ class ProgramData:
     q_upper: np.ndarray
     qd_max: np.ndarray
     j23_coupled: bool = False  # the controller counts axis 3 as q2 + q3 (ABB IRB 2400)
+    language: str | None = None  # the controller's program format (robot.yaml)
 
     def controller_column(self, col: dict, prefix: str, j: int) -> np.ndarray:
         """Column ``<prefix><j+1>`` of a trajectory table as the controller counts it

@@ -31,7 +31,7 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines
 from offline_prog.export.program import ProgramData
-from offline_prog.robot_model import RobotModel, load_robot
+from offline_prog.robot.model import RobotModel, load_robot
 
 DEFAULT_APPROACH_M = 0.02  # approach / retract along -y of F (y = pressing direction n)
 START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ

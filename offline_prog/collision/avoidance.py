@@ -1,0 +1,219 @@
+"""Collision avoidance: re-plan with other branches and tool rotations, and as the
+last resort turn a symmetric tool along the path.
+
+When no configuration branch and no fixed tool rotation is collision-free, Drake
+InverseKinematics looks for joint configurations that still hold the process pose
+— the path point at the TCP, the surface normal on the tool's axis — while the
+rotation about that axis stays within its bound and every checked pair keeps the
+clearance (MinimumDistanceLowerBoundConstraint). Solved on a coarse σ grid, each
+sample seeded with the previous one, the rotations found are fitted with a smooth
+quintic spline φ(s), and the flange path is rebuilt with it, so that the analytic
+pipeline (branch, retiming, collision check) runs on a smooth, exact path again.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from pydrake.multibody.inverse_kinematics import InverseKinematics
+from pydrake.solvers import Solve
+
+from offline_prog.collision.check import CollisionResult
+from offline_prog.errors import PlanFailedError
+from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.path.bspline_fit import fit_on_knots, open_knots
+from offline_prog.path.fixed_tcp import FlangePath
+
+GRID_POINTS = 80  # IK samples along the path
+CLEARANCE_MARGIN_M = 2e-3  # asked of the IK beyond the clearance
+INFLUENCE_M = 0.05  # distance at which pairs start to count in the constraint
+NORMAL_TOL_RAD = 1e-6
+POSITION_TOL_M = 1e-7
+SPLINE_CONTROL_POINTS = 10
+
+
+def _turn_angle(x_T: np.ndarray, axis_I: np.ndarray, t_I: np.ndarray) -> float:
+    """Angle about axis_I from x_T to the tangent t_I [rad]."""
+    return float(np.arctan2(np.cross(x_T, t_I) @ axis_I, x_T @ t_I))
+
+
+def turn_profile(
+    drake,
+    path,
+    normal_field,
+    *,
+    X_IT,
+    s_plan: np.ndarray,
+    q_plan: np.ndarray,
+    axis: np.ndarray,
+    bound_rad: float,
+    clearance: float,
+):
+    """A smooth tool rotation φ(s) that keeps the clearance, or None.
+
+    Args:
+        drake: the DrakeCell with every shape (the part body frame is P).
+        path: the processing path; normal_field: its surface normals.
+        X_IT: the physical tool frame; axis: (3,) the symmetry axis in T.
+        s_plan, q_plan: (M,) arc lengths and (M, 6) joints of the colliding plan: the
+            first sample and any retry are seeded from it.
+        bound_rad: largest |φ|; clearance: required distance [m].
+
+    Returns:
+        φ(s) ↦ (φ, φ′, φ″) for ``FlangePath(tool_turn=...)``, or None when some
+        sample has no solution.
+    """
+    plant = drake.plant
+    context = drake.diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    part = plant.GetBodyByName("part").body_frame()
+    world = plant.world_frame()
+    R_IT = X_IT.rotation().matrix()
+    axis_I, x_T, p_IT = R_IT @ axis, R_IT[:, 0], X_IT.translation()
+    s_grid = np.linspace(0.0, path.length, GRID_POINTS)
+    p_PF, t_P = path(s_grid, order=1)
+    n_P = normal_field(s_grid)[0]
+    n_P = n_P - np.einsum("ij,ij->i", n_P, t_P)[:, None] * t_P
+    n_P /= np.linalg.norm(n_P, axis=1, keepdims=True)
+    q_seed_plan = np.column_stack([np.interp(s_grid, s_plan, q_plan[:, j]) for j in range(6)])
+    q_prev, angles = q_seed_plan[0], []
+    for k in range(len(s_grid)):
+        ik = InverseKinematics(plant, plant_context)
+        ik.AddPositionConstraint(part, p_PF[k], world, p_IT - POSITION_TOL_M, p_IT + POSITION_TOL_M)
+        ik.AddAngleBetweenVectorsConstraint(world, axis_I, part, n_P[k], 0.0, NORMAL_TOL_RAD)
+        ik.AddAngleBetweenVectorsConstraint(world, x_T, part, t_P[k], 0.0, bound_rad)
+        ik.AddMinimumDistanceLowerBoundConstraint(clearance + CLEARANCE_MARGIN_M, INFLUENCE_M)
+        q = ik.q()
+        ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(q_prev)), q_prev, q)
+        for seed in (q_prev, q_seed_plan[k]):  # the previous solution, else the plan's
+            result = Solve(ik.prog(), seed)
+            if result.is_success():
+                break
+        else:
+            return None
+        q_prev = result.GetSolution(q)
+        plant.SetPositions(plant_context, q_prev)
+        R_IP = part.CalcPoseInWorld(plant_context).rotation().matrix()
+        angles.append(_turn_angle(x_T, axis_I, R_IP @ t_P[k]))
+    angles = np.unwrap(np.asarray(angles))
+    spline = fit_on_knots(
+        s_grid, angles[:, None], open_knots(s_grid, SPLINE_CONTROL_POINTS, 5), 5, closed=False
+    )
+
+    def tool_turn(s: np.ndarray):
+        s = np.clip(s, 0.0, path.length)
+        return tuple(spline(s, nu=k)[:, 0] for k in range(3))
+
+    return tool_turn
+
+
+# Collision avoidance: at most this many re-plans (tool rotations × branches).
+MAX_AVOIDANCE_ATTEMPTS = 12
+
+
+@dataclasses.dataclass
+class Attempt:
+    """One joint plan and its collision check."""
+
+    rotation: float
+    flange: object
+    nominal: object
+    joints: JointTrajectory
+    collisions: CollisionResult
+
+
+def avoid_collisions(first: Attempt, rotations, attempt) -> tuple[Attempt, dict]:
+    """Re-plan with the other tool rotations and configuration branches until one is
+    collision-free (cheap choices first; the process pose is held in every one).
+
+    Returns:
+        The collision-free attempt (else the one with the largest clearance) and a
+        record for the report: the samples that needed avoidance, what was tried and
+        what changed.
+    """
+    tried, best = 0, first
+    candidates = [
+        (first.rotation, first.flange, b.branch)
+        for b in first.joints.branches
+        if b.feasible and b.branch != first.joints.branch
+    ]
+    candidates += [(phi, flange, None) for phi, flange in rotations[1:]]
+    for phi, flange, branch in candidates:
+        if tried >= MAX_AVOIDANCE_ATTEMPTS:
+            break
+        tried += 1
+        try:
+            trial = attempt(phi, flange, branch)
+        except PlanFailedError:
+            continue
+        if trial.collisions.min_distance_m > best.collisions.min_distance_m:
+            best = trial
+        if trial.collisions.collision_free:
+            break
+    sigma = first.joints.trajectory.sigma
+    needed = sorted(set(first.collisions.samples_in_collision))
+    change = []
+    if best.rotation != first.rotation:
+        change.append(
+            f"tool rotation {np.rad2deg(first.rotation):.1f}° → {np.rad2deg(best.rotation):.1f}°"
+        )
+    if best.joints.branch != first.joints.branch:
+        change.append(f"branch {first.joints.branch} → {best.joints.branch}")
+    record = {
+        "samples_that_needed_it": needed,
+        "sigma_m_that_needed_it": [float(sigma[i]) for i in needed if 0 <= i < len(sigma)],
+        "first_failure": first.collisions.message,
+        "attempts": tried,
+        "resolved": best.collisions.collision_free,
+        "change": ", ".join(change) or "none",
+    }
+    return best, record
+
+
+def turn_tool_along_path(
+    chosen: Attempt, record: dict, attempt, scene, path, normal, inputs
+) -> Attempt:
+    """Last resort for a symmetric tool: turn it along the path (Drake IK with a
+    minimum-distance constraint, :func:`turn_profile`) and re-plan with that turn.
+
+    Args:
+        chosen: the best attempt so far (colliding); record: the avoidance record,
+            updated in place with the attempt and, if it worked, the change.
+        attempt: (rotation, flange) ↦ Attempt, the planner of one flange path.
+        scene: the DrakeCell; path, normal: the arc-length path and normal field in P;
+        inputs: the plan's Inputs (cell, X_IT, X_PE).
+
+    Returns:
+        The turned attempt if it is collision-free, else ``chosen``.
+    """
+    cell = inputs.cell
+    axis = np.eye(3)["xyz".index(cell.tool.symmetry_axis)]
+    turn = turn_profile(
+        scene,
+        path,
+        normal,
+        X_IT=inputs.X_IT,
+        s_plan=chosen.joints.trajectory.s,
+        q_plan=chosen.joints.q,
+        axis=axis,
+        bound_rad=np.deg2rad(cell.tool.free_rotation_deg),
+        clearance=cell.motion.clearance,
+    )
+    if turn is None:
+        return chosen
+    turned = FlangePath(path, normal, X_IT=inputs.X_IT, X_PE=inputs.X_PE, tool_turn=turn, axis=axis)
+    phi = turn(np.linspace(0.0, path.length, 200))[0]
+    record["attempts"] += 1
+    try:
+        trial = attempt(float(phi[0]), turned)
+    except PlanFailedError:
+        return chosen
+    if not trial.collisions.collision_free:
+        return chosen
+    record["resolved"] = True
+    record["change"] = (
+        "tool turned along the path (Drake IK with a minimum-distance constraint): "
+        f"φ from {np.rad2deg(phi.min()):.1f}° to {np.rad2deg(phi.max()):.1f}°"
+    )
+    return trial

@@ -1,0 +1,288 @@
+"""Collision and clearance checks along a joint trajectory, samples and between them.
+
+Every unfiltered geometry pair of a :class:`~offline_prog.scene.drake_cell.DrakeCell` is measured
+with SceneGraph's signed distance (convex pieces for meshes), grouped by shape name. Pairs
+of meshes near or below the clearance are then measured on the original triangle meshes
+with python-fcl (:func:`~offline_prog.scene.exact_distance.exact_distance`), which decides.
+
+Motion bound (Schwarzer, Saha & Latombe, "Adaptive dynamic collision checking for single
+and multiple articulated robots in complex environments", IEEE T-RO 21(3), 2005): moving
+the joints along the straight line from q_a to q_b moves no point of the robot or the part
+farther than M(a, b) = Σ_k ρ_k |q_b,k − q_a,k|, where ρ_k bounds the distance of every
+geometry outboard of joint k from a point on its axis (``DrakeCell.motion_radii``). A pair's
+signed distance changes by at most c·M, c = 1 when one side is fixed (tool, obstacles,
+robot base) and 2 when both move. Hence, per geometry pair g (each queried alone):
+
+* evaluated at sample i with distance d_g, g is certified (≥ clearance + margin) up to a
+  cumulative motion of (d_g − clearance − margin) / c_g and next evaluated at the last
+  sample within it (conservative advancement; pruning);
+* between two evaluated neighbours a, b, d_g ≥ (d_g(a) + d_g(b) − c_g M(a, b)) / 2; a step
+  where this falls below the clearance is bisected (q interpolated linearly) until it
+  holds, an end overlaps, or M ≤ the clearance: so no contact is missed between checks
+  (no tunnelling) and the clearance is violated unseen by at most c·M/2 ≤ the clearance.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from offline_prog.arrays import true_runs
+from offline_prog.collision.result import (  # noqa: F401  (re-exported)
+    CollisionResult,
+    CollisionStretch,
+    PairMinimum,
+    failure_message,
+    write_collisions_json,
+)
+from offline_prog.scene.drake_cell import DrakeCell
+from offline_prog.scene.exact_distance import exact_distance, exact_shape, exact_shape_of_drake
+
+# A pair certified above clearance + this is not evaluated (its minimum is then over
+# the evaluated points only).
+PRUNE_MARGIN_M = 0.02
+PROFILE_POINTS = 400  # samples of the distance-over-time profile (report plot)
+# Drake (convex pieces) and FCL (original shapes) distances further apart are noted.
+EXACT_MISMATCH_TOL_M = 5e-4
+N_WORST_PAIRS = 5
+MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drake's, noted
+MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
+TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
+OWNER_ORDER = ("part", "tool", "robot", "obstacle")
+
+
+class _Pairs:
+    """The unfiltered geometry pairs g of a cell, grouped into shape pairs s, and their
+    signed distances at a joint vector (Drake) or on the original shapes (FCL)."""
+
+    def __init__(self, cell: DrakeCell):
+        self.cell, plant = cell, cell.plant
+        self.context = cell.diagram.CreateDefaultContext()
+        self.plant_context = plant.GetMyMutableContextFromRoot(self.context)
+        scene_graph = cell.diagram.scene_graph()
+        self.sg_context = scene_graph.GetMyContextFromRoot(self.context)
+        self.port = scene_graph.get_query_output_port()
+        self.set(plant.GetPositions(self.plant_context, cell.robot))
+        fixed = {b.name() for b in plant.GetBodiesWeldedTo(plant.world_body())}
+        rank = {owner: i for i, owner in enumerate(OWNER_ORDER)}
+        self.ids, self.names, shape_of, c = [], [], [], []
+        for r in self.query.ComputeSignedDistancePairwiseClosestPoints():
+            labels = (cell.labels[r.id_A], cell.labels[r.id_B])
+            a, b = sorted(labels, key=lambda label: (rank[label.owner], label.name))
+            if (a.name, b.name) not in self.names:
+                self.names.append((a.name, b.name))
+            self.ids.append((r.id_A, r.id_B))
+            shape_of.append(self.names.index((a.name, b.name)))
+            c.append(1.0 if a.body in fixed or b.body in fixed else 2.0)
+        self.shape_of, self.c = np.array(shape_of, dtype=int), np.array(c)
+        owner = {label.name: label.owner for label in cell.labels.values()}
+        self.groups = [
+            "robot-self" if owner[a] == owner[b] else f"{owner[a]}-{owner[b]}"
+            for a, b in self.names
+        ]
+        mesh = {lb.name for lb in cell.labels.values() if lb.shape and lb.shape.kind == "mesh"}
+        self.has_mesh = np.array([a in mesh or b in mesh for a, b in self.names], dtype=bool)
+        self._exact, self.exact_checks, self.evaluations = {}, 0, 0
+
+    def set(self, q: np.ndarray) -> None:
+        self.cell.plant.SetPositions(self.plant_context, self.cell.robot, q)
+        self.query = self.port.Eval(self.sg_context)
+
+    def distance(self, g: int) -> float:
+        """Drake's signed distance [m] of geometry pair g at the last set q."""
+        self.evaluations += 1
+        return self.query.ComputeSignedDistancePairClosestPoints(*self.ids[g]).distance
+
+    def _components(self, name: str):
+        """[(ExactShape, a GeometryId giving its pose X_IG)] of a shape name."""
+        if name not in self._exact:
+            inspector = self.cell.diagram.scene_graph().model_inspector()
+            ids = [g for g, label in self.cell.labels.items() if label.name == name]
+            shape = self.cell.labels[ids[0]].shape
+            self._exact[name] = (
+                [(exact_shape(shape.kind, shape.size_m, shape.mesh), ids[0])]
+                if shape is not None
+                else [(exact_shape_of_drake(inspector.GetShape(g)), g) for g in ids]
+            )
+        return self._exact[name]
+
+    def exact(self, q: np.ndarray, s: int) -> float:
+        """FCL's distance [m] of shape pair s on the original shapes at q."""
+        self.set(q)
+        self.exact_checks += 1
+        a, b = (self._components(name) for name in self.names[s])
+        pose = self.query.GetPoseInWorld
+        return min(exact_distance(sa, pose(ga), sb, pose(gb)) for sa, ga in a for sb, gb in b)
+
+
+def _at(values: np.ndarray, x: float) -> float:
+    """values (N, ...) linearly interpolated at the fractional sample index x."""
+    i = min(int(x), len(values) - 2) if len(values) > 1 else 0
+    return values[i] + (x - i) * (values[i + 1] - values[i]) if x != i else values[i]
+
+
+def check_trajectory(
+    cell: DrakeCell,
+    q: np.ndarray,
+    t: np.ndarray,
+    sigma: np.ndarray,
+    *,
+    clearance: float,
+    margin: float = PRUNE_MARGIN_M,
+    n_worst: int = N_WORST_PAIRS,
+) -> CollisionResult:
+    """Check every unfiltered shape pair along a joint trajectory, samples and between.
+
+    Args:
+        cell: the cell with its shapes (:func:`~offline_prog.scene.drake_cell.build_cell_model`).
+        q: (N, 6) joint positions [rad], one row per sample; linear in between.
+        t: (N,) sample times [s].
+        sigma: (N,) path parameter σ at the samples [m].
+        clearance: smallest allowed signed distance of any checked pair [m].
+        margin: pruning margin [m] (see PRUNE_MARGIN_M).
+        n_worst: how many closest pairs get FCL's exact distance as a cross-check.
+
+    Raises:
+        ValueError: q, t or sigma of the wrong shape, or a negative clearance.
+    """
+    q, t, sigma = (np.asarray(a, dtype=float) for a in (q, t, sigma))
+    n = len(q)
+    if q.ndim != 2 or q.shape[1] != 6 or n < 1 or not np.all(np.isfinite(q)):
+        raise ValueError(f"q: expected (N, 6) finite joint positions, got shape {q.shape}")
+    if t.shape != (n,) or sigma.shape != (n,):
+        raise ValueError(f"t, sigma: expected shape ({n},), got {t.shape} and {sigma.shape}")
+    if not (np.isfinite(clearance) and clearance >= 0):
+        raise ValueError(f"clearance: expected a distance >= 0 m, got {clearance!r}")
+    start = time.perf_counter()
+    pairs, rho = _Pairs(cell), cell.motion_radii()
+    step = np.abs(np.diff(q, axis=0)) @ rho  # (N - 1,) motion bound of each step [m]
+    cumulative = np.concatenate([[0.0], np.cumsum(step)])
+    # (geometry pairs g, points x, Drake distances) of each evaluation.
+    found: list[tuple] = [(np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
+
+    def bisect(g: int, xa: float, da: float, xb: float, db: float, motion: float) -> None:
+        if (da + db - pairs.c[g] * motion) / 2 >= clearance or min(da, db) < -TOUCH_TOL_M:
+            return  # certified, or an overlap already found at an end
+        if motion <= max(clearance, MIN_SUBSTEP_M):
+            return
+        xm = (xa + xb) / 2
+        pairs.set(_at(q, xm))
+        dm = pairs.distance(g)
+        found.append(([g], [xm], [dm]))
+        bisect(g, xa, da, xm, dm, motion / 2)
+        bisect(g, xm, dm, xb, db, motion / 2)
+
+    # Per geometry pair: the next sample to evaluate (n: certified to the end).
+    due = np.zeros(len(pairs.ids), dtype=int)
+    last_i, last_d = np.full(len(due), -2), np.zeros(len(due))
+    while len(due) and (i := int(due.min())) < n:
+        now = np.flatnonzero(due == i)
+        pairs.set(q[i])
+        d = np.array([pairs.distance(g) for g in now], dtype=float)
+        found.append((now, np.full(len(now), float(i)), d))
+        budget = (d - clearance - margin) / pairs.c[now]
+        reach = np.searchsorted(cumulative, cumulative[i] + budget, side="right") - 1
+        due[now] = np.where(reach >= n - 1, n, np.maximum(reach, i + 1))
+        lower = (last_d[now] + d - pairs.c[now] * step[i - 1]) / 2 if i else d
+        split = (last_i[now] == i - 1) & (lower < clearance)  # steps to bisect
+        for g, d_g in zip(now[split], d[split], strict=True):
+            bisect(g, i - 1.0, last_d[g], float(i), d_g, step[i - 1])
+        last_i[now], last_d[now] = i, d
+    g, x, d = (np.concatenate([np.asarray(f[k]) for f in found]) for k in range(3))
+    s = pairs.shape_of[g.astype(int)]
+    order = np.lexsort((x, s))  # one row per (shape pair, point): its closest pieces
+    s, x, d = s[order], x[order], d[order]
+    rows = np.flatnonzero(np.r_[True, (s[1:] != s[:-1]) | (x[1:] != x[:-1])])
+    s, x, d = s[rows], x[rows], np.minimum.reduceat(d, rows)
+    return _result(cell, pairs, (s, x, d), q, t, sigma, clearance, n_worst, rho, start)
+
+
+def _result(cell, pairs, table, q, t, sigma, clearance, n_worst, rho, start):
+    """The CollisionResult of the evaluated table (mesh pairs refined with FCL)."""
+    s, x, drake = table
+    dist, exact = drake.copy(), np.full(len(x), np.nan)
+    notes = []
+    refine = np.flatnonzero((drake < clearance) & pairs.has_mesh[s])
+    if len(refine) > MAX_EXACT_CHECKS:
+        notes.append(f"{len(refine) - MAX_EXACT_CHECKS} mesh-pair points kept Drake's distance")
+    for k in refine[:MAX_EXACT_CHECKS]:
+        exact[k] = pairs.exact(_at(q, x[k]), s[k])
+        dist[k] = exact[k] if exact[k] > 0 else min(drake[k], 0.0)
+
+    def entry(k: int) -> PairMinimum:
+        a, b = pairs.names[s[k]]
+        e = None if np.isnan(exact[k]) else float(exact[k])
+        return PairMinimum(
+            a, b, pairs.groups[s[k]], float(dist[k]), float(_at(sigma, x[k])),
+            float(_at(t, x[k])), float(x[k]), float(drake[k]), max(0.0, -float(dist[k])), e,
+        )  # fmt: skip
+
+    bounds = np.flatnonzero(np.r_[True, s[1:] != s[:-1], True]) if len(s) else [0]
+    minima, stretches = [], []
+    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+        minima.append(entry(lo + int(np.argmin(dist[lo:hi]))))
+        for a, b in true_runs(dist[lo:hi] < clearance):
+            worst = entry(lo + a + int(np.argmin(dist[lo + a : lo + b])))
+            first, last = entry(lo + a), entry(lo + b - 1)
+            stretches.append(CollisionStretch(
+                worst.a, worst.b, worst.group, first.sample, last.sample,
+                first.sigma_m, last.sigma_m, first.t_s, last.t_s, worst,
+            ))  # fmt: skip
+    minima.sort(key=lambda pair: pair.distance_m)
+    stretches.sort(key=lambda stretch: stretch.sample_start)
+    for pair in minima[:n_worst]:
+        if pair.exact_distance_m is None:
+            index = pairs.names.index((pair.a, pair.b))
+            pair.exact_distance_m = pairs.exact(_at(q, pair.sample), index)
+        e, d = pair.exact_distance_m, pair.drake_distance_m
+        if not (e == 0.0 and d <= 0.0) and abs(e - d) > EXACT_MISMATCH_TOL_M:
+            pair.note = f"Drake {d * 1e3:.2f} mm, exact {e * 1e3:.2f} mm"
+            notes.append(f"{pair.a} vs {pair.b} at σ = {pair.sigma_m:.4f} m: {pair.note}")
+    overlaps = [k for k in np.lexsort((dist, x)) if dist[k] < -TOUCH_TOL_M]
+    first = entry(overlaps[0]) if overlaps else None
+    stretch = next((r for r in stretches if first and (r.a, r.b) == (first.a, first.b)
+                    and r.sample_start <= first.sample <= r.sample_end), None)  # fmt: skip
+    closest = minima[0] if minima else None
+    min_distance = closest.distance_m if closest else np.inf
+    evaluated = np.unique(x)
+    samples = int(np.sum(evaluated == np.floor(evaluated)))
+    stats = {
+        "samples": len(t),
+        "checked_samples": samples,
+        "pruned_samples": len(t) - samples,
+        "substeps": len(evaluated) - samples,
+        "distance_queries": pairs.evaluations,
+        "exact_checks": pairs.exact_checks,
+        "motion_radii_m": rho.tolist(),
+        "elapsed_s": time.perf_counter() - start,
+    }
+    below = np.unique(np.floor(x[dist < clearance]).astype(int)).tolist()
+    return CollisionResult(
+        clearance, bool(min_distance >= clearance), float(min_distance), closest, minima,
+        minima[:n_worst], stretches, below, first, list(cell.allowed_contact),
+        failure_message(first, stretch, closest, clearance), notes, stats,
+    )  # fmt: skip
+
+
+def distance_profile(
+    cell: DrakeCell, q: np.ndarray, t: np.ndarray, n_points: int = PROFILE_POINTS
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Smallest signed distance per pair group over time, for plots.
+
+    Args:
+        cell: the cell with its shapes; q: (N, 6) joint path [rad]; t: (N,) times [s].
+        n_points: how many evenly spaced samples to evaluate.
+
+    Returns:
+        (t_k (K,), {group: (K,) smallest Drake signed distance in that group [m]}).
+    """
+    pairs = _Pairs(cell)
+    index = np.unique(np.linspace(0, len(q) - 1, min(n_points, len(q))).astype(int))
+    profile = {group: np.full(len(index), np.inf) for group in sorted(set(pairs.groups))}
+    for k, i in enumerate(index):
+        pairs.set(q[i])
+        for g in range(len(pairs.ids)):
+            group = profile[pairs.groups[pairs.shape_of[g]]]
+            group[k] = min(group[k], pairs.distance(g))
+    return t[index], profile

@@ -1,0 +1,116 @@
+"""Semantic checks of a cell file that its types alone cannot express.
+
+Every failure is a InputError naming the file and key (one line).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.config.cell import Cell
+from offline_prog.constants import UNIT_SCALE
+from offline_prog.errors import InputError
+
+
+def _error(file, key, reason) -> InputError:
+    return InputError(file, key, reason)
+
+
+def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
+    """Semantic checks the types alone cannot express."""
+    robot_dirs = (
+        sorted(p.name for p in robots_dir.iterdir() if p.is_dir()) if (robots_dir.is_dir()) else []
+    )
+    if cell.robot.model not in robot_dirs:
+        raise _error(
+            file,
+            "robot.model",
+            f"{cell.robot.model!r} is not a robot folder in "
+            f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})",
+        )
+    path, motion = cell.path, cell.motion
+    for key, value in (("path.units", path.units), ("part.mesh_units", cell.part.mesh_units)):
+        if value not in UNIT_SCALE:
+            raise _error(file, key, f"{value!r} is not a unit (use m or mm)")
+    sources = [k for k in ("points", "dxf", "analytic") if getattr(path, k) is not None]
+    if len(sources) != 1:
+        raise _error(
+            file,
+            "path",
+            f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
+        )
+    for key in ("points", "dxf"):
+        value = getattr(path, key)
+        if value is not None and not (file.parent / value).is_file():
+            raise _error(file, f"path.{key}", f"file {file.parent / value} does not exist")
+    if cell.part.mesh is not None and not (file.parent / cell.part.mesh).is_file():
+        raise _error(file, "part.mesh", f"file {file.parent / cell.part.mesh} does not exist")
+    if path.normal_from_mesh and cell.part.mesh is None:
+        raise _error(file, "path.normal_from_mesh", "needs part.mesh")
+    if path.normal is not None and np.linalg.norm(path.normal) < 1e-9:
+        raise _error(file, "path.normal", "is the zero vector")
+    if path.degree < 5:
+        raise _error(file, "path.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
+    for key, value in (
+        ("path.fit_tolerance_mm", path.fit_tolerance_mm),
+        ("motion.speed", motion.speed),
+        ("motion.max_acceleration", motion.max_acceleration),
+        ("motion.max_jerk", motion.max_jerk),
+        ("motion.sample_rate_hz", motion.sample_rate_hz),
+    ):
+        if not value > 0:
+            raise _error(file, key, f"must be > 0, got {value}")
+    if motion.speed_reference not in ("tcp", "flange"):
+        raise _error(
+            file, "motion.speed_reference", f"{motion.speed_reference!r} (use tcp or flange)"
+        )
+    if not 0.0 <= cell.tool.free_rotation_deg <= 180.0:
+        raise _error(file, "tool.free_rotation_deg", "must be within [0, 180]")
+    if cell.tool.symmetry_axis not in ("x", "y", "z"):
+        raise _error(file, "tool.symmetry_axis", f"{cell.tool.symmetry_axis!r} (use x, y or z)")
+    if motion.cusp_smoothing_mm is not None and not motion.cusp_smoothing_mm > 0:
+        raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
+    if not motion.clearance >= 0:
+        raise _error(file, "motion.clearance", f"must be ≥ 0 m, got {motion.clearance}")
+    _check_shapes(file, cell)
+
+
+def _check_shapes(file: Path, cell: Cell) -> None:
+    """Shape names unique, mesh files present, allowed contacts naming known shapes."""
+    owners = [
+        ("part.geometry", cell.part.geometry),
+        ("tool.geometry", cell.tool.geometry),
+        ("obstacles", cell.obstacles),
+    ]
+    names = {cell.part.name} if cell.part.mesh else set()
+    for key, shapes in owners:
+        for i, shape in enumerate(shapes):
+            where = f"{key}[{i}]"
+            if shape.name in names:
+                raise _error(file, f"{where}.name", f"{shape.name!r} is used twice")
+            names.add(shape.name)
+            if shape.shape not in ("box", "cylinder", "sphere", "capsule", "mesh"):
+                raise _error(
+                    file,
+                    f"{where}.shape",
+                    f"{shape.shape!r} (use box, cylinder, sphere, capsule or mesh)",
+                )
+            if shape.mesh_units not in UNIT_SCALE:
+                raise _error(file, f"{where}.mesh_units", f"{shape.mesh_units!r} (use m or mm)")
+            if shape.shape == "mesh" and not (shape.mesh and (file.parent / shape.mesh).is_file()):
+                raise _error(
+                    file, f"{where}.mesh", f"file {file.parent / (shape.mesh or '')} does not exist"
+                )
+    for i, pair in enumerate(cell.allowed_contact):
+        if len(pair) != 2:
+            raise _error(file, f"allowed_contact[{i}]", f"expected [name, name], got {pair}")
+        for name in pair:
+            if name not in names:
+                raise _error(
+                    file,
+                    f"allowed_contact[{i}]",
+                    f"{name!r} is not a shape of the "
+                    f"cell (have: {', '.join(sorted(names)) or 'none'})",
+                )

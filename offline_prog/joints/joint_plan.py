@@ -1,0 +1,261 @@
+"""From the flange trajectory to a joint trajectory q(t) within the robot's limits.
+
+Stages: pick one configuration branch and 2π start for the whole path
+(``path_ik``), get q′(σ), q″(σ) by differencing the exact analytic IK at σ ± h
+on that branch, slow down where the joints need it (``joint_timing``), and
+sample the final trajectory with its joint positions, speeds, accelerations,
+singularity distances and joint steps. Failures are results that say where
+(σ, t) and why.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.arrays import true_runs
+from offline_prog.errors import Failure, PlanFailedError, PlanFailure
+from offline_prog.joints.path_ik import (
+    BranchResult,
+    base_poses,
+    branch_results,
+    choose_branch,
+    singularity_distances,
+)
+from offline_prog.robot.kinematics_opw import wrap_to_pi
+from offline_prog.robot.model import RobotModel
+from offline_prog.timing.joint_timing import JointRates, Retiming, retime
+from offline_prog.timing.time_law import Sin2TimeLaw
+from offline_prog.timing.trajectory import (
+    TimeLawParameter,
+    WorkspaceTrajectory,
+    sample_workspace_trajectory,
+)
+
+# σ grid for branch choice and joint rates [m], and the IK difference step [m].
+GRID_SPACING_M = 5e-4
+DIFF_STEP_M = 1e-4
+# Singularity thresholds: |sin θ5| and |sin elbow| below sin(5°), shoulder 30 mm.
+NEAR_SINGULAR = {
+    "wrist": np.sin(np.deg2rad(5.0)),
+    "elbow": np.sin(np.deg2rad(5.0)),
+    "shoulder": 0.03,
+    "jacobian": 0.01,  # smallest singular value of the flange Jacobian (Drake IK robots)
+}
+
+
+class JointPlanError(PlanFailedError):
+    """The robot cannot follow the path: σ [m], t [s] and why (a PlanFailure)."""
+
+    def __init__(self, sigma: float, t: float, reason: str):
+        super().__init__(PlanFailure(Failure.of(reason), float(sigma), float(t), reason))
+
+
+@dataclasses.dataclass(frozen=True)
+class JointTrajectory:
+    """The joint trajectory on the final samples (rows match ``trajectory``).
+
+    Attributes:
+        trajectory: the retimed workspace trajectory.
+        branch: the chosen solution index; branches: every branch's verdict.
+        q, qd, qdd: (N, 6) joint positions [rad], speeds [rad/s], accelerations [rad/s²].
+        margin_rad: (6,) smallest distance of each joint to its limits [rad].
+        largest_step: (joint index, σ, step [rad]) between neighbouring samples.
+        singularities: per kind, (min distance, σ at it) and the near stretches.
+        retiming: the speed reductions the joints needed.
+    """
+
+    trajectory: WorkspaceTrajectory
+    branch: int
+    branches: list[BranchResult]
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    margin_rad: np.ndarray
+    largest_step: tuple[int, float, float]
+    singularities: dict
+    retiming: Retiming
+
+
+class BranchPath:
+    """q(σ) on one branch, evaluated exactly by the analytic IK of the flange pose."""
+
+    def __init__(self, robot: RobotModel, X_IB, flange, parameter: TimeLawParameter, branch: int):
+        self.robot, self.X_IB, self.flange = robot, X_IB, flange
+        self.parameter, self.branch = parameter, branch
+
+    def poses(self, sigma: np.ndarray) -> np.ndarray:
+        """(N, 4, 4) X_BE at σ."""
+        f = self.flange(self.parameter.s(sigma)[0])
+        return base_poses(self.X_IB, f.p_IE, f.R_IE)
+
+    def q(self, sigma: np.ndarray, q_near: np.ndarray) -> np.ndarray:
+        """(N, 6) the branch's solution at σ, taken as the 2π-equivalent nearest q_near."""
+        raw = self.robot.inverse(self.poses(sigma))[:, self.branch]
+        return q_near + wrap_to_pi(raw - q_near)
+
+    def singularity_distances(self, q: np.ndarray, sigma: np.ndarray) -> dict:
+        """Wrist, elbow and shoulder distances (``path_ik.singularity_distances``)."""
+        return singularity_distances(self.robot, q, self.poses(sigma))
+
+    def rates(self, sigma: np.ndarray, q_near: np.ndarray) -> JointRates:
+        """q, q′, q″ at σ by central differences of the exact IK (error O(h²))."""
+        length = self.parameter.length
+        h = min(DIFF_STEP_M, length / 4)
+        center = np.clip(sigma, h, length - h)
+        q0 = self.q(center, q_near)
+        q_minus, q_plus = self.q(center - h, q0), self.q(center + h, q0)
+        dq = (q_plus - q_minus) / (2 * h)
+        ddq = (q_plus - 2 * q0 + q_minus) / h**2
+        shifted = sigma != center  # only within h of the path's ends
+        q = q0.copy()
+        if shifted.any():
+            q[shifted] = self.q(sigma[shifted], q0[shifted])
+        return JointRates(sigma, q, dq + ddq * (sigma - center)[:, None], ddq)
+
+
+# Step between tried tool rotations [rad] and the σ grid for trying them [points].
+ROTATION_STEP_RAD = np.deg2rad(5.0)
+ROTATION_TRIAL_POINTS = 400
+
+
+def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y"):
+    """Fixed turns φ ∈ [−bound, bound] of a symmetric tool about its axis, best first.
+
+    The process frame is laid onto T·R_axis(φ) instead of T, which a tool
+    symmetric about that axis cannot tell apart. A constant φ keeps the flange
+    path exactly as smooth as with φ = 0. Ranked by the joint-limit margin of each
+    φ's best branch (the smaller |φ| on ties); the collision check may move on to
+    the next.
+
+    Returns:
+        [(φ [rad], the FlangePath built with it), ...], best first.
+    """
+    from pydrake.common.eigen_geometry import AngleAxis
+    from pydrake.math import RigidTransform, RotationMatrix
+
+    from offline_prog.path.fixed_tcp import FlangePath
+
+    unit = np.eye(3)["xyz".index(axis)]
+    count = int(np.ceil(bound_rad / ROTATION_STEP_RAD))
+    angles = np.linspace(-bound_rad, bound_rad, 2 * count + 1) if count else np.zeros(1)
+    s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
+    ranked = []
+    for phi in sorted(angles, key=abs):
+        X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
+        flange = FlangePath(path, normal, X_IT=X_IT_phi, X_PE=X_PE)
+        f = flange(s)
+        result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
+        score = (result.feasible, result.margin_rad if result.feasible else result.sample)
+        ranked.append((score, -abs(phi), float(phi), flange))
+    ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)
+    return [(phi, flange) for _, _, phi, flange in ranked]
+
+
+def _time_at(law: Sin2TimeLaw, sigma: float) -> float:
+    t = np.linspace(0.0, law.duration, 20001)
+    return float(np.interp(sigma, law(t)[0], t))
+
+
+def plan_joint_trajectory(
+    robot: RobotModel,
+    X_IB,
+    flange,
+    parameter: TimeLawParameter,
+    nominal: Sin2TimeLaw,
+    *,
+    rate_hz: float,
+    branch: int | None = None,
+) -> JointTrajectory:
+    """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
+
+    Args:
+        robot: the robot record (analytic IK; Drake IK for family "drake").
+        X_IB: robot base in I.
+        flange: the flange path X_IE(s).
+        parameter: σ ↦ s for the time law's speed reference.
+        nominal: the process time law (before joint limits).
+        rate_hz: output sample rate.
+        branch: use this analytic branch (if feasible) instead of the best one.
+    """
+    length = parameter.length
+    grid = np.linspace(0.0, length, max(2001, int(np.ceil(length / GRID_SPACING_M)) + 1))
+    if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
+        from offline_prog.joints.drake_path import DrakeIkPath
+
+        path = DrakeIkPath(robot, X_IB, flange, parameter)
+        chosen = path.choose(grid)
+        results = [chosen]
+    else:
+        results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
+        chosen = choose_branch(results) if branch is None else results[branch]
+        path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
+    if not chosen.feasible:
+        sigma = float(grid[chosen.sample])
+        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason)
+    rates = path.rates(grid, chosen.q)
+    # Speed and acceleration limits hold for the controller's joints (a linear map).
+    controller = JointRates(
+        rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
+    )
+    retiming = retime(controller, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
+    if not retiming.feasible:
+        joint, sigma, use = retiming.worst
+        raise JointPlanError(
+            sigma,
+            _time_at(retiming.law, sigma),
+            f"joint speed/acceleration limit on axis {joint + 1} "
+            f"({use:.2f}× the limit) even at reduced speed",
+        )
+    trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
+    sigma, sd, sdd, _ = retiming.law(trajectory.t)
+    q_near = np.column_stack([np.interp(sigma, grid, chosen.q[:, j]) for j in range(6)])
+    final = path.rates(sigma, q_near)
+    q = final.q
+    qd = final.dq * sd[:, None]
+    qdd = final.ddq * (sd**2)[:, None] + final.dq * sdd[:, None]
+    q_c = robot.controller_joints(q)
+    margin = np.minimum(q_c.min(axis=0) - robot.q_lower, robot.q_upper - q_c.max(axis=0))
+    if margin.min() < 0:  # the grid missed a limit between its points
+        joint = int(np.argmin(margin))
+        i = int(
+            np.argmax(
+                (q_c[:, joint] < robot.q_lower[joint]) | (q_c[:, joint] > robot.q_upper[joint])
+            )
+        )
+        raise JointPlanError(
+            float(sigma[i]), float(trajectory.t[i]), f"joint limit on axis {joint + 1}"
+        )
+    steps = np.abs(np.diff(q, axis=0))
+    i, j = np.unravel_index(np.argmax(steps), steps.shape)
+    distances = path.singularity_distances(q, sigma)
+    singular = {}
+    for kind, d in distances.items():
+        k = int(np.argmin(d))
+        near = true_runs(d < NEAR_SINGULAR[kind])
+        stretches = [(float(sigma[a]), float(sigma[b - 1])) for a, b in near]
+        # Wrist and elbow distances are |sin| of an angle: report that angle.
+        value, unit = (
+            (float(d[k]), "m" if kind == "shoulder" else "m/rad")
+            if kind in ("shoulder", "jacobian")
+            else (float(np.rad2deg(np.arcsin(min(d[k], 1.0)))), "deg")
+        )
+        singular[kind] = {
+            "distance": value,
+            "unit": unit,
+            "sigma_m": float(sigma[k]),
+            "near": stretches,
+        }
+    return JointTrajectory(
+        trajectory,
+        chosen.branch,
+        results,
+        q,
+        qd,
+        qdd,
+        margin,
+        (int(j), float(sigma[i + 1]), float(steps[i, j])),
+        singular,
+        retiming,
+    )

@@ -1,0 +1,177 @@
+"""Joint path along the flange path: one configuration branch, the best 2π start.
+
+All eight analytic solutions are computed for every sample at once. Each branch
+(the solution index of the OPW / UR closed form: shoulder, elbow and wrist sides)
+is unwrapped along the path; a branch that jumps between neighbouring samples
+passes a singularity (where the closed form swaps sides) and is dropped. For
+joints with more than one turn of range, the multiple of 2π that keeps the whole
+path inside the limits with the largest margin is chosen; a closed contour that
+turns the part once about the tool therefore starts the wrist where it has the
+range for the full turn. The branch with the largest margin wins.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.robot.model import RobotModel
+
+# Largest joint step between neighbouring samples that is still continuous motion
+# [rad]; a bigger step means the closed form swapped sides (a singularity).
+MAX_JOINT_STEP_RAD = np.deg2rad(10.0)
+# Candidate turns k in q + 2πk for joints with more than one turn of range.
+TURN_CANDIDATES = np.arange(-2, 3)
+TWO_PI = 2.0 * np.pi
+
+
+@dataclasses.dataclass(frozen=True)
+class BranchResult:
+    """How one branch fares along the path.
+
+    Attributes:
+        branch: solution index 0..7.
+        q: (N, 6) joint path [rad] with the chosen 2π offsets (NaN if unreachable).
+        feasible: reachable, continuous and inside the joint limits everywhere.
+        margin_rad: smallest distance to a joint limit over the path [rad]
+            (negative: the amount by which a limit is exceeded).
+        reason: why it is infeasible ("" if feasible), with the sample index.
+        sample: index of the first failing sample (−1 if feasible).
+    """
+
+    branch: int
+    q: np.ndarray
+    feasible: bool
+    margin_rad: float
+    reason: str
+    sample: int
+
+
+def base_poses(X_IB, p_IE: np.ndarray, R_IE: np.ndarray) -> np.ndarray:
+    """(N, 4, 4) flange poses X_BE = X_BI · X_IE in the robot base."""
+    R_BI = X_IB.rotation().matrix().T
+    X_BE = np.zeros((len(p_IE), 4, 4))
+    X_BE[:, :3, :3] = R_BI @ R_IE
+    X_BE[:, :3, 3] = (p_IE - X_IB.translation()) @ R_BI.T
+    X_BE[:, 3, 3] = 1.0
+    return X_BE
+
+
+def best_turns(q: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+    """Per-joint offsets 2πk maximizing the limit margin of a joint path.
+
+    Args:
+        q: (B, N, 6) unwrapped joint paths of B branches [rad].
+        lower, upper: (6,) joint limits [rad].
+
+    Returns:
+        offsets: (B, 6) multiples of 2π to add [rad]; margins: (B, 6) the smallest
+        distance of each shifted joint path to its limits [rad].
+    """
+    with np.errstate(invalid="ignore"):  # branches with no solution at all stay NaN
+        q_min = np.nanmin(np.where(np.isnan(q), np.inf, q), axis=1)  # (B, 6)
+        q_max = np.nanmax(np.where(np.isnan(q), -np.inf, q), axis=1)
+    shifts = 2.0 * np.pi * TURN_CANDIDATES  # (K,)
+    margin = np.minimum(
+        q_min[..., None] + shifts - lower[:, None], upper[:, None] - q_max[..., None] - shifts
+    )  # (B, 6, K)
+    best = np.argmax(margin, axis=-1)
+    offsets = shifts[best]
+    return offsets, np.take_along_axis(margin, best[..., None], axis=-1)[..., 0]
+
+
+def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
+    """Evaluate all eight branches along the poses X_BE (N, 4, 4)."""
+    solutions = np.swapaxes(robot.inverse(X_BE), 0, 1)  # (8, N, 6)
+    reachable = ~np.isnan(solutions).any(axis=-1)  # (8, N)
+    filled = np.where(reachable[..., None], solutions, 0.0)
+    # Unwrap along the path: each step taken as its equivalent in [−π, π).
+    step = np.diff(filled, axis=1)
+    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
+    q = np.concatenate([filled[:, :1], filled[:, :1] + np.cumsum(step, axis=1)], axis=1)
+    # Limits apply to the joints as the controller counts them (ABB: axis 3 = q2 + q3).
+    offsets, margins = best_turns(
+        robot.controller_joints(np.where(reachable[..., None], q, np.nan)),
+        robot.q_lower,
+        robot.q_upper,
+    )
+    q = q + offsets[:, None, :]
+    steps = np.abs(step).max(axis=-1)  # (8, N−1)
+    results = []
+    for b in range(8):
+        margin = float(margins[b].min())
+        if not reachable[b].all():
+            first = int(np.argmin(reachable[b]))
+            results.append(
+                BranchResult(b, np.full_like(q[b], np.nan), False, -np.inf, "out of reach", first)
+            )
+            continue
+        jumps = np.flatnonzero(
+            (steps[b] > MAX_JOINT_STEP_RAD) & reachable[b, 1:] & reachable[b, :-1]
+        )
+        if jumps.size:
+            results.append(
+                BranchResult(
+                    b,
+                    q[b],
+                    False,
+                    margin,
+                    "singularity (the configuration flips)",
+                    int(jumps[0]) + 1,
+                )
+            )
+            continue
+        if margin < 0:
+            joint = int(np.argmin(margins[b]))
+            q_c = robot.controller_joints(q[b])
+            outside = (q_c[:, joint] < robot.q_lower[joint]) | (
+                q_c[:, joint] > robot.q_upper[joint]
+            )
+            results.append(
+                BranchResult(
+                    b,
+                    q[b],
+                    False,
+                    margin,
+                    f"joint limit on axis {joint + 1}",
+                    int(np.argmax(outside)),
+                )
+            )
+            continue
+        results.append(BranchResult(b, q[b], True, margin, "", -1))
+    return results
+
+
+def choose_branch(results: list[BranchResult]) -> BranchResult:
+    """The feasible branch with the largest limit margin, else the one that gets
+    furthest along the path (its reason explains the failure)."""
+    feasible = [r for r in results if r.feasible]
+    if feasible:
+        return max(feasible, key=lambda r: r.margin_rad)
+    return max(results, key=lambda r: (r.sample, r.margin_rad))
+
+
+def singularity_distances(robot: RobotModel, q: np.ndarray, X_BE: np.ndarray) -> dict:
+    """Distances to the wrist, elbow and shoulder singularities along a joint path.
+
+    Args:
+        q: (N, 6) joint path [rad]; X_BE: (N, 4, 4) the matching flange poses.
+
+    Returns:
+        {"wrist": (N,) |sin θ5|, "elbow": (N,) |sin| of the elbow stretch angle,
+        "shoulder": (N,) distance of the wrist centre from its singular locus [m]}.
+    """
+    p = robot.params
+    if robot.family == "opw":
+        theta = q * np.asarray(p.sign_corrections) - np.asarray(p.offsets)
+        wrist = np.abs(np.sin(theta[:, 4]))
+        elbow = np.abs(np.sin(theta[:, 2] + np.arctan2(p.a2, p.c3)))
+        p_BC = X_BE[:, :3, 3] - p.c4 * X_BE[:, :3, 2]
+        shoulder = np.abs(np.hypot(p_BC[:, 0], p_BC[:, 1]) - abs(p.b))
+    else:  # UR: wrist q5 ∈ {0, π}, elbow q3 ∈ {0, π}, shoulder |p_05,xy| = d4
+        wrist = np.abs(np.sin(q[:, 4]))
+        elbow = np.abs(np.sin(q[:, 2]))
+        p_05 = X_BE[:, :3, 3] - p.d6 * X_BE[:, :3, 2]
+        shoulder = np.abs(np.hypot(p_05[:, 0], p_05[:, 1]) - p.d4)
+    return {"wrist": wrist, "elbow": elbow, "shoulder": shoulder}

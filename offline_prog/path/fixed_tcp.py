@@ -1,0 +1,151 @@
+"""The robot flange path for a spatially fixed TCP (paper §3.2, eqs. 5–8).
+
+The process frame F at arc length s is brought onto the fixed tool frame T
+(X_TP = X_PF(s)⁻¹), so the flange follows
+
+    X_IE(s) = X_IT · X_PF(s)⁻¹ · X_PE,
+
+i.e. p_IE = p_IT + R_IT R_PFᵀ (p_PE − p_PF) (eqs. 5, 7) and R_IE = R_IT R_PFᵀ R_PE
+(eqs. 6, 8). Derivatives with respect to s are exact (the chain rule through the
+spline and the process frames); w_s is the flange's angular velocity per metre of
+path, expressed in I, so that w_IE_I = w_s · ṡ.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from pydrake.math import RigidTransform
+
+from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.process_frames import NormalField, process_frames
+
+
+def vee(W: np.ndarray) -> np.ndarray:
+    """(N, 3) vector of the skew-symmetric part of (N, 3, 3) matrices."""
+    return 0.5 * np.stack(
+        [W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0], W[:, 1, 0] - W[:, 0, 1]], axis=1
+    )
+
+
+@dataclasses.dataclass(frozen=True)
+class FlangeSamples:
+    """The flange path and its s-derivatives at N arc lengths s.
+
+    Attributes:
+        s: (N,) TCP arc length along the processing path [m].
+        p_PF: (N, 3) process-frame origin (path point) in P [m].
+        R_PF: (N, 3, 3) process frames [t n b] in P.
+        p_IE, dp_IE, ddp_IE: (N, 3) flange position in I and its 1st/2nd
+            s-derivatives [m, 1, 1/m].
+        R_IE: (N, 3, 3) flange orientation in I.
+        w_s, dw_s: (N, 3) angular velocity per unit s in I [rad/m] and its
+            s-derivative [rad/m²].
+    """
+
+    s: np.ndarray
+    p_PF: np.ndarray
+    R_PF: np.ndarray
+    p_IE: np.ndarray
+    dp_IE: np.ndarray
+    ddp_IE: np.ndarray
+    R_IE: np.ndarray
+    w_s: np.ndarray
+    dw_s: np.ndarray
+
+
+class FlangePath:
+    """X_IE(s) for a part carried past the fixed tool.
+
+    Args:
+        path: the processing path r(s) = p_PF in P, by arc length.
+        normal: the surface normal field on the part.
+        X_IT: the fixed TCP frame T in I.
+        X_PE: the flange frame E in the part frame P.
+        tool_turn: optional φ(s) ↦ (φ, φ′, φ″) (N,) each [rad, rad/m, rad/m²]: the
+            process frame is laid onto T·R_axis(φ(s)) (a tool symmetric about axis).
+        axis: (3,) unit axis of T for tool_turn.
+    """
+
+    def __init__(
+        self,
+        path: ArcLengthPath,
+        normal: NormalField,
+        *,
+        X_IT: RigidTransform,
+        X_PE: RigidTransform,
+        tool_turn=None,
+        axis=(0.0, 1.0, 0.0),
+    ):
+        self.path = path
+        self.normal = normal
+        self.X_IT = X_IT
+        self.X_PE = X_PE
+        self.tool_turn = tool_turn
+        self.axis = np.asarray(axis, dtype=float)
+
+    @property
+    def length(self) -> float:
+        """TCP path length [m]."""
+        return self.path.length
+
+    def __call__(self, s: np.ndarray) -> FlangeSamples:
+        s = np.asarray(s, dtype=float)
+        p_PF, dp_PF, ddp_PF = self.path(s, order=2)
+        R_PF, dR_PF, ddR_PF = process_frames(self.path, self.normal, s)
+        R_IT = self.X_IT.rotation().matrix()
+        p_IT = self.X_IT.translation()
+        R_PE = self.X_PE.rotation().matrix()
+        p_PE = self.X_PE.translation()
+
+        # p_IE = p_IT + R_IT R_PFᵀ d, with d = p_PE − p_PF (paper eqs. 5, 7).
+        d = p_PE - p_PF
+        R_TP, dR_TP, ddR_TP = (np.swapaxes(M, 1, 2) for M in (R_PF, dR_PF, ddR_PF))
+        p_TE_T = np.einsum("nij,nj->ni", R_TP, d)
+        dp_TE_T = np.einsum("nij,nj->ni", dR_TP, d) - np.einsum("nij,nj->ni", R_TP, dp_PF)
+        ddp_TE_T = (
+            np.einsum("nij,nj->ni", ddR_TP, d)
+            - 2.0 * np.einsum("nij,nj->ni", dR_TP, dp_PF)
+            - np.einsum("nij,nj->ni", R_TP, ddp_PF)
+        )
+        # G = R_IT · R_axis(φ(s)): the tool frame the process frame is laid onto.
+        G, dG, ddG = self._tool_rotation(s, R_IT)
+        p_IE = p_IT + np.einsum("nij,nj->ni", G, p_TE_T)
+        dp_IE = np.einsum("nij,nj->ni", dG, p_TE_T) + np.einsum("nij,nj->ni", G, dp_TE_T)
+        ddp_IE = (
+            np.einsum("nij,nj->ni", ddG, p_TE_T)
+            + 2.0 * np.einsum("nij,nj->ni", dG, dp_TE_T)
+            + np.einsum("nij,nj->ni", G, ddp_TE_T)
+        )
+
+        # R_IE = R_IT R_TP R_PE (paper eqs. 6, 8) and its derivatives.
+        M, dM, ddM = R_TP @ R_PE, dR_TP @ R_PE, ddR_TP @ R_PE
+        R_IE = G @ M
+        dR_IE = dG @ M + G @ dM
+        ddR_IE = ddG @ M + 2.0 * dG @ dM + G @ ddM
+        # skew(w_s) = R' Rᵀ; its derivative is R'' Rᵀ + R' R'ᵀ.
+        R_EI = np.swapaxes(R_IE, 1, 2)
+        w_s = vee(dR_IE @ R_EI)
+        dw_s = vee(ddR_IE @ R_EI + dR_IE @ np.swapaxes(dR_IE, 1, 2))
+        return FlangeSamples(s, p_PF, R_PF, p_IE, dp_IE, ddp_IE, R_IE, w_s, dw_s)
+
+    def _tool_rotation(self, s: np.ndarray, R_IT: np.ndarray):
+        """(G, G′, G″), each (N, 3, 3): G = R_IT·exp(K φ(s)), K = skew(axis)."""
+        n = len(s)
+        if self.tool_turn is None:
+            G = np.broadcast_to(R_IT, (n, 3, 3))
+            zero = np.zeros((n, 3, 3))
+            return G, zero, zero
+        phi, dphi, ddphi = (np.asarray(v, dtype=float) for v in self.tool_turn(s))
+        a = self.axis
+        K = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+        A = (
+            np.eye(3)
+            + np.sin(phi)[:, None, None] * K
+            + (1.0 - np.cos(phi))[:, None, None] * (K @ K)
+        )  # Rodrigues
+        G = R_IT @ A
+        dG = G @ K * dphi[:, None, None]
+        ddG = G @ (K @ K * (dphi**2)[:, None, None] + K * ddphi[:, None, None])
+        return G, dG, ddG

@@ -1,0 +1,105 @@
+"""Turning a checked cell file into the path's inputs.
+
+The processing-path points from the cell's one source (CSV, DXF or analytic curve),
+and the surface-normal field. Every failure is a InputError naming the file and key.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.config.cell import Cell
+from offline_prog.errors import InputError
+from offline_prog.path import sources as path_sources
+from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.process_frames import constant_normal, mesh_normals, spline_normal
+
+
+def _error(file, key, reason) -> InputError:
+    return InputError(file, key, reason)
+
+
+def _analytic_points(file: Path, cell: Cell) -> path_sources.PathPoints:
+    a, scale = cell.path.analytic, path_sources.UNIT_SCALE[cell.path.units]
+    needs = {
+        "line": ("start", "end"),
+        "arc": ("center", "radius", "start_deg", "end_deg"),
+        "rounded_rectangle": ("center", "size", "corner_radius"),
+    }
+    if a.kind not in needs:
+        raise _error(file, "path.analytic.kind", f"{a.kind!r} (use {', '.join(needs)})")
+    for key in needs[a.kind]:
+        if getattr(a, key) is None:
+            raise _error(file, f"path.analytic.{key}", f"missing (required for {a.kind})")
+    closed = cell.path.closed
+    if a.kind == "line":
+        if closed:
+            raise _error(file, "path.closed", "a line cannot be closed")
+        p = path_sources.line_points(np.multiply(a.start, scale), np.multiply(a.end, scale))
+    elif a.kind == "arc":
+        if closed and not np.isclose(abs(a.end_deg - a.start_deg), 360.0):
+            raise _error(file, "path.closed", "a closed arc must sweep 360°")
+        if a.radius <= 0 or a.start_deg == a.end_deg:
+            raise _error(file, "path.analytic", "an arc needs radius > 0 and start ≠ end")
+        p = path_sources.arc_points(
+            np.multiply(a.center, scale), a.radius * scale, a.start_deg, a.end_deg, closed=closed
+        )
+    else:
+        if not closed:
+            raise _error(file, "path.closed", "a rounded_rectangle is closed: set true")
+        try:
+            p = path_sources.rounded_rectangle_points(
+                np.multiply(a.center, scale), np.multiply(a.size, scale), a.corner_radius * scale
+            )
+        except ValueError as error:
+            raise _error(file, "path.analytic", str(error)) from None
+    return path_sources.clean_points(p, None, closed=closed)
+
+
+def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
+    """The processing-path points in P [m] from the cell's one path source."""
+    path = cell.path
+    if path.analytic is not None:
+        return _analytic_points(file, cell)
+    key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
+    try:
+        if path.points:
+            return path_sources.read_csv_points(
+                file.parent / source, units=path.units, closed=path.closed
+            )
+        return path_sources.read_dxf_points(
+            file.parent / source, layer=path.dxf_layer, closed=path.closed, units=path.units
+        )
+    except ValueError as error:
+        raise _error(file, key, f"{source}: {error}") from None
+
+
+def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
+    """The surface-normal field, from exactly one of: CSV columns, path.normal, part.mesh."""
+    given = [
+        k
+        for k, v in (
+            ("nx,ny,nz columns", points.normals_P is not None),
+            ("path.normal", cell.path.normal is not None),
+            ("path.normal_from_mesh", cell.path.normal_from_mesh),
+        )
+        if v
+    ]
+    if len(given) != 1:
+        raise _error(
+            file,
+            "path.normal",
+            "give the surface normal exactly one way: nx,ny,nz "
+            f"columns, path.normal, or path.normal_from_mesh (got {given or 'none'})",
+        )
+    if cell.path.normal is not None:
+        return constant_normal(np.asarray(cell.path.normal, float))
+    if points.normals_P is not None:
+        return spline_normal(path, points.normals_P)
+    import trimesh
+
+    mesh = trimesh.load(file.parent / cell.part.mesh, force="mesh")
+    mesh.apply_scale(path_sources.UNIT_SCALE[cell.part.mesh_units])
+    return spline_normal(path, mesh_normals(mesh, points.p_PR))

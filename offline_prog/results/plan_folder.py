@@ -1,0 +1,144 @@
+"""The plan folder: trajectory.csv, report.json, collisions, programs, preview, report.html.
+
+Every file is written to a temporary name in the target folder and renamed into
+place, so a crash never leaves a half-written file that looks complete.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.atomic import write_atomic
+from offline_prog.collision.check import write_collisions_json
+from offline_prog.config.cell import transform
+from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
+from offline_prog.export.program import ProgramData
+from offline_prog.plan import Plan
+from offline_prog.results.report import report
+from offline_prog.timing.trajectory import CSV_COLUMNS
+from offline_prog.viz.preview import write_preview_html
+from offline_prog.viz.report_html import write_report_html
+
+
+def csv_columns(n_joints: int) -> list[str]:
+    """CSV_COLUMNS then q1..qN [rad] and qd1..qdN [rad/s] in the URDF's joint order."""
+    return [
+        *CSV_COLUMNS,
+        *(f"q{i + 1}" for i in range(n_joints)),
+        *(f"qd{i + 1}" for i in range(n_joints)),
+    ]
+
+
+def trajectory_csv(plan: Plan) -> str:
+    """CSV text: header csv_columns, one row per sample, SI units (s, m, rad)."""
+    buffer = io.StringIO()
+    joints = plan.joints
+    np.savetxt(
+        buffer,
+        np.hstack([plan.trajectory.table(), joints.q, joints.qd]),
+        delimiter=",",
+        fmt="%.10g",
+        header=",".join(csv_columns(joints.q.shape[1])),
+        comments="",
+    )
+    return buffer.getvalue()
+
+
+def clearance_csv(t: np.ndarray, profile: dict[str, np.ndarray]) -> str:
+    """``t_s,<group>_m,...``: the smallest distance per pair group over time [m]."""
+    buffer = io.StringIO()
+    groups = list(profile)
+    table = np.column_stack(
+        [t, *(np.where(np.isfinite(profile[g]), profile[g], np.nan) for g in groups)]
+    )
+    np.savetxt(
+        buffer,
+        table,
+        delimiter=",",
+        fmt="%.9g",
+        header=",".join(["t_s", *(f"{g}_m" for g in groups)]),
+        comments="",
+    )
+    return buffer.getvalue()
+
+
+def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
+    X = np.zeros((len(p), 4, 4))
+    X[:, :3, :3], X[:, :3, 3], X[:, 3, 3] = R, p, 1.0
+    return X
+
+
+def program_data(plan: Plan, summary: dict) -> ProgramData:
+    """The plan as the program writers need it (poses in the robot base B)."""
+    cell, joints, traj = plan.cell, plan.joints, plan.trajectory
+    X_IB = transform(cell.robot.X_IB)
+    X_BI = X_IB.inverse().GetAsMatrix4()
+    X_BE = X_BI @ _poses(traj.flange.p_IE, traj.flange.R_IE)
+    # The physical tool T, and the part frames that sit on it: X_BE = X_BT X_PF⁻¹ X_EP⁻¹
+    # holds by construction, whatever rotation about a symmetric tool's axis was used.
+    X_BT = X_BI @ transform(cell.tool.X_IT).GetAsMatrix4()
+    X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
+    X_PF = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)
+    return ProgramData(
+        cell_name=cell.name or plan.cell_file.stem,
+        cell_file=str(plan.cell_file),
+        robot=plan.robot.name,
+        tool=cell.tool.name,
+        part=cell.part.name,
+        process_speed_m_s=cell.motion.speed,
+        speed_reference=traj.reference,
+        cycle_time_s=traj.duration,
+        feasible=plan.feasible,
+        failure=plan.failure,
+        joint_names=tuple(plan.robot.joint_names),
+        generated=summary["generated"],
+        t=traj.t,
+        sigma=traj.s,
+        q=joints.q,
+        qd=joints.qd,
+        X_BE=X_BE,
+        X_PF=X_PF,
+        X_BT=X_BT,
+        X_EP=X_EP,
+        tcp_speed=traj.tcp_speed,
+        q_lower=plan.robot.q_lower,
+        q_upper=plan.robot.q_upper,
+        qd_max=plan.robot.qd_max,
+        j23_coupled=plan.robot.j23_coupled,
+        language=plan.robot.language,
+    )
+
+
+def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
+    """Write trajectory.csv and report.json into ``out_dir``.
+
+    Returns:
+        The written files by name, and the report that went into report.json.
+    """
+    out_dir = Path(out_dir)
+    files = {
+        "trajectory": out_dir / "trajectory.csv",
+        "report": out_dir / "report.json",
+        "collisions": out_dir / "collisions.json",
+    }
+    summary = report(plan)
+    write_atomic(files["trajectory"], trajectory_csv(plan))
+    write_collisions_json(plan.collisions, files["collisions"])
+    if plan.clearance_profile is not None:
+        files["clearance"] = out_dir / "clearance.csv"
+        write_atomic(files["clearance"], clearance_csv(*plan.clearance_profile))
+    write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
+    data = program_data(plan, summary)
+    files["plan"] = data.save(out_dir)
+    if data.feasible:  # no program from a failed plan (offline-prog export --force can)
+        for fmt in default_formats(data.language):
+            for file in export(data, fmt, out_dir / PROGRAMS_DIR):
+                files[f"{fmt}:{file.name}"] = file
+    files["preview"] = out_dir / "preview.html"
+    write_preview_html(plan, files["preview"])
+    files["report_html"] = write_report_html(out_dir)  # last: it lists the programs
+    return files, summary

@@ -1,0 +1,173 @@
+"""report.json: what a plan did, measured, in SI units (keys carry the unit).
+
+Path and fit, motion limits and the measured speed errors, the robot's branch,
+margins, singularities and speed reductions, the collision summary, cusps and the
+stage timings.
+"""
+
+from __future__ import annotations
+
+import datetime
+
+import numpy as np
+
+from offline_prog import __version__
+from offline_prog.plan import Plan
+
+
+def speed_checks(plan: Plan) -> dict[str, float]:
+    """Independent checks of the speed that the time law promised.
+
+    ``tcp_speed_max_error_rel``: max |v_Q − σ̇| / v_peak, with v_Q the rigid-body
+    speed of the part point under the TCP (tcp reference; for the flange
+    reference the flange speed |v_IE| is compared instead).
+    ``chord_speed_max_error_rel``: during cruise, max |chord/Δt − v_peak| / v_peak
+    from consecutive sampled positions alone (no derivatives): this checks that
+    σ is the true arc length.
+    """
+    tr = plan.trajectory
+    v_peak = tr.law.v_peak
+    _, v_law, _, _ = tr.law(tr.t)
+    if tr.reference == "tcp":
+        commanded, measured, points = tr.s_dot, tr.tcp_speed, tr.flange.p_PF
+    else:
+        commanded, measured, points = v_law, np.linalg.norm(tr.v_IE, axis=1), tr.flange.p_IE
+    chord = np.linalg.norm(np.diff(points, axis=0), axis=1) / np.diff(tr.t)
+    cruise = (v_law[:-1] >= v_peak * (1 - 1e-12)) & (v_law[1:] >= v_peak * (1 - 1e-12))
+    chord_error = np.abs(chord[cruise] - v_peak).max() / v_peak if cruise.any() else 0.0
+    return {
+        "tcp_speed_max_error_rel": float(np.abs(measured - commanded).max() / v_peak),
+        "chord_speed_max_error_rel": float(chord_error),
+        "cruise_samples": int(cruise.sum()),
+    }
+
+
+def _merged(stretches):
+    """Contiguous (σ_start, σ_end, speed) stretches joined, keeping the lowest speed."""
+    out = []
+    for start, end, speed in stretches:
+        if out and start <= out[-1][1] + 1e-9:
+            out[-1] = (out[-1][0], end, min(out[-1][2], speed))
+        else:
+            out.append((start, end, speed))
+    return out
+
+
+def robot_report(plan: Plan) -> dict:
+    """Branch, joint-limit margins, joint steps, singularities and speed reductions."""
+    robot, joints = plan.robot, plan.joints
+    retiming, top = joints.retiming, plan.cell.motion.speed
+    joint, sigma, step = joints.largest_step
+    use_speed = np.abs(robot.controller_joints(joints.qd)) / robot.qd_max
+    use_accel = np.abs(robot.controller_joints(joints.qdd)) / robot.qdd_max
+    return {
+        "model": robot.name,
+        "joint_names": list(robot.joint_names),
+        "branch": joints.branch,
+        "feasible_branches": [b.branch for b in joints.branches if b.feasible],
+        "tool_rotation_deg": float(np.rad2deg(plan.tool_rotation_rad)),
+        "joint_limit_margin_deg": np.rad2deg(joints.margin_rad).round(3).tolist(),
+        "min_joint_limit_margin_deg": float(np.rad2deg(joints.margin_rad.min())),
+        "largest_joint_step": {
+            "joint": joint + 1,
+            "sigma_m": sigma,
+            "step_deg": float(np.rad2deg(step)),
+        },
+        "max_joint_speed_use": use_speed.max(axis=0).round(4).tolist(),
+        "max_joint_acceleration_use": use_accel.max(axis=0).round(4).tolist(),
+        "singularities": joints.singularities,
+        "speed_reductions": [
+            {
+                "sigma_start_m": a,
+                "sigma_end_m": b,
+                "speed_m_s": v,
+                "reduction_percent": 100.0 * (1.0 - v / top),
+            }
+            for a, b, v in _merged(retiming.reductions)
+        ],
+        "ramp_acceleration_scale": retiming.a_scale,
+        "cycle_time_without_joint_limits_s": plan.nominal_duration_s,
+    }
+
+
+def collision_summary(plan: Plan) -> dict:
+    """report.json's collision keys: min_distance_m, collision_free, the closest pair."""
+    result = plan.collisions
+    closest = result.closest
+    return {
+        "collision_free": result.collision_free,
+        "min_distance_m": result.min_distance_m if np.isfinite(result.min_distance_m) else None,
+        "closest_pair": None
+        if closest is None
+        else {
+            "pair": [closest.a, closest.b],
+            "group": closest.group,
+            "sigma_m": closest.sigma_m,
+            "t_s": closest.t_s,
+            "distance_m": closest.distance_m,
+        },
+        "clearance_m": result.clearance_m,
+        "feasible": plan.feasible,
+        "failure": plan.failure,
+        "collision_avoidance": plan.avoidance,
+    }
+
+
+def report(plan: Plan) -> dict:
+    """The machine-readable plan summary (SI units unless the key says otherwise)."""
+    cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
+    law = tr.law
+    source = next(k for k in ("points", "dxf", "analytic") if getattr(cell.path, k) is not None)
+    smoothing = None
+    if hasattr(plan.flange, "max_deviation_m"):
+        smoothing = {
+            "max_deviation_mm": plan.flange.max_deviation_m * 1e3,
+            "n_control_points": plan.flange.n_control_points,
+        }
+    return {
+        "generator": f"offline_prog {__version__}",
+        "generated": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "cell": str(plan.cell_file),
+        "name": cell.name,
+        "robot": cell.robot.model,
+        "tool": cell.tool.name,
+        "part": cell.part.name,
+        "path": {
+            "source": source,
+            "n_points": int(len(plan.points.p_PR)),
+            "closed": bool(cell.path.closed),
+            "polygon_length_m": fitted.period,
+            "length_m": plan.path.length,
+        },
+        "fit": {
+            "degree": fitted.degree,
+            "n_control_points": fitted.n_control_points,
+            "tolerance_mm": cell.path.fit_tolerance_mm,
+            "max_error_mm": fitted.max_error_m * 1e3,
+            "rms_error_mm": fitted.rms_error_m * 1e3,
+        },
+        "motion": {
+            "speed_reference": tr.reference,
+            "limits": {
+                "speed_m_s": law.v_max,
+                "max_acceleration_m_s2": law.a_max,
+                "max_jerk_m_s3": law.j_max,
+            },
+            "top_speed_m_s": law.v_peak,
+            "top_speed_reduced": law.reduced,
+            "sample_rate_hz": cell.motion.sample_rate_hz,
+        },
+        "trajectory": {
+            "duration_s": tr.duration,
+            "n_samples": int(len(tr.t)),
+            "max_flange_speed_m_s": float(np.linalg.norm(tr.v_IE, axis=1).max()),
+            "max_flange_acceleration_m_s2": float(np.linalg.norm(tr.a_IE, axis=1).max()),
+            "max_angular_speed_rad_s": float(np.linalg.norm(tr.w_IE_I, axis=1).max()),
+            **speed_checks(plan),
+        },
+        "robot_motion": robot_report(plan),
+        **collision_summary(plan),
+        "cusps": [c.__dict__ for c in plan.cusps],
+        "cusp_smoothing": smoothing,
+        "timings_s": plan.timings_s,
+    }

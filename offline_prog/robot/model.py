@@ -1,0 +1,272 @@
+"""Robots as data: one folder per robot with a URDF and a small parameter record.
+
+Layout (``robots/`` at the repository root carries a ``package.xml`` naming the ROS
+package ``offline_prog_robots``)::
+
+    robots/<name>/<name>.urdf   standard URDF: base_link, link_1..link_6, tool0
+    robots/<name>/robot.yaml    family, kinematic parameters, joint limits
+    robots/<name>/README.md     the source of every number
+
+``robot.yaml`` keeps degrees at the edge (``position_deg``, ``velocity_deg_s``,
+``acceleration_deg_s2``, ``offsets_deg``); :func:`load_robot` converts to SI.
+Frames: B robot base (URDF ``base_link``), E flange (URDF ``tool0``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from offline_prog.robot import kinematics_opw, kinematics_ur
+from offline_prog.robot.kinematics_opw import OpwParameters
+from offline_prog.robot.kinematics_ur import UrParameters
+
+ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
+PARAMS_FILE = "robot.yaml"
+_TOP_KEYS = {"vendor", "family", "urdf", "joint_names", "kinematics", "limits", "controller"}
+# Controller program languages a robot record may name (offline_prog.export writes each).
+LANGUAGES = ("krl", "rapid", "urscript")
+_KINEMATIC_KEYS = {
+    "opw": ("a1", "a2", "b", "c1", "c2", "c3", "c4", "offsets_deg", "sign_corrections"),
+    "ur": ("d1", "a2", "a3", "d4", "d5", "d6"),
+    "drake": (),  # no closed form: joint paths come from Drake InverseKinematics
+}
+_LIMIT_KEYS = ("position_deg", "velocity_deg_s", "acceleration_deg_s2")
+
+
+@dataclass(frozen=True, eq=False)
+class RobotModel:
+    """One robot's kinematics and joint limits, in SI units.
+
+    Attributes:
+        name: Folder name under ``robots/``, e.g. ``"kuka_kr16_2"``.
+        family: ``"opw"`` or ``"ur"``: which analytic kinematics applies; ``"drake"``
+            for a robot without a closed form (Drake InverseKinematics only).
+        params: Kinematic parameter record of that family (None for ``"drake"``).
+        joint_names: The six URDF revolute joints, base to flange.
+        q_lower: (6,) lower joint position limits [rad].
+        q_upper: (6,) upper joint position limits [rad].
+        qd_max: (6,) joint speed limits [rad/s].
+        qdd_max: (6,) joint acceleration limits [rad/s^2].
+        urdf_path: Absolute path of the URDF.
+        j23_coupled: the controller counts axis 3 as q2 + q3 (see controller_joints).
+        vendor: the maker, e.g. ``"kuka"`` (robot.yaml ``vendor``).
+        language: the controller's program format (``krl``, ``rapid``, ``urscript``) or
+            None (robot.yaml ``controller.language``).
+    """
+
+    name: str
+    family: str
+    params: OpwParameters | UrParameters | None
+    joint_names: tuple[str, ...]
+    q_lower: np.ndarray
+    q_upper: np.ndarray
+    qd_max: np.ndarray
+    qdd_max: np.ndarray
+    urdf_path: Path
+    j23_coupled: bool = False
+    vendor: str = ""
+    language: str | None = None
+
+    def controller_joints(self, q: np.ndarray) -> np.ndarray:
+        """(..., 6) the joint values the controller counts (and limits) from URDF q.
+
+        Equal to q, except on robots whose controller couples axis 3 to axis 2
+        (``controller: {j23_coupled: true}``, e.g. the ABB IRB 2400: axis 3 = q2 + q3).
+        Linear, so it maps joint speeds and accelerations the same way.
+        """
+        if not self.j23_coupled:
+            return q
+        out = np.array(q, dtype=float, copy=True)
+        out[..., 2] = q[..., 1] + q[..., 2]
+        return out
+
+    def forward(self, q: np.ndarray) -> np.ndarray:
+        """Flange poses X_BE (N, 4, 4) [m] for joint vectors q (N, 6) [rad]."""
+        module = kinematics_opw if self.family == "opw" else kinematics_ur
+        return module.forward(self.params, q)
+
+    def inverse(self, X_BE: np.ndarray) -> np.ndarray:
+        """All eight solutions (N, 8, 6) [rad] for flange poses X_BE (N, 4, 4) [m].
+
+        Rows of NaN mark solutions that do not exist; limits are not applied.
+        """
+        module = kinematics_opw if self.family == "opw" else kinematics_ur
+        return module.inverse(self.params, X_BE)
+
+
+def list_robots(robots_dir: Path | None = None) -> list[str]:
+    """Names of the robot folders (those holding a robot.yaml), sorted."""
+    robots_dir = ROBOTS_DIR if robots_dir is None else Path(robots_dir)
+    return sorted(p.parent.name for p in robots_dir.glob(f"*/{PARAMS_FILE}"))
+
+
+def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
+    """Loads ``<robots_dir>/<name>/robot.yaml`` and checks it.
+
+    Args:
+        name: Robot folder name, e.g. ``"ur10e"``.
+        robots_dir: Folder holding the robot folders; default the repository's
+            ``robots/``.
+
+    Returns:
+        The robot's model in SI units.
+
+    Raises:
+        ValueError: One line naming the file, the key and what was expected, when
+            the folder, the record or the URDF is missing or a value is invalid.
+    """
+    robots_dir = ROBOTS_DIR if robots_dir is None else Path(robots_dir)
+    folder = robots_dir / name
+    if not name or Path(name).name != name or name in (".", "..") or not folder.is_dir():
+        known = ", ".join(list_robots(robots_dir)) or "none"
+        raise ValueError(f"{folder}: no robot folder named {name!r} (known robots: {known})")
+    path = folder / PARAMS_FILE
+    if not path.is_file():
+        raise ValueError(f"{path}: file not found (each robot folder needs a {PARAMS_FILE})")
+    try:
+        record = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as error:
+        raise ValueError(f"{path}: not valid YAML: {' '.join(str(error).split())}") from None
+    check = _Checker(path)
+    family = record.get("family") if isinstance(record, dict) else None
+    optional = {"urdf", "controller", "vendor"} | ({"kinematics"} if family == "drake" else set())
+    check.keys(record, "", required=_TOP_KEYS - optional, allowed=_TOP_KEYS)
+    if family not in _KINEMATIC_KEYS:
+        check.fail("family", family, f"one of {sorted(_KINEMATIC_KEYS)}")
+    urdf_name = record.get("urdf", f"{name}.urdf")
+    if not isinstance(urdf_name, str) or not (folder / urdf_name).is_file():
+        check.fail("urdf", urdf_name, f"the name of a URDF file in {folder}")
+    names = record["joint_names"]
+    if (
+        not isinstance(names, list)
+        or len(names) != 6
+        or not all(isinstance(n, str) and n for n in names)
+        or len(set(names)) != 6
+    ):
+        check.fail("joint_names", names, "6 distinct joint names")
+    limits = record["limits"]
+    check.keys(limits, "limits", required=set(_LIMIT_KEYS), allowed=set(_LIMIT_KEYS))
+    position = check.numbers(limits["position_deg"], "limits.position_deg", shape=(6, 2))
+    if not np.all(position[:, 0] < position[:, 1]):
+        check.fail(
+            "limits.position_deg", limits["position_deg"], "[lower, upper] with lower < upper"
+        )
+    velocity = check.numbers(limits["velocity_deg_s"], "limits.velocity_deg_s", positive=True)
+    acceleration = check.numbers(
+        limits["acceleration_deg_s2"], "limits.acceleration_deg_s2", positive=True
+    )
+    return RobotModel(
+        name=name,
+        family=family,
+        params=None
+        if family == "drake"
+        else _kinematic_params(check, family, record["kinematics"]),
+        joint_names=tuple(names),
+        q_lower=_frozen(np.radians(position[:, 0])),
+        q_upper=_frozen(np.radians(position[:, 1])),
+        qd_max=_frozen(np.radians(velocity)),
+        qdd_max=_frozen(np.radians(acceleration)),
+        urdf_path=(folder / urdf_name).resolve(),
+        j23_coupled=_j23_coupled(check, record.get("controller")),
+        vendor=str(record.get("vendor", "")),
+        language=_language(check, record.get("controller")),
+    )
+
+
+def _j23_coupled(check: _Checker, controller: Any) -> bool:
+    """The ``controller: {j23_coupled: bool}`` record (default False)."""
+    if controller is None:
+        return False
+    check.keys(controller, "controller", required=set(), allowed={"j23_coupled", "language"})
+    value = controller.get("j23_coupled", False)
+    if not isinstance(value, bool):
+        check.fail("controller.j23_coupled", value, "true or false")
+    return value
+
+
+def _language(check: _Checker, controller: Any) -> str | None:
+    """The ``controller: {language: krl | rapid | urscript}`` record (default None)."""
+    if controller is None or controller.get("language") is None:
+        return None
+    if controller["language"] not in LANGUAGES:
+        check.fail("controller.language", controller["language"], f"one of {', '.join(LANGUAGES)}")
+    return controller["language"]
+
+
+def _kinematic_params(
+    check: _Checker, family: str, kinematics: Any
+) -> OpwParameters | UrParameters:
+    """Builds the family's parameter record from the ``kinematics`` mapping."""
+    keys = _KINEMATIC_KEYS[family]
+    check.keys(kinematics, "kinematics", required=set(keys), allowed=set(keys))
+    lengths = {
+        key: float(check.numbers(kinematics[key], f"kinematics.{key}", shape=()))
+        for key in keys
+        if key not in ("offsets_deg", "sign_corrections")
+    }
+    if family == "ur":
+        return UrParameters(**lengths)
+    offsets = check.numbers(kinematics["offsets_deg"], "kinematics.offsets_deg")
+    signs = kinematics["sign_corrections"]
+    if not isinstance(signs, list) or len(signs) != 6 or any(s not in (1, -1) for s in signs):
+        check.fail("kinematics.sign_corrections", signs, "6 entries, each 1 or -1")
+    return OpwParameters(
+        **lengths,
+        offsets=tuple(float(o) for o in np.radians(offsets)),
+        sign_corrections=tuple(int(s) for s in signs),
+    )
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    """Read-only float copy, so a frozen RobotModel stays unchanged."""
+    array = np.array(array, dtype=float)
+    array.flags.writeable = False
+    return array
+
+
+class _Checker:
+    """Validates values read from one record file; failures are one-line ValueErrors."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, key: str, value: Any, expected: str) -> None:
+        raise ValueError(f"{self.path}: key '{key}': expected {expected}, got {value!r}")
+
+    def keys(self, mapping: Any, where: str, *, required: set[str], allowed: set[str]) -> None:
+        if not isinstance(mapping, dict):
+            self.fail(where or "<top level>", mapping, "a mapping")
+        prefix = f"{where}." if where else ""
+        for key in sorted(required - mapping.keys()):
+            raise ValueError(f"{self.path}: key '{prefix}{key}': missing")
+        for key in sorted(mapping.keys() - allowed):
+            raise ValueError(
+                f"{self.path}: key '{prefix}{key}': unknown (allowed: {', '.join(sorted(allowed))})"
+            )
+
+    def numbers(
+        self, value: Any, key: str, *, shape: tuple[int, ...] = (6,), positive: bool = False
+    ) -> np.ndarray:
+        expected = "a number" if shape == () else f"finite numbers of shape {list(shape)}"
+        if positive:
+            expected = expected.replace("finite", "positive finite")
+        try:
+            array = np.array(value, dtype=float)
+            ok = not _has_bool_or_str(value) and array.shape == shape
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
+            self.fail(key, value, expected)
+        return array
+
+
+def _has_bool_or_str(value: Any) -> bool:
+    """True if value (possibly nested lists) holds a bool or a string."""
+    if isinstance(value, list):
+        return any(_has_bool_or_str(v) for v in value)
+    return isinstance(value, (bool, str))

@@ -1,0 +1,228 @@
+"""The stages of :func:`offline_prog.plan.plan_cell`, each a function with typed inputs
+and outputs (the dataclasses below), in the paper's order:
+
+``load_inputs`` (§2) → ``fit_path`` (§2, §4) → ``flange_paths`` (§3, §4) →
+``build_scene`` → ``attempt_motion`` (§4, joints, collisions) → ``avoid``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from pydrake.math import RigidTransform
+
+from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
+from offline_prog.collision.check import check_trajectory
+from offline_prog.config.cell import Cell, load_cell, transform
+from offline_prog.config.checks import check_cell
+from offline_prog.errors import InputError
+from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
+from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
+from offline_prog.path.cusps import Cusp, SmoothedFlangePath, find_cusps
+from offline_prog.path.fixed_tcp import FlangePath
+from offline_prog.path.inputs import load_points, normal_field
+from offline_prog.path.process_frames import NormalTangentError
+from offline_prog.path.sources import PathPoints
+from offline_prog.robot.model import RobotModel, load_robot
+from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
+from offline_prog.scene.shapes import ShapeError
+from offline_prog.timing.time_law import sin2_time_law
+from offline_prog.timing.trajectory import TimeLawParameter
+
+# Grid spacing for the checks of the fitted path [m] and the largest tangent turn
+# between neighbours on it before the path counts as doubling back.
+CHECK_GRID_SPACING_M = 2.5e-4
+MAX_TANGENT_TURN_RAD = np.deg2rad(90.0)
+# Fewest grid points of that check, and of the check that frames exist everywhere
+# (a short path still gets a dense look).
+MIN_CHECK_POINTS = 2001
+
+
+@dataclasses.dataclass
+class Inputs:
+    """Stage ``load``: the checked cell and what it names."""
+
+    file: Path
+    cell: Cell
+    points: PathPoints
+    robot: RobotModel
+    X_IB: RigidTransform  # robot base B in I
+    X_IT: RigidTransform  # fixed tool T in I
+    X_PE: RigidTransform  # flange E in the part P
+
+
+@dataclasses.dataclass
+class FittedPath:
+    """Stage ``fit``: the B-spline, its arc-length path σ ↦ p_PF(σ) and the normals."""
+
+    fitted: FittedSpline
+    path: ArcLengthPath
+    normal: object  # normal field n(σ) in P, see offline_prog.path.process_frames
+
+
+@dataclasses.dataclass
+class FlangePaths:
+    """Stage ``frames``: the flange path for each tool rotation φ [rad], best first."""
+
+    rotations: list[tuple[float, FlangePath]]
+    cusps: list[Cusp]
+
+
+def load_inputs(file: Path, robots_dir: Path) -> Inputs:
+    """Read and check the cell file; load the path points and the robot."""
+    cell = load_cell(file)
+    check_cell(file, cell, robots_dir)
+    points = load_points(file, cell)
+    try:
+        robot = load_robot(cell.robot.model, robots_dir)
+    except ValueError as error:
+        raise InputError(file, "robot.model", str(error)) from None
+    return Inputs(
+        file,
+        cell,
+        points,
+        robot,
+        transform(cell.robot.X_IB),
+        transform(cell.tool.X_IT),
+        transform(cell.part.X_PE),
+    )
+
+
+def _check_turns(file: Path, path: ArcLengthPath) -> None:
+    """Reject paths that stop or double back (a tangent flip makes frames undefined)."""
+    if path.map.min_speed <= 0.0:
+        raise InputError(file, "path", "the fitted curve stops (zero tangent)")
+    n = max(MIN_CHECK_POINTS, int(path.length / CHECK_GRID_SPACING_M))
+    s = np.linspace(0.0, path.length, n)
+    _, t = path(s, order=1)
+    cos_turn = np.einsum("ij,ij->i", t[:-1], t[1:])
+    worst = int(np.argmin(cos_turn))
+    if cos_turn[worst] < np.cos(MAX_TANGENT_TURN_RAD):
+        turn = np.rad2deg(np.arccos(np.clip(cos_turn[worst], -1.0, 1.0)))
+        raise InputError(
+            file,
+            "path",
+            f"the path stops and turns back (tangent turns {turn:.0f}° "
+            f"within {s[1] * 1e3:.2f} mm at σ = {s[worst]:.4f} m); split it or "
+            "check the point order",
+        )
+
+
+def fit_path(inputs: Inputs) -> FittedPath:
+    """B-spline fit of the points (paper §2, eqs. 1–3), true arc length (§4), normals."""
+    file, spec = inputs.file, inputs.cell.path
+    try:
+        fitted = fit_bspline(
+            inputs.points.p_PR,
+            closed=spec.closed,
+            degree=spec.degree,
+            tolerance_m=spec.fit_tolerance_mm * 1e-3,
+            n_control_points=spec.n_control_points,
+        )
+    except ValueError as error:
+        raise InputError(file, "path", str(error)) from None
+    path = ArcLengthPath(fitted)
+    _check_turns(file, path)
+    return FittedPath(fitted, path, normal_field(file, inputs.cell, inputs.points, path))
+
+
+def flange_paths(inputs: Inputs, fit: FittedPath) -> FlangePaths:
+    """Process frames and flange paths X_IE(σ) (paper §3, eqs. 5–8), one per tool
+    rotation about a symmetric tool's axis, best first; cusps of the first (§4)."""
+    cell, file = inputs.cell, inputs.file
+    try:
+        flange = FlangePath(fit.path, fit.normal, X_IT=inputs.X_IT, X_PE=inputs.X_PE)
+        flange(np.linspace(0.0, fit.path.length, MIN_CHECK_POINTS))  # frames everywhere?
+        rotations = [(0.0, flange)]
+        if cell.tool.free_rotation_deg > 0:
+            rotations = tool_rotations(
+                inputs.robot,
+                inputs.X_IB,
+                fit.path,
+                fit.normal,
+                X_IT=inputs.X_IT,
+                X_PE=inputs.X_PE,
+                bound_rad=np.deg2rad(cell.tool.free_rotation_deg),
+                axis=cell.tool.symmetry_axis,
+            )
+        cusps = find_cusps(rotations[0][1])
+    except NormalTangentError as error:
+        raise InputError(file, "path.normal", str(error)) from None
+    if cell.motion.speed_reference == "flange" and any(c.kind == "cusp" for c in cusps):
+        first = next(c for c in cusps if c.kind == "cusp")
+        raise InputError(
+            file,
+            "motion.speed_reference",
+            f"flange: the flange stops at a "
+            f"cusp at σ = {first.sigma_m:.4f} m; use tcp or motion.cusp_smoothing_mm",
+        )
+    return FlangePaths(rotations, cusps)
+
+
+def build_scene(inputs: Inputs) -> DrakeCell:
+    """Robot, part, tool (at the cell's own X_IT) and obstacles in one Drake plant."""
+    try:
+        return build_cell_model(inputs.cell, inputs.file, inputs.robot)
+    except ShapeError as error:
+        raise InputError(inputs.file, error.key, error.reason) from None
+
+
+def attempt_motion(
+    inputs: Inputs, scene: DrakeCell, rotation: float, flange, branch: int | None = None
+) -> Attempt:
+    """One joint plan for one flange path: time law (§4), path IK on a branch, joint
+    retiming, and the collision check of every sample and step.
+
+    Raises:
+        PlanFailedError: the robot cannot follow the path (σ, t and why).
+    """
+    motion = inputs.cell.motion
+    if motion.cusp_smoothing_mm is not None:
+        try:
+            flange = SmoothedFlangePath(flange, motion.cusp_smoothing_mm * 1e-3)
+        except ValueError as error:
+            raise InputError(inputs.file, "motion.cusp_smoothing_mm", str(error)) from None
+    parameter = TimeLawParameter(flange, motion.speed_reference)
+    nominal = sin2_time_law(
+        parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+    )
+    joints = plan_joint_trajectory(
+        inputs.robot,
+        inputs.X_IB,
+        flange,
+        parameter,
+        nominal,
+        rate_hz=motion.sample_rate_hz,
+        branch=branch,
+    )
+    traj = joints.trajectory
+    collisions = check_trajectory(scene, joints.q, traj.t, traj.sigma, clearance=motion.clearance)
+    return Attempt(rotation, flange, nominal, joints, collisions)
+
+
+def avoid(
+    inputs: Inputs,
+    fit: FittedPath,
+    flanges: FlangePaths,
+    scene: DrakeCell,
+    first: Attempt,
+    progress: Callable[[str], None],
+) -> tuple[Attempt, dict | None]:
+    """Collision avoidance where the first plan collides: other branches and tool
+    rotations, then a tool turned along the path by Drake IK with a minimum distance."""
+    if first.collisions.collision_free:
+        return first, None
+
+    def attempt(rotation, flange, branch=None):
+        return attempt_motion(inputs, scene, rotation, flange, branch)
+
+    progress("collision avoidance: other tool rotations and branches")
+    chosen, record = avoid_collisions(first, flanges.rotations, attempt)
+    if not chosen.collisions.collision_free and inputs.cell.tool.free_rotation_deg > 0:
+        progress("collision avoidance: Drake IK with a minimum-distance constraint")
+        chosen = turn_tool_along_path(chosen, record, attempt, scene, fit.path, fit.normal, inputs)
+    return chosen, record
