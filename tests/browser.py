@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-WINDOW = (1400, 4000)  # CSS px; with the default device scale, screenshot px = CSS px
+WINDOW = (1400, 5600)  # CSS px; with the default device scale, screenshot px = CSS px
 TIMEOUT_S = 120
 _FLAGS = [
     "--headless",
@@ -97,6 +97,10 @@ window.addEventListener("load", () => {
     images: [...document.images].map(i => ({...box(i), complete: i.complete,
       natural: [i.naturalWidth, i.naturalHeight], alt: i.alt})),
     tables: [...document.querySelectorAll("table")].map(box),
+    plots: [...document.querySelectorAll("div.plot")].map(e => ({...box(e), id: e.id,
+      panels: e.querySelectorAll(".uplot").length})),
+    canvases: [...document.querySelectorAll("canvas")].map(box),
+    svgs: [...document.querySelectorAll("svg.view")].map(box),
   };
   const pre = document.createElement("pre");
   pre.id = "layout"; pre.textContent = JSON.stringify(out);

@@ -60,5 +60,5 @@ def write_joint_csv(data: ProgramData, out_dir: Path, name: str = "joint_traject
 
 def write_ros_json(data: ProgramData, out_dir: Path, name: str = "joint_trajectory") -> Path:
     file = Path(out_dir) / f"{name}.json"
-    write_atomic(file, json.dumps(ros_json(data), indent=1) + "\n")
+    write_atomic(file, json.dumps(ros_json(data), separators=(",", ":")) + "\n")
     return file

@@ -1,0 +1,150 @@
+"""The MeshCat preview: a standalone preview.html that shows the robot and part in a
+real browser (software WebGL), an animation as long as the plan, and the preview
+command; plus a plan that fails its collision check."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from offline_prog.plan import plan_cell
+from offline_prog.viz.preview import show_plan
+
+from browser import WEBGL_ARGS, keep_artifact, require_chromium, screenshot
+from conftest import CELLS, REPO
+
+
+@pytest.fixture(scope="module")
+def seal(planned_folder):
+    return planned_folder("seal_plate_kr16")
+
+
+def test_animation_has_the_plan_duration(seal):
+    from pydrake.geometry import Meshcat
+
+    plan, _ = seal
+    info = show_plan(plan, Meshcat())
+    # Frames 0 .. floor(T · fps): one per 1/fps of the plan, the last at its end.
+    expected = int(np.floor(plan.trajectory.duration * info["frames_per_second"])) + 1
+    assert info["frames"] == expected
+
+
+def test_preview_html_needs_no_server(seal, tmp_path, monkeypatch):
+    """preview.html is written from the plan alone: no MeshCat server is started, the
+    page opens no connection, and its animation is as long as the plan."""
+    import offline_prog.viz.preview as preview
+
+    def no_server(*args, **kwargs):
+        raise AssertionError("a MeshCat server was started to write a file")
+
+    monkeypatch.setattr(preview, "Meshcat", no_server)
+    monkeypatch.setattr("pydrake.geometry.Meshcat", no_server)
+    plan, _ = seal
+    info = preview.write_preview_html(plan, tmp_path / "preview.html")
+    text = (tmp_path / "preview.html").read_text()
+    assert "make_connection(" not in text and "handle_command_bytearray(_b(" in text
+    expected = int(np.floor(plan.trajectory.duration * info["frames_per_second"])) + 1
+    assert info["frames"] == expected
+
+
+@pytest.mark.slow
+def test_preview_html_shows_the_cell_in_a_browser(seal, tmp_path):
+    require_chromium()
+    _, out = seal
+    page = out / "preview.html"
+    text = page.read_text()
+    assert "<script" in text and len(text) > 100_000  # MeshCat's viewer is inlined
+    png = screenshot(page, tmp_path / "preview.png", size=(1200, 800), extra=WEBGL_ARGS)
+    keep_artifact(png, "preview_seal_plate_kr16.png")
+    image = np.asarray(Image.open(png).convert("RGB")).astype(float)
+    assert image.std() > 20, "the 3D view is blank"
+    red, green, blue = image[..., 0], image[..., 1], image[..., 2]
+    orange = (red > 180) & (green > 60) & (green < 190) & (blue < 90)  # robot and plate
+    assert orange.mean() > 0.01, "no robot or part in view"
+    h, w = orange.shape
+    centre = orange[h // 4 : 3 * h // 4, w // 4 : 3 * w // 4]
+    assert centre.mean() > orange.mean(), "the camera is not framed on the cell"
+
+
+@pytest.mark.slow
+def test_preview_command_serves_and_exits(tmp_path):
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "preview",
+            str(CELLS / "tape_cylinder_ur10e.yaml"),
+            "--port",
+            "7077",
+            "--seconds",
+            "0",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "MeshCat preview at http://localhost:7077" in done.stdout
+
+
+@pytest.mark.slow
+def test_a_colliding_plan_writes_its_reports_but_no_program(tmp_path):
+    cell = (CELLS / "seal_plate_kr16.yaml").read_text()
+    # A block in the plate's plane, beside the nozzle: the plate sweeps through it.
+    blocked = cell.replace(
+        "obstacles:   # in I",
+        "obstacles:   # in I\n"
+        "  - {name: intruder, shape: box, size_mm: [20, 20, 20], "
+        "pose: {translation: [1.05, 0.05, 0.5025]}}",
+    )
+    assert blocked != cell
+    file = tmp_path / "blocked.yaml"
+    file.write_text(blocked)
+    out = tmp_path / "out"
+    done = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(file), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=300,
+    )
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "collision: plate vs intruder" in lines[0], lines
+    report = json.loads((out / "report.json").read_text())
+    assert report["collision_free"] is False and report["feasible"] is False
+    assert (out / "collisions.json").is_file() and (out / "preview.html").is_file()
+    assert not (out / "programs").exists()
+
+
+@pytest.mark.slow
+def test_collision_avoidance_is_tried_and_reported(tmp_path):
+    """A cable duct touching the forearm: the planner re-plans with the other branches
+    and tool rotations (the process pose is held in all), keeps the one with the
+    most clearance, and the report says which samples needed it and what changed."""
+    cell = (CELLS / "weld_seam_irb2400.yaml").read_text().replace(": data/", f": {CELLS}/data/")
+    file = tmp_path / "duct.yaml"
+    file.write_text(
+        cell.replace(
+            "obstacles:   # in I",
+            "obstacles:   # in I\n"
+            "  - {name: cable_duct, shape: sphere, radius_mm: 40, "
+            "pose: {translation: [0.695, 0.05, 1.21]}}",
+        )
+    )
+    plan = plan_cell(file)
+    record = plan.avoidance
+    assert record is not None and record["attempts"] >= 1
+    assert record["first_failure"].startswith("collision: link_4 vs cable_duct")
+    assert record["samples_that_needed_it"] and record["sigma_m_that_needed_it"][0] >= 0
+    first_depth = float(record["first_failure"].split("depth ")[1].split(" mm")[0]) * 1e-3
+    assert plan.collisions.min_distance_m >= -first_depth - 1e-9  # never worse
+    # No branch or fixed rotation clears the duct: the plan is reported as failed, and
+    # the record says so (the resolved case: tests/collision/test_avoidance.py).
+    assert record["resolved"] is False and not plan.feasible
+    assert plan.failure.startswith("collision:")
