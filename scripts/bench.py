@@ -21,19 +21,21 @@ from __future__ import annotations
 
 import argparse
 import functools
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
-from offline_prog import kinematics_opw
-from offline_prog.cell import transform
-from offline_prog.collision import check_trajectory
-from offline_prog.drake_cell import build_cell_model, build_drake_cell
-from offline_prog.drake_ik import solve_path, solve_pose
-from offline_prog.path_ik import base_poses, branch_results, choose_branch
+from offline_prog.collision.check import check_trajectory
+from offline_prog.config.cell import transform
+from offline_prog.joints.drake_ik import solve_path, solve_pose
+from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch
 from offline_prog.plan import plan_cell
+from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # py_opw_reference
 
 CELLS = Path(__file__).resolve().parents[1] / "cells"
 
@@ -69,6 +71,73 @@ def bench_stages(cells: list[Path]) -> None:
         )
 
 
+def bench_command(cell: Path, runs: int = 5) -> None:
+    """The whole ``offline-prog plan`` command as a user runs it (a fresh process each
+    time, all outputs written), median of ``runs``; then each part's share, measured
+    in this process: imports (a fresh interpreter), the plan stages, every output."""
+    import statistics
+    import subprocess
+    import tempfile
+
+    print(f"== whole command: offline-prog plan {cell.name} (median of {runs}) ==")
+    walls = []
+    with tempfile.TemporaryDirectory() as out:
+        for _ in range(runs):
+            start = time.perf_counter()
+            subprocess.run(
+                [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", out],
+                check=True,
+                capture_output=True,
+            )
+            walls.append(time.perf_counter() - start)
+        code = (
+            "import time; t = time.perf_counter(); import offline_prog.cli, offline_prog.plan, "
+            "offline_prog.results.plan_folder; print(time.perf_counter() - t)"
+        )
+        imports = statistics.median(
+            float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                                 text=True).stdout)
+            for _ in range(3)
+        )  # fmt: skip
+        parts = {"interpreter + imports": imports}
+        plan = plan_cell(cell)
+        parts.update({f"plan: {k}": v for k, v in plan.timings_s.items()})
+        parts.update({f"write: {k}": v for k, v in _output_times(plan, Path(out)).items()})
+    wall = statistics.median(walls)
+    print(f"wall {wall:.2f} s (runs: {', '.join(f'{w:.2f}' for w in walls)})")
+    for name, seconds in parts.items():
+        print(f"  {name:28s} {seconds * 1e3:7.0f} ms  {100 * seconds / wall:5.1f} %")
+    rest = wall - sum(parts.values())
+    print(f"  {'(process start, CLI, rest)':28s} {rest * 1e3:7.0f} ms  {100 * rest / wall:5.1f} %")
+
+
+def _output_times(plan, out: Path) -> dict[str, float]:
+    """Seconds per output of ``write_outputs``, each written on its own."""
+    from offline_prog.export.formats import default_formats, export
+    from offline_prog.results import plan_folder
+    from offline_prog.results.report import report
+    from offline_prog.viz.preview import write_preview_html
+    from offline_prog.viz.report_html import write_report_html
+
+    times = {}
+
+    def timed(name, function):
+        start = time.perf_counter()
+        result = function()
+        times[name] = time.perf_counter() - start
+        return result
+
+    summary = timed("report.json", lambda: report(plan))
+    timed("trajectory.csv", lambda: plan_folder.trajectory_csv(plan))
+    data = plan_folder.program_data(plan, summary)
+    timed("plan.npz", lambda: data.save(out))
+    for fmt in default_formats(data.language):
+        timed(f"program {fmt}", lambda fmt=fmt: export(data, fmt, out / "programs"))
+    timed("preview.html", lambda: write_preview_html(plan, out / "preview.html"))
+    timed("report.html", lambda: write_report_html(out))
+    return times
+
+
 def bench_collision(cells: list[Path]) -> None:
     print("\n== collision check along the planned path (full cell geometry) ==")
     for file in cells:
@@ -89,7 +158,9 @@ def bench_collision(cells: list[Path]) -> None:
 def py_opw_robot(robot):
     """py-opw-kinematics for an OPW robot, or None when it is not installed."""
     try:
-        return kinematics_opw.py_opw_robot(robot.params)
+        from py_opw_reference import py_opw_robot as reference
+
+        return reference(robot.params)
     except ImportError:
         return None
 
@@ -159,8 +230,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=5000)
     parser.add_argument("--drake-samples", type=int, default=300)
+    parser.add_argument("--only", choices=["command"], help="run one part of the benchmark")
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
+    bench_command(CELLS / "seal_plate_kr16.yaml")
+    if args.only == "command":
+        return
     bench_stages(cells)
     bench_collision(cells)
     for file in cells:
