@@ -48,6 +48,16 @@ def _parser() -> argparse.ArgumentParser:
         default=None,
         help="keep the server this long (default: until Ctrl-C)",
     )
+    robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
+    robot_commands = robots.add_subparsers(dest="robots_command", required=True)
+    robot_commands.add_parser("list", help="the robots in offline_prog/robots")
+    matrix = robot_commands.add_parser(
+        "self-collision",
+        help="sample configurations and write robots/<robot>/self_collision.yaml",
+    )
+    matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
+    matrix.add_argument("--samples", type=int, default=10_000, help="configurations (10000)")
+    matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
@@ -108,6 +118,30 @@ def _export_options(args) -> dict:
     return options
 
 
+def _run_robots(args, console: Console) -> None:
+    """``robots list`` and ``robots self-collision ROBOT``."""
+    from offline_prog.errors import InputError
+    from offline_prog.robot.model import ROBOTS_DIR, list_robots, load_robot
+
+    if args.robots_command == "list":
+        for name in list_robots():
+            console.print(name)
+        return
+    from offline_prog.scene.self_collision import write_matrix
+
+    if args.samples < 1:
+        raise InputError("--samples", "", f"must be at least 1, got {args.samples}")
+    try:
+        robot = load_robot(args.robot)
+    except ValueError as error:
+        raise InputError(ROBOTS_DIR, "", str(error)) from None
+    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed)
+    for kind in ("adjacent", "always", "constant", "never", "check"):
+        names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
+        console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
+    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
+
+
 def _run_export(args, console: Console) -> None:
     from offline_prog.export.formats import export
     from offline_prog.export.program import ProgramData
@@ -118,64 +152,6 @@ def _run_export(args, console: Console) -> None:
     for file in files:
         console.print(f"  {args.format:<9} {file}")
     console.print(f"exported {len(files)} file(s) from {args.plan_dir}")
-
-
-def _summary(console: Console, report: dict, files: dict, seconds: float) -> None:
-    fit, motion, traj = report["fit"], report["motion"], report["trajectory"]
-    console.print(
-        f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
-        f"tool {report['tool']}, part {report['part']}"
-    )
-    console.print(
-        f"  path      {report['path']['length_m'] * 1e3:.1f} mm "
-        f"({report['path']['source']}, {'closed' if report['path']['closed'] else 'open'})"
-        f", fit degree {fit['degree']} with {fit['n_control_points']} control points, "
-        f"max error {fit['max_error_mm']:.4f} mm, RMS {fit['rms_error_mm']:.4f} mm"
-    )
-    reduced = " (reduced: short path)" if motion["top_speed_reduced"] else ""
-    console.print(
-        f"  motion    {motion['top_speed_m_s'] * 1e3:.1f} mm/s at the "
-        f"{motion['speed_reference']}{reduced}, cycle {traj['duration_s']:.3f} s, "
-        f"{traj['n_samples']} samples, speed error "
-        f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
-    )
-    robot = report["robot_motion"]
-    reductions = robot["speed_reductions"]
-    console.print(
-        f"  robot     branch {robot['branch']}, min joint-limit margin "
-        f"{robot['min_joint_limit_margin_deg']:.1f}°, largest joint step "
-        f"{robot['largest_joint_step']['step_deg']:.3f}°, "
-        + (
-            f"speed lowered on {len(reductions)} stretch(es), down to "
-            f"{min(r['speed_m_s'] for r in reductions) * 1e3:.1f} mm/s"
-            if reductions
-            else "process speed held everywhere"
-        )
-    )
-    distance = report["min_distance_m"]
-    closest = report["closest_pair"]
-    console.print(
-        "  clearance "
-        + (
-            "no checked pairs"
-            if distance is None
-            else f"min distance {distance * 1e3:.1f} mm ({' vs '.join(closest['pair'])} at "
-            f"σ={closest['sigma_m']:.3f} m), "
-            + ("collision-free" if report["collision_free"] else "FAILS")
-        )
-    )
-    cusps = report["cusps"]
-    console.print(
-        f"  cusps     {len(cusps)}"
-        + (
-            "  " + ", ".join(f"{c['kind']} at σ={c['sigma_m']:.3f} m" for c in cusps[:5])
-            if cusps
-            else ""
-        )
-    )
-    for name, path in files.items():
-        console.print(f"  {name:<9} {path}")
-    console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
 
 
 def _serve_preview(plan, args, console: Console) -> None:
@@ -233,6 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         from offline_prog.plan import plan_cell
         from offline_prog.results.plan_folder import write_outputs
+        from offline_prog.results.summary import print_summary
 
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
@@ -240,6 +217,9 @@ def main(argv: list[str] | None = None) -> int:
 
         if args.command == "export":
             _run_export(args, console)
+            return 0
+        if args.command == "robots":
+            _run_robots(args, console)
             return 0
         if args.command == "preview":
             args.preview, args.out = True, None
@@ -250,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "plan":
                 files, report = write_outputs(plan, out)
         if args.command == "plan":
-            _summary(console, report, files, time.perf_counter() - started)
+            print_summary(console, report, files, time.perf_counter() - started)
         if args.preview:
             _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs

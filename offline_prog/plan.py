@@ -26,7 +26,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from offline_prog.collision.check import CollisionResult, distance_profile
+from offline_prog.collision.check import CollisionResult
+from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell
 from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.arc_length import ArcLengthPath

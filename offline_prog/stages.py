@@ -200,7 +200,14 @@ def attempt_motion(
         branch=branch,
     )
     traj = joints.trajectory
-    collisions = check_trajectory(scene, joints.q, traj.t, traj.sigma, clearance=motion.clearance)
+    collisions = check_trajectory(
+        scene,
+        joints.q,
+        traj.t,
+        traj.sigma,
+        clearance=motion.clearance,
+        self_clearance=motion.self_clearance,
+    )
     return Attempt(rotation, flange, nominal, joints, collisions)
 
 

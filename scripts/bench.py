@@ -139,20 +139,33 @@ def _output_times(plan, out: Path) -> dict[str, float]:
 
 
 def bench_collision(cells: list[Path]) -> None:
+    """Collision checking of each demo plan with the vendor meshes (what plans use) and
+    with the primitive stand-ins (<robot>_primitives.urdf), same path, same process."""
+    import dataclasses
+
     print("\n== collision check along the planned path (full cell geometry) ==")
     for file in cells:
         plan = plan_cell(file)
-        drake = build_cell_model(plan.cell, file, plan.robot)
-        traj, q = plan.trajectory, plan.joints.q
-        check = functools.partial(
-            check_trajectory, drake, q, traj.t, traj.sigma, clearance=plan.cell.motion.clearance
-        )
-        seconds, result = best_of(3, check)
-        print(
-            f"{file.stem:24s} {len(q):6d} samples  {seconds * 1e3:7.1f} ms  "
-            f"{len(q) / seconds:10.0f} samples/s  min distance "
-            f"{result.min_distance_m * 1e3:.1f} mm"
-        )
+        traj, q, motion = plan.trajectory, plan.joints.q, plan.cell.motion
+        rates = {}
+        stand_in = plan.robot.urdf_path.with_name(f"{plan.robot.name}_primitives.urdf")
+        for model, robot in (
+            ("meshes", plan.robot),
+            ("stand-ins", dataclasses.replace(plan.robot, urdf_path=stand_in)),
+        ):
+            drake = build_cell_model(plan.cell, file, robot)
+            check = functools.partial(
+                check_trajectory, drake, q, traj.t, traj.sigma, clearance=motion.clearance,
+                self_clearance=motion.self_clearance,
+            )  # fmt: skip
+            seconds, result = best_of(3, check)
+            rates[model] = len(q) / seconds
+            print(
+                f"{file.stem:24s} {model:9s} {len(q):6d} samples  {seconds * 1e3:7.1f} ms  "
+                f"{rates[model]:10.0f} samples/s  min distance "
+                f"{result.min_distance_m * 1e3:.1f} mm"
+            )
+        print(f"{'':24s} meshes / stand-ins: {rates['meshes'] / rates['stand-ins']:.2f}×")
 
 
 def py_opw_robot(robot):
@@ -230,9 +243,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=5000)
     parser.add_argument("--drake-samples", type=int, default=300)
-    parser.add_argument("--only", choices=["command"], help="run one part of the benchmark")
+    parser.add_argument(
+        "--only", choices=["command", "collision"], help="run one part of the benchmark"
+    )
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
+    if args.only == "collision":
+        bench_collision(cells)
+        return
     bench_command(CELLS / "seal_plate_kr16.yaml")
     if args.only == "command":
         return

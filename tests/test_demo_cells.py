@@ -149,3 +149,15 @@ def test_joint_columns_drive_the_flange_along_the_planned_poses(planned):
     fd = (q[2:] - q[:-2]) / (t[2:] - t[:-2])[:, None]
     assert np.abs(fd - qd[1:-1]).max() <= 1e-3 * max(np.abs(qd).max(), 1e-3)
     assert report["robot_motion"]["min_joint_limit_margin_deg"] > 0
+
+
+def test_demo_cells_plan_clear_at_the_default_clearances_with_vendor_meshes(planned):
+    """Every demo cell keeps 5 mm to everything and 5 mm between the robot's links (the
+    pairs its self-collision matrix marks "check"); the skipped pairs are listed."""
+    file, _, _, report = planned
+    assert "clearance" not in file.read_text().split("motion:")[1].split("obstacles:")[0]
+    assert report["clearance_m"] == 0.005 and report["self_clearance_m"] == 0.005
+    assert report["collision_free"] and report["min_distance_m"] >= 0.005
+    skipped = report["self_collision_pairs_skipped"]
+    assert skipped and all(p["class"] != "check" and p["reason"] for p in skipped)
+    assert {p["class"] for p in skipped} <= {"adjacent", "always", "constant", "never"}

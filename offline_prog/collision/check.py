@@ -42,7 +42,6 @@ from offline_prog.scene.exact_distance import exact_distance, exact_shape, exact
 # A pair certified above clearance + this is not evaluated (its minimum is then over
 # the evaluated points only).
 PRUNE_MARGIN_M = 0.02
-PROFILE_POINTS = 400  # samples of the distance-over-time profile (report plot)
 # Drake (convex pieces) and FCL (original shapes) distances further apart are noted.
 EXACT_MISMATCH_TOL_M = 5e-4
 N_WORST_PAIRS = 5
@@ -76,6 +75,9 @@ class _Pairs:
             shape_of.append(self.names.index((a.name, b.name)))
             c.append(1.0 if a.body in fixed or b.body in fixed else 2.0)
         self.shape_of, self.c = np.array(shape_of, dtype=int), np.array(c)
+        robot = {label.name for label in cell.labels.values() if label.owner == "robot"}
+        # Robot link vs robot link: held to the self-clearance, per shape pair s.
+        self.is_self = np.array([a in robot and b in robot for a, b in self.names], dtype=bool)
         owner = {label.name: label.owner for label in cell.labels.values()}
         self.groups = [
             "robot-self" if owner[a] == owner[b] else f"{owner[a]}-{owner[b]}"
@@ -129,6 +131,7 @@ def check_trajectory(
     sigma: np.ndarray,
     *,
     clearance: float,
+    self_clearance: float | None = None,
     margin: float = PRUNE_MARGIN_M,
     n_worst: int = N_WORST_PAIRS,
 ) -> CollisionResult:
@@ -140,6 +143,7 @@ def check_trajectory(
         t: (N,) sample times [s].
         sigma: (N,) path parameter σ at the samples [m].
         clearance: smallest allowed signed distance of any checked pair [m].
+        self_clearance: the same for robot link vs robot link pairs (default: clearance).
         margin: pruning margin [m] (see PRUNE_MARGIN_M).
         n_worst: how many closest pairs get FCL's exact distance as a cross-check.
 
@@ -152,19 +156,23 @@ def check_trajectory(
         raise ValueError(f"q: expected (N, 6) finite joint positions, got shape {q.shape}")
     if t.shape != (n,) or sigma.shape != (n,):
         raise ValueError(f"t, sigma: expected shape ({n},), got {t.shape} and {sigma.shape}")
-    if not (np.isfinite(clearance) and clearance >= 0):
-        raise ValueError(f"clearance: expected a distance >= 0 m, got {clearance!r}")
+    self_clearance = clearance if self_clearance is None else self_clearance
+    for name, value in (("clearance", clearance), ("self_clearance", self_clearance)):
+        if not (np.isfinite(value) and value >= 0):
+            raise ValueError(f"{name}: expected a distance >= 0 m, got {value!r}")
     start = time.perf_counter()
     pairs, rho = _Pairs(cell), cell.motion_radii()
+    clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
+    clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]
     step = np.abs(np.diff(q, axis=0)) @ rho  # (N - 1,) motion bound of each step [m]
     cumulative = np.concatenate([[0.0], np.cumsum(step)])
     # (geometry pairs g, points x, Drake distances) of each evaluation.
     found: list[tuple] = [(np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
 
     def bisect(g: int, xa: float, da: float, xb: float, db: float, motion: float) -> None:
-        if (da + db - pairs.c[g] * motion) / 2 >= clearance or min(da, db) < -TOUCH_TOL_M:
+        if (da + db - pairs.c[g] * motion) / 2 >= clear_g[g] or min(da, db) < -TOUCH_TOL_M:
             return  # certified, or an overlap already found at an end
-        if motion <= max(clearance, MIN_SUBSTEP_M):
+        if motion <= max(clear_g[g], MIN_SUBSTEP_M):
             return
         xm = (xa + xb) / 2
         pairs.set(_at(q, xm))
@@ -181,11 +189,11 @@ def check_trajectory(
         pairs.set(q[i])
         d = np.array([pairs.distance(g) for g in now], dtype=float)
         found.append((now, np.full(len(now), float(i)), d))
-        budget = (d - clearance - margin) / pairs.c[now]
+        budget = (d - clear_g[now] - margin) / pairs.c[now]
         reach = np.searchsorted(cumulative, cumulative[i] + budget, side="right") - 1
         due[now] = np.where(reach >= n - 1, n, np.maximum(reach, i + 1))
         lower = (last_d[now] + d - pairs.c[now] * step[i - 1]) / 2 if i else d
-        split = (last_i[now] == i - 1) & (lower < clearance)  # steps to bisect
+        split = (last_i[now] == i - 1) & (lower < clear_g[now])  # steps to bisect
         for g, d_g in zip(now[split], d[split], strict=True):
             bisect(g, i - 1.0, last_d[g], float(i), d_g, step[i - 1])
         last_i[now], last_d[now] = i, d
@@ -195,15 +203,18 @@ def check_trajectory(
     s, x, d = s[order], x[order], d[order]
     rows = np.flatnonzero(np.r_[True, (s[1:] != s[:-1]) | (x[1:] != x[:-1])])
     s, x, d = s[rows], x[rows], np.minimum.reduceat(d, rows)
-    return _result(cell, pairs, (s, x, d), q, t, sigma, clearance, n_worst, rho, start)
+    clearances = (clearance, self_clearance, clear_s)
+    return _result(cell, pairs, (s, x, d), q, t, sigma, clearances, n_worst, rho, start)
 
 
-def _result(cell, pairs, table, q, t, sigma, clearance, n_worst, rho, start):
+def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start):
     """The CollisionResult of the evaluated table (mesh pairs refined with FCL)."""
     s, x, drake = table
+    clearance, self_clearance, clear_s = clearances
+    limit = clear_s[s]  # (K,) each evaluated point's clearance [m]
     dist, exact = drake.copy(), np.full(len(x), np.nan)
     notes = []
-    refine = np.flatnonzero((drake < clearance) & pairs.has_mesh[s])
+    refine = np.flatnonzero((drake < limit) & pairs.has_mesh[s])
     if len(refine) > MAX_EXACT_CHECKS:
         notes.append(f"{len(refine) - MAX_EXACT_CHECKS} mesh-pair points kept Drake's distance")
     for k in refine[:MAX_EXACT_CHECKS]:
@@ -222,7 +233,7 @@ def _result(cell, pairs, table, q, t, sigma, clearance, n_worst, rho, start):
     minima, stretches = [], []
     for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
         minima.append(entry(lo + int(np.argmin(dist[lo:hi]))))
-        for a, b in true_runs(dist[lo:hi] < clearance):
+        for a, b in true_runs(dist[lo:hi] < limit[lo:hi]):
             worst = entry(lo + a + int(np.argmin(dist[lo + a : lo + b])))
             first, last = entry(lo + a), entry(lo + b - 1)
             stretches.append(CollisionStretch(
@@ -257,32 +268,14 @@ def _result(cell, pairs, table, q, t, sigma, clearance, n_worst, rho, start):
         "motion_radii_m": rho.tolist(),
         "elapsed_s": time.perf_counter() - start,
     }
-    below = np.unique(np.floor(x[dist < clearance]).astype(int)).tolist()
+    below = np.unique(np.floor(x[dist < limit]).astype(int)).tolist()
+    margin = {(p.a, p.b): p.distance_m - clear_s[pairs.names.index((p.a, p.b))] for p in minima}
+    violation = min(minima, key=lambda p: margin[(p.a, p.b)], default=None)
+    violated = violation is not None and margin[(violation.a, violation.b)] < 0
+    violation_clearance = clear_s[pairs.names.index((violation.a, violation.b))] if violated else 0
     return CollisionResult(
-        clearance, bool(min_distance >= clearance), float(min_distance), closest, minima,
+        clearance, not violated, float(min_distance), closest, minima,
         minima[:n_worst], stretches, below, first, list(cell.allowed_contact),
-        failure_message(first, stretch, closest, clearance), notes, stats,
+        failure_message(first, stretch, violation if violated else None, violation_clearance),
+        notes, stats, self_clearance, cell.skipped_self_pairs,
     )  # fmt: skip
-
-
-def distance_profile(
-    cell: DrakeCell, q: np.ndarray, t: np.ndarray, n_points: int = PROFILE_POINTS
-) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Smallest signed distance per pair group over time, for plots.
-
-    Args:
-        cell: the cell with its shapes; q: (N, 6) joint path [rad]; t: (N,) times [s].
-        n_points: how many evenly spaced samples to evaluate.
-
-    Returns:
-        (t_k (K,), {group: (K,) smallest Drake signed distance in that group [m]}).
-    """
-    pairs = _Pairs(cell)
-    index = np.unique(np.linspace(0, len(q) - 1, min(n_points, len(q))).astype(int))
-    profile = {group: np.full(len(index), np.inf) for group in sorted(set(pairs.groups))}
-    for k, i in enumerate(index):
-        pairs.set(q[i])
-        for g in range(len(pairs.ids)):
-            group = profile[pairs.groups[pairs.shape_of[g]]]
-            group[k] = min(group[k], pairs.distance(g))
-    return t[index], profile

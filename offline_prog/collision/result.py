@@ -87,6 +87,10 @@ class CollisionResult:
     message: str
     notes: list[str]
     stats: dict
+    self_clearance_m: float | None = None  # robot link vs robot link [m] (None: clearance_m)
+    # Robot link pairs not checked, with class and reason (robots/<robot>/self_collision.yaml);
+    # None: the robot has no matrix, every pair was checked.
+    skipped_self_pairs: list | None = None
 
 
 def failure_message(first, stretch, closest, clearance) -> str:

@@ -107,7 +107,8 @@ class MotionConfig:
     speed_reference: str = "tcp"  # tcp | flange
     sample_rate_hz: float = 250.0
     cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation
-    clearance: float = 0.005  # m: closest allowed approach of any checked pair
+    clearance: float = 0.005  # m: robot and part vs obstacles, the tool and each other
+    self_clearance: float = 0.005  # m: robot link vs robot link (pairs of class "check")
 
 
 @dataclasses.dataclass

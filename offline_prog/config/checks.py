@@ -72,8 +72,9 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "tool.symmetry_axis", f"{cell.tool.symmetry_axis!r} (use x, y or z)")
     if motion.cusp_smoothing_mm is not None and not motion.cusp_smoothing_mm > 0:
         raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
-    if not motion.clearance >= 0:
-        raise _error(file, "motion.clearance", f"must be ≥ 0 m, got {motion.clearance}")
+    for key in ("clearance", "self_clearance"):
+        if not getattr(motion, key) >= 0:
+            raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
     _check_shapes(file, cell)
 
 

@@ -107,6 +107,13 @@ def collision_summary(plan: Plan) -> dict:
             "distance_m": closest.distance_m,
         },
         "clearance_m": result.clearance_m,
+        "self_clearance_m": result.self_clearance_m,
+        "self_collision_pairs_skipped": None
+        if result.skipped_self_pairs is None
+        else [
+            {"pair": [p.a, p.b], "class": p.kind, "reason": p.reason}
+            for p in result.skipped_self_pairs
+        ],
         "feasible": plan.feasible,
         "failure": plan.failure,
         "collision_avoidance": plan.avoidance,

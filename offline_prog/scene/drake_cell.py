@@ -30,6 +30,7 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.scene.exact_distance import bounding_radius
+from offline_prog.scene.self_collision import read_matrix
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
 PART_COLOR = Rgba(0.85, 0.55, 0.15, 1.0)
@@ -72,6 +73,9 @@ class DrakeCell:
     labels: dict[GeometryId, GeometryLabel] = dataclasses.field(default_factory=dict)
     allowed_contact: list[tuple[str, str]] = dataclasses.field(default_factory=list)
     visualizer: object = None  # MeshcatVisualizer when built with a Meshcat
+    # Robot link pairs not checked for self-collision (robots/<robot>/self_collision.yaml:
+    # every class but "check"), or None when the robot has no matrix (all pairs checked).
+    skipped_self_pairs: list | None = None
 
     @property
     def frame_E(self):
@@ -162,6 +166,29 @@ def _filter(scene_graph, plant, labels, part, allowed_contact) -> None:
         manager.Apply(CollisionFilterDeclaration().ExcludeBetween(a, b))
 
 
+def _filter_self_pairs(scene_graph, plant, model, robot: RobotModel):
+    """Exclude the robot's link pairs that its self-collision matrix does not mark
+    ``check``; returns those pairs (None: the robot has no matrix, all are checked)."""
+    try:
+        pairs = read_matrix(robot.urdf_path.parent)
+    except ValueError as error:
+        raise ShapeError("robot.model", str(error)) from None
+    if pairs is None:
+        return None
+    manager = scene_graph.collision_filter_manager()
+    skipped = [p for p in pairs if p.kind != "check"]
+    for pair in skipped:
+        a, b = (plant.GetBodyByName(name, model) for name in (pair.a, pair.b))
+        ids = [plant.GetCollisionGeometriesForBody(body) for body in (a, b)]
+        if all(ids):
+            manager.Apply(
+                CollisionFilterDeclaration().ExcludeBetween(
+                    GeometrySet(ids[0]), GeometrySet(ids[1])
+                )
+            )
+    return skipped
+
+
 def build_drake_cell(
     robot: RobotModel,
     *,
@@ -227,6 +254,7 @@ def build_drake_cell(
         for geometry_id in plant.GetCollisionGeometriesForBody(body):
             labels[geometry_id] = GeometryLabel("robot", body.name(), body.name())
     _filter(builder.scene_graph(), plant, labels, part, allowed_contact)
+    skipped = _filter_self_pairs(builder.scene_graph(), plant, model, robot)
     visualizer = None
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
@@ -236,8 +264,9 @@ def build_drake_cell(
         )
     diagram = builder.Build()
     return DrakeCell(
-        diagram, plant, model, X_IB, X_IT, X_PE, labels, list(allowed_contact), visualizer
-    )
+        diagram, plant, model, X_IB, X_IT, X_PE, labels, list(allowed_contact), visualizer,
+        skipped,
+    )  # fmt: skip
 
 
 def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel, meshcat=None) -> DrakeCell:

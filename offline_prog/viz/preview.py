@@ -113,18 +113,34 @@ def _joints_at(plan, times: np.ndarray) -> np.ndarray:
 
 def _mesh_file(shape) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """(vertices (V, 3) [m], faces (F, 3), vertex colours (V, 3) or None) of a Drake
-    Mesh (its file, with its materials' colours) or Convex (its hull)."""
-    import trimesh  # only for mesh files: a second of import time otherwise saved
+    Mesh (its file; each part coloured by its material, e.g. an OBJ's .mtl) or Convex
+    (its hull)."""
+    import trimesh  # only for mesh files: half a second of import time otherwise saved
 
-    loaded = trimesh.load(shape.source().path(), force="mesh")
-    loaded.apply_scale(shape.scale3())
+    scale = np.asarray(shape.scale3())
     if isinstance(shape, Convex):
-        hull = loaded.convex_hull
-        return np.asarray(hull.vertices), np.asarray(hull.faces), None
-    colors = None
-    if loaded.visual.kind is not None:
-        colors = np.asarray(loaded.visual.to_color().vertex_colors)[:, :3] / 255.0
-    return np.asarray(loaded.vertices), np.asarray(loaded.faces), colors
+        hull = trimesh.load(shape.source().path(), force="mesh").convex_hull
+        return np.asarray(hull.vertices) * scale, np.asarray(hull.faces), None
+    parts = trimesh.load(shape.source().path(), force="scene").dump(concatenate=False)
+    vertices, faces, colors, offset = [], [], [], 0
+    for part in parts:
+        vertices.append(np.asarray(part.vertices) * scale)
+        faces.append(np.asarray(part.faces) + offset)
+        offset += len(part.vertices)
+        colors.append(np.tile(_part_color(part), (len(part.vertices), 1)))
+    colored = any(c is not None for c in colors)
+    return (
+        np.vstack(vertices),
+        np.vstack(faces),
+        np.vstack(colors) if colored and all(c is not None for c in colors) else None,
+    )
+
+
+def _part_color(part) -> np.ndarray | None:
+    """(3,) the diffuse colour in [0, 1] of one mesh part's material, or None."""
+    material = getattr(part.visual, "material", None)
+    color = getattr(material, "main_color", None) if material is not None else None
+    return None if color is None else np.asarray(color[:3], dtype=float) / 255.0
 
 
 def _draw_shape(scene: StaticScene, path: str, shape, rgba) -> None:

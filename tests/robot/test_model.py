@@ -17,6 +17,7 @@ from pydrake.systems.framework import DiagramBuilder
 from offline_prog.robot.kinematics_opw import OpwParameters
 from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot.model import PARAMS_FILE, ROBOTS_DIR, list_robots, load_robot
+from offline_prog.scene.self_collision import read_matrix
 
 ROBOTS = ("ur10e", "kuka_kr16_2", "abb_irb2400")
 LINKS = ["base_link"] + [f"link_{i}" for i in range(1, 7)]
@@ -60,8 +61,10 @@ def test_urdf_structure_and_limits_match_record(name):
     for link_name in LINKS:
         link = links[link_name]
         assert float(link.find("inertial/mass").get("value")) > 0
-        shapes = [g[0].tag for g in link.findall("collision/geometry")]
-        assert shapes and set(shapes) <= {"box", "cylinder", "sphere"}, link_name
+        # One vendor collision mesh per link, shipped beside the URDF (tests/robot/test_meshes).
+        shapes = link.findall("collision/geometry/mesh")
+        assert len(shapes) == 1, link_name
+        assert (robot.urdf_path.parent / shapes[0].get("filename")).is_file(), link_name
     joints = {joint.get("name"): joint for joint in root.findall("joint")}
     for i, joint_name in enumerate(robot.joint_names):
         joint = joints[joint_name]
@@ -101,8 +104,17 @@ def test_urdf_loads_in_drake_by_package_uri_without_self_collision(name):
     query = scene_graph.get_query_output_port().Eval(
         SceneGraph.GetMyContextFromRoot(scene_graph, context)
     )
-    # Drake filters parent-child pairs; any other overlap at q = 0 is a modelling error.
-    assert query.ComputePointPairPenetration() == []
+    # Drake filters parent-child pairs; any other overlap at q = 0 is a modelling error,
+    # unless the robot's self-collision matrix marks the pair "always" (vendor meshes that
+    # overlap by design, e.g. the IRB 2400's link_4 and link_6).
+    inspector = scene_graph.model_inspector()
+    always = {frozenset((p.a, p.b)) for p in read_matrix(ROBOTS_DIR / name) if p.kind == "always"}
+    for contact in query.ComputePointPairPenetration():
+        bodies = frozenset(
+            plant.GetBodyFromFrameId(inspector.GetFrameId(g)).name()
+            for g in (contact.id_A, contact.id_B)
+        )
+        assert bodies in always, sorted(bodies)
 
 
 @pytest.fixture

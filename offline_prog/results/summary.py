@@ -1,0 +1,64 @@
+"""The short summary ``offline-prog plan`` prints at the end, read from report.json."""
+
+from __future__ import annotations
+
+from rich.console import Console
+
+
+def print_summary(console: Console, report: dict, files: dict, seconds: float) -> None:
+    """A few lines: path and fit, motion, robot, clearance, cusps, the files, the time."""
+    fit, motion, traj = report["fit"], report["motion"], report["trajectory"]
+    console.print(
+        f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
+        f"tool {report['tool']}, part {report['part']}"
+    )
+    console.print(
+        f"  path      {report['path']['length_m'] * 1e3:.1f} mm "
+        f"({report['path']['source']}, {'closed' if report['path']['closed'] else 'open'})"
+        f", fit degree {fit['degree']} with {fit['n_control_points']} control points, "
+        f"max error {fit['max_error_mm']:.4f} mm, RMS {fit['rms_error_mm']:.4f} mm"
+    )
+    reduced = " (reduced: short path)" if motion["top_speed_reduced"] else ""
+    console.print(
+        f"  motion    {motion['top_speed_m_s'] * 1e3:.1f} mm/s at the "
+        f"{motion['speed_reference']}{reduced}, cycle {traj['duration_s']:.3f} s, "
+        f"{traj['n_samples']} samples, speed error "
+        f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
+    )
+    robot = report["robot_motion"]
+    reductions = robot["speed_reductions"]
+    console.print(
+        f"  robot     branch {robot['branch']}, min joint-limit margin "
+        f"{robot['min_joint_limit_margin_deg']:.1f}°, largest joint step "
+        f"{robot['largest_joint_step']['step_deg']:.3f}°, "
+        + (
+            f"speed lowered on {len(reductions)} stretch(es), down to "
+            f"{min(r['speed_m_s'] for r in reductions) * 1e3:.1f} mm/s"
+            if reductions
+            else "process speed held everywhere"
+        )
+    )
+    distance = report["min_distance_m"]
+    closest = report["closest_pair"]
+    console.print(
+        "  clearance "
+        + (
+            "no checked pairs"
+            if distance is None
+            else f"min distance {distance * 1e3:.1f} mm ({' vs '.join(closest['pair'])} at "
+            f"σ={closest['sigma_m']:.3f} m), "
+            + ("collision-free" if report["collision_free"] else "FAILS")
+        )
+    )
+    cusps = report["cusps"]
+    console.print(
+        f"  cusps     {len(cusps)}"
+        + (
+            "  " + ", ".join(f"{c['kind']} at σ={c['sigma_m']:.3f} m" for c in cusps[:5])
+            if cusps
+            else ""
+        )
+    )
+    for name, path in files.items():
+        console.print(f"  {name:<9} {path}")
+    console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
