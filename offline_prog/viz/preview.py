@@ -137,10 +137,14 @@ def _mesh_file(shape) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
 
 
 def _part_color(part) -> np.ndarray | None:
-    """(3,) the diffuse colour in [0, 1] of one mesh part's material, or None."""
+    """(3,) the diffuse colour of one mesh part's material, or None, as linear RGB in
+    [0, 1]: materials give sRGB, three.js takes vertex colours as linear."""
     material = getattr(part.visual, "material", None)
     color = getattr(material, "main_color", None) if material is not None else None
-    return None if color is None else np.asarray(color[:3], dtype=float) / 255.0
+    if color is None:
+        return None
+    srgb = np.asarray(color[:3], dtype=float) / 255.0
+    return np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
 
 
 def _draw_shape(scene: StaticScene, path: str, shape, rgba) -> None:

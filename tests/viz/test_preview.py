@@ -50,6 +50,29 @@ def test_preview_html_needs_no_server(seal, tmp_path, monkeypatch):
     assert info["frames"] == expected
 
 
+def test_preview_draws_the_vendor_meshes_in_their_colours(seal):
+    """Every robot link is drawn from its vendor mesh (hundreds of vertices, coloured
+    by its materials), not from boxes."""
+    import umsgpack
+
+    import offline_prog.viz.preview as preview
+
+    plan, _ = seal
+    scene, _ = preview.preview_scene(plan)
+    drawn = {}
+    for message in scene.messages:
+        if isinstance(message, bytes):
+            command = umsgpack.unpackb(message)
+            if command["type"] == "set_object" and "/kuka_kr16_2/" in command["path"]:
+                link = command["path"].split("/")[3]
+                drawn[link] = command["object"]["geometries"][0]
+    assert set(drawn) == {"base_link", *(f"link_{k}" for k in range(1, 7))}
+    for link, geometry in drawn.items():
+        attributes = geometry["data"]["attributes"]
+        n_vertices = len(attributes["position"]["array"].data) // 12  # float32 x, y, z
+        assert n_vertices > 300 and "color" in attributes, link
+
+
 @pytest.mark.slow
 def test_preview_html_shows_the_cell_in_a_browser(seal, tmp_path):
     require_chromium()
