@@ -204,7 +204,7 @@ def attempt_motion(
         scene,
         joints.q,
         traj.t,
-        traj.sigma,
+        traj.s,
         clearance=motion.clearance,
         self_clearance=motion.self_clearance,
     )

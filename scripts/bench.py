@@ -155,7 +155,7 @@ def bench_collision(cells: list[Path]) -> None:
         ):
             drake = build_cell_model(plan.cell, file, robot)
             check = functools.partial(
-                check_trajectory, drake, q, traj.t, traj.sigma, clearance=motion.clearance,
+                check_trajectory, drake, q, traj.t, traj.s, clearance=motion.clearance,
                 self_clearance=motion.self_clearance,
             )  # fmt: skip
             seconds, result = best_of(3, check)

@@ -151,7 +151,7 @@ def avoid_collisions(first: Attempt, rotations, attempt) -> tuple[Attempt, dict]
             best = trial
         if trial.collisions.collision_free:
             break
-    sigma = first.joints.trajectory.sigma
+    sigma = first.joints.trajectory.s
     needed = sorted(set(first.collisions.samples_in_collision))
     change = []
     if best.rotation != first.rotation:

@@ -35,6 +35,10 @@ from offline_prog.timing.trajectory import (
 
 # σ grid for branch choice and joint rates [m], and the IK difference step [m].
 GRID_SPACING_M = 5e-4
+# Fewest path-IK grid points, however short the path (a short seam still gets a fine look).
+MIN_GRID_POINTS = 2001
+# Time grid that inverts σ(t) for failure messages (t to ~duration / 20000).
+TIME_INVERSION_POINTS = 20001
 DIFF_STEP_M = 1e-4
 # Singularity thresholds: |sin θ5| and |sin elbow| below sin(5°), shoulder 30 mm.
 NEAR_SINGULAR = {
@@ -154,7 +158,7 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
 
 
 def _time_at(law: Sin2TimeLaw, sigma: float) -> float:
-    t = np.linspace(0.0, law.duration, 20001)
+    t = np.linspace(0.0, law.duration, TIME_INVERSION_POINTS)
     return float(np.interp(sigma, law(t)[0], t))
 
 
@@ -180,7 +184,7 @@ def plan_joint_trajectory(
         branch: use this analytic branch (if feasible) instead of the best one.
     """
     length = parameter.length
-    grid = np.linspace(0.0, length, max(2001, int(np.ceil(length / GRID_SPACING_M)) + 1))
+    grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
     if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
         from offline_prog.joints.drake_path import DrakeIkPath
 

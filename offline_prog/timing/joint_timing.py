@@ -27,6 +27,9 @@ CENTRIPETAL_SHARE = 0.5
 # A capped stretch is widened by this much on each side [m of σ].
 CAP_PADDING_M = 2e-3
 MAX_RETIMING_ROUNDS = 12
+# Each retiming round lowers an over-limit speed, or the ramps, to this share of what
+# the limit allows: a margin so the next round's samples land inside the limits.
+RETIMING_STEP_SHARE = 0.9
 
 
 @dataclasses.dataclass(frozen=True)
@@ -164,12 +167,12 @@ def retime(
         bad = over_speed > 1.0
         if bad.any():
             _, sd, _, _ = law(t)
-            limit = np.where(bad, 0.9 * sd / np.maximum(over_speed, 1.0), np.inf)
+            limit = np.where(bad, RETIMING_STEP_SHARE * sd / np.maximum(over_speed, 1.0), np.inf)
             lowered = np.interp(rates.sigma, sigma, limit)
             cap = np.minimum(cap, lowered)
         hard = (accel > 1.0) & (tangential > centripetal)
         if hard.any():
-            a_scale *= 0.9 / float(np.sqrt(accel[hard].max()))
+            a_scale *= RETIMING_STEP_SHARE / float(np.sqrt(accel[hard].max()))
     t = np.arange(0.0, law.duration, 1.0 / check_rate_hz)
     sigma, speed, _, _, accel = limit_use(rates, law, t, qd_max, qdd_max)
     use = np.maximum(speed, accel)

@@ -60,7 +60,10 @@ class WorkspaceTrajectory:
         tcp_speed: (N,) speed of the part point under the TCP relative to the tool
             [m/s], from the rigid-body velocity of the part.
         law: the time law; reference: "tcp" or "flange".
-        sigma: (N,) the time law's parameter σ(t) (= s for the tcp reference) [m].
+        law_position: (N,) the time law's own position r(t) [m]: the TCP arc length s
+            for the tcp reference, the flange path's arc length for the flange reference.
+            Reports, the CSV and the programs call the TCP arc length s "σ"; this is the
+            one place r differs from it.
     """
 
     t: np.ndarray
@@ -76,7 +79,7 @@ class WorkspaceTrajectory:
     tcp_speed: np.ndarray
     law: Sin2TimeLaw
     reference: str
-    sigma: np.ndarray
+    law_position: np.ndarray
 
     @property
     def duration(self) -> float:
@@ -171,7 +174,7 @@ def sample_workspace_trajectory(
         tcp_speed=np.linalg.norm(v_IQ, axis=1),
         law=law,
         reference=parameter.reference,
-        sigma=sigma,
+        law_position=sigma,
     )
 
 

@@ -55,7 +55,7 @@ def test_turn_profile_holds_the_process_and_the_clearance():
         rate_hz=motion.sample_rate_hz,
     )
     traj = joints.trajectory
-    result = check_trajectory(drake, joints.q, traj.t, traj.sigma, clearance=clearance)
+    result = check_trajectory(drake, joints.q, traj.t, traj.s, clearance=clearance)
     assert result.collision_free, result.message
     # The process is held: Drake FK puts the path point on the TCP.
     context = drake.plant.CreateDefaultContext()

@@ -219,7 +219,7 @@ def test_demo_cells_with_geometry_are_clear_and_list_the_tool_contact(name, tmp_
     plan = plan_cell(DATA / f"{name}.yaml")
     cell = build_cell_model(plan.cell, plan.cell_file, plan.robot)
     traj, clearance = plan.trajectory, plan.cell.motion.clearance
-    result = check_trajectory(cell, plan.joints.q, traj.t, traj.sigma, clearance=clearance)
+    result = check_trajectory(cell, plan.joints.q, traj.t, traj.s, clearance=clearance)
     allowed = [tuple(pair) for pair in plan.cell.allowed_contact]
     assert result.collision_free, result.message
     assert result.allowed == allowed and result.min_distance_m >= clearance
@@ -237,7 +237,7 @@ def test_demo_cells_with_geometry_are_clear_and_list_the_tool_contact(name, tmp_
         plan.robot, X_IB=cell.X_IB, X_IT=cell.X_IT, X_PE=cell.X_PE, part_shapes=geometry.part,
         tool_shapes=geometry.tool, obstacles=geometry.obstacles,
     )  # fmt: skip
-    touching = check_trajectory(unfiltered, plan.joints.q, traj.t, traj.sigma, clearance=clearance)
+    touching = check_trajectory(unfiltered, plan.joints.q, traj.t, traj.s, clearance=clearance)
     assert not touching.collision_free
     assert {touching.closest.a, touching.closest.b} == set(allowed[0])
     assert f"{touching.closest.a} vs {touching.closest.b}" in touching.message

@@ -156,7 +156,7 @@ def test_collision_avoidance_is_tried_and_reported(tmp_path):
         cell.replace(
             "obstacles:   # in I",
             "obstacles:   # in I\n"
-            "  - {name: cable_duct, shape: sphere, radius_mm: 40, "
+            "  - {name: cable_duct, shape: sphere, radius_mm: 60, "
             "pose: {translation: [0.695, 0.05, 1.21]}}",
         )
     )
