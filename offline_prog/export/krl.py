@@ -39,6 +39,7 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.krl_points import process_points
 from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
+from offline_prog.export.text import krl_comment
 from offline_prog.robot.model import load_robot
 
 STYLES = ("external_tcp", "flange")
@@ -157,8 +158,9 @@ def _conventions(style: str, convention: str, n: int, chord_tol_m, angle_tol_rad
 
 
 def _comments(lines: list[str]) -> list[str]:
-    ascii_lines = [line.encode("ascii", "replace").decode() for line in lines]
-    return ["; " + part for line in ascii_lines for part in textwrap.wrap(line, 100) or [""]]
+    """KRL comment lines: each text line sanitized (export.text), wrapped at 100."""
+    safe = [krl_comment(line) for line in lines]
+    return ["; " + part for line in safe for part in textwrap.wrap(line, 100) or [""]]
 
 
 def _check(name: str, style: str, convention: str, line_limit: int, tolerances) -> None:

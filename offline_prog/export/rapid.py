@@ -21,7 +21,6 @@ Units at this edge: mm, degrees, quaternions ``[q1, q2, q3, q4] = [w, x, y, z]``
 from __future__ import annotations
 
 import dataclasses
-import re
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +30,7 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines
 from offline_prog.export.program import ProgramData
+from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.robot.model import RobotModel, load_robot
 
 DEFAULT_APPROACH_M = 0.02  # approach / retract along -y of F (y = pressing direction n)
@@ -44,9 +44,7 @@ EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
 NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 _PART_OVERHEAD = 6  # MODULE, comment, zone, PROC, ENDPROC, ENDMODULE
-_ASCII = {"°": " deg", "σ": "sigma", "≤": "<=", "≥": ">=", "×": "x", "π": "pi", "→": "->"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,12 +139,6 @@ def _robtarget(name: str, X: np.ndarray, conf: np.ndarray) -> str:
     return f"LOCAL CONST robtarget {name} := [{_pose(X)[1:-1]},[{cf}],{EXTAX}];"
 
 
-def _ascii(line: str) -> str:
-    for old, new in _ASCII.items():
-        line = line.replace(old, new)
-    return " ".join(line.split()).encode("ascii", "replace").decode()
-
-
 def _module_text(name: str, body: list[str], procs: dict[str, list[str]]) -> str:
     lines = [f"MODULE {name}"] + ["  " + line for line in body]
     for proc, statements in procs.items():
@@ -201,8 +193,7 @@ def write_rapid(
     Raises:
         ValueError: naming the bad argument.
     """
-    if not _NAME.match(module) or len(module) > NAME_MAX - 6:
-        raise ValueError(f"module={module!r}: need a RAPID name of at most {NAME_MAX - 6} chars")
+    identifier(module, max_chars=NAME_MAX - 6, what="module")
     if not (chord_tol_m > 0 and angle_tol_rad > 0 and zone_mm >= 0 and approach_m >= 0):
         raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0, zone_mm >= 0, approach_m >= 0")
     robot = load_robot(data.robot)
@@ -214,10 +205,8 @@ def write_rapid(
     sel = select_points(p_PF, R_PF, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
     idx, n = sel.indices, len(sel.indices)
     conf, speeds = confdata(robot, data.q[idx]), segment_speeds_mms(data, idx)
-    tool, wobj = (
-        re.sub(r"[^A-Za-z0-9_]", "_", f"{k}_{s}")[:NAME_MAX]
-        for k, s in [("tool", data.tool), ("wobj", data.part)]
-    )
+    tool = identifier_from("tool", data.tool, max_chars=NAME_MAX)
+    wobj = identifier_from("wobj", data.part, max_chars=NAME_MAX)
     tail = f", {tool}\\WObj:={wobj};"
     names = [f"p{i:0{max(4, len(str(n - 1)))}d}" for i in range(n)]
     z = _list((zone_mm,) * 3 + (zone_mm / 10, zone_mm, zone_mm / 10), 5)[1:-1]
@@ -267,7 +256,7 @@ def write_rapid(
         + ", not collision-checked. tload: PLACEHOLDER 5 kg gripper; part load: GripLoad.",
     ]
     header = header_lines(data, conventions=conventions, forced=forced)
-    head = ["! " + _ascii(line) for line in header] + head
+    head = ["! " + rapid_comment(line) for line in header] + head
 
     decls, moves = part(range(1, n))
     texts = {module: _module_text(module, head + decls, {"main": first + moves + last})}

@@ -22,10 +22,12 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.density import select_points
 from offline_prog.export.header import header_lines
 from offline_prog.export.program import ProgramData
+from offline_prog.export.text import identifier, urscript_comment
 
 E_SERIES_PERIOD_S = 0.002
 SERVOJ_LOOKAHEAD_S = 0.1
 SERVOJ_GAIN = 300
+NAME_MAX = 63  # our bound for the program's function name
 START_SPEED_RAD_S = 0.5  # movej to the start
 START_ACCEL_RAD_S2 = 1.0
 # The controller's base frame C in the URDF base_link B: turned π about z.
@@ -82,7 +84,9 @@ def urscript_text(
             "(URDF base_link turned pi about z), rotation vectors."
         ),
     ]
-    lines = [f"# {line}" for line in header_lines(data, conventions=conventions, forced=forced)]
+    identifier(name, max_chars=NAME_MAX, what="name")
+    header = header_lines(data, conventions=conventions, forced=forced)
+    lines = [f"# {urscript_comment(line)}" for line in header]
     lines.append(f"def {name}():")
     q0 = data.q[0]
     lines.append(f"  movej({_list(q0)}, a={START_ACCEL_RAD_S2}, v={START_SPEED_RAD_S})")
