@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.atomic import atomic_stream
+
 PLAN_FILE = "plan.npz"
 _ARRAYS = (
     "t",
@@ -89,21 +91,15 @@ class ProgramData:
 
     def save(self, folder: Path) -> Path:
         """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
-        import os
-        import tempfile
-
         meta = {
             f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in _ARRAYS
         }
         meta["joint_names"] = list(self.joint_names)
         target = Path(folder) / PLAN_FILE
-        target.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=target.parent, suffix=".npz.tmp")
-        with os.fdopen(handle, "wb") as stream:
+        with atomic_stream(target) as stream:
             np.savez_compressed(
                 stream, meta=json.dumps(meta), **{name: getattr(self, name) for name in _ARRAYS}
             )
-        os.replace(temp, target)
         return target
 
     @classmethod
@@ -118,7 +114,12 @@ class ProgramData:
             with np.load(file) as data:
                 meta = json.loads(str(data["meta"]))
                 arrays = {name: np.asarray(data[name]) for name in _ARRAYS}
-        except (OSError, KeyError, ValueError) as error:
-            raise ValueError(f"{file}: not a plan folder ({error})") from None
-        meta["joint_names"] = tuple(meta["joint_names"])
-        return cls(**meta, **arrays)
+        except FileNotFoundError:
+            raise ValueError(f"{file}: not a plan folder (no {PLAN_FILE})") from None
+        except Exception as error:  # truncated or foreign: zipfile, zlib, pickle, json ...
+            raise ValueError(f"{file}: unreadable, not a complete plan ({error})") from None
+        try:
+            meta["joint_names"] = tuple(meta["joint_names"])
+            return cls(**meta, **arrays)
+        except (KeyError, TypeError) as error:
+            raise ValueError(f"{file}: not a plan of this version ({error})") from None
