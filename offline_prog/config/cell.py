@@ -13,11 +13,12 @@ import types
 import typing
 from pathlib import Path
 
-import yaml
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform
 
+from offline_prog.config import safe_yaml
+from offline_prog.config.safe_yaml import short_repr
 from offline_prog.errors import InputError
 
 REQUIRED = {"required": True}
@@ -124,28 +125,23 @@ class Cell:
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
 
 
-class _TagTolerantLoader(yaml.SafeLoader):
-    """Reads Drake's tagged nodes (``!Rpy {...}``) as {"__tag__": tag, **mapping}."""
-
-
-def _construct_tagged(loader, tag_suffix, node):
-    if isinstance(node, yaml.MappingNode):
-        return {"__tag__": "!" + tag_suffix, **loader.construct_mapping(node, deep=True)}
-    return {"__tag__": "!" + tag_suffix}
-
-
-_TagTolerantLoader.add_multi_constructor("!", _construct_tagged)
-
-
 def _is_number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
+def _is_float_text(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _check_vector(file, key, value, size):
     if not (isinstance(value, list) and len(value) == size and all(map(_is_number, value))):
-        raise InputError(file, key, f"expected a list of {size} numbers, got {value!r}")
+        raise InputError(file, key, f"expected a list of {size} numbers, got {short_repr(value)}")
     if not all(math.isfinite(v) for v in value):
-        raise InputError(file, key, f"NaN or infinity in {value!r}")
+        raise InputError(file, key, f"NaN or infinity in {short_repr(value)}")
 
 
 def _check_transform(file, key, raw):
@@ -192,15 +188,15 @@ def _check_value(file, key, raw, schema):
         )
     ):
         if not isinstance(raw, list):
-            raise InputError(file, key, f"expected a list, got {raw!r}")
+            raise InputError(file, key, f"expected a list, got {short_repr(raw)}")
         for i, item in enumerate(raw):
             _check_value(file, f"{key}[{i}]", item, args[0])
         return
     if origin is list:
         if not (isinstance(raw, list) and all(map(_is_number, raw))):
-            raise InputError(file, key, f"expected a list of numbers, got {raw!r}")
+            raise InputError(file, key, f"expected a list of numbers, got {short_repr(raw)}")
         if not all(math.isfinite(v) for v in raw):
-            raise InputError(file, key, f"NaN or infinity in {raw!r}")
+            raise InputError(file, key, f"NaN or infinity in {short_repr(raw)}")
         return
     expected = {
         float: _is_number,
@@ -209,7 +205,10 @@ def _check_value(file, key, raw, schema):
         str: lambda v: isinstance(v, str),
     }[schema]
     if not expected(raw):
-        raise InputError(file, key, f"expected {schema.__name__}, got {raw!r}")
+        hint = ""
+        if schema is float and isinstance(raw, str) and _is_float_text(raw):
+            hint = f" (YAML reads {raw} as text: write {float(raw):.1e})"
+        raise InputError(file, key, f"expected {schema.__name__}, got {short_repr(raw)}{hint}")
     if schema is float and not math.isfinite(raw):
         raise InputError(file, key, f"{raw} is not a finite number")
 
@@ -239,18 +238,8 @@ def load_cell(file: str | os.PathLike) -> Cell:
         InputError: with a one-line message naming the file, key and reason.
     """
     file = Path(file)
-    try:
-        text = file.read_text()
-    except OSError as error:
-        raise InputError(file, "", f"cannot read ({error.strerror})") from None
-    try:
-        raw = yaml.load(text, Loader=_TagTolerantLoader)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        line = f"line {mark.line + 1}: " if mark else ""
-        raise InputError(
-            file, "", f"{line}not valid YAML ({getattr(error, 'problem', error)})"
-        ) from None
+    text = safe_yaml.read_text(file)  # size, encoding
+    raw = safe_yaml.load(file, text)  # aliases, depth, duplicate keys
     _check_mapping(file, "", raw, Cell)
     try:
         return yaml_load_typed(schema=Cell, data=text)
