@@ -10,7 +10,12 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cell import Cell
-from offline_prog.constants import UNIT_SCALE
+from offline_prog.constants import (
+    MAX_DATA_FILE_BYTES,
+    MAX_SAMPLE_RATE_HZ,
+    MAX_SPEED_M_S,
+    UNIT_SCALE,
+)
 from offline_prog.errors import InputError
 
 
@@ -41,12 +46,13 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             "path",
             f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
         )
-    for key in ("points", "dxf"):
-        value = getattr(path, key)
-        if value is not None and not (file.parent / value).is_file():
-            raise _error(file, f"path.{key}", f"file {file.parent / value} does not exist")
-    if cell.part.mesh is not None and not (file.parent / cell.part.mesh).is_file():
-        raise _error(file, "part.mesh", f"file {file.parent / cell.part.mesh} does not exist")
+    for key, value in (
+        ("path.points", path.points),
+        ("path.dxf", path.dxf),
+        ("part.mesh", cell.part.mesh),
+    ):
+        if value is not None:
+            _check_data_file(file, key, file.parent / value)
     if path.normal_from_mesh and cell.part.mesh is None:
         raise _error(file, "path.normal_from_mesh", "needs part.mesh")
     if path.normal is not None and np.linalg.norm(path.normal) < 1e-9:
@@ -62,6 +68,19 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     ):
         if not value > 0:
             raise _error(file, key, f"must be > 0, got {value}")
+    if motion.speed > MAX_SPEED_M_S:
+        raise _error(
+            file,
+            "motion.speed",
+            f"{motion.speed:g} m/s is more than {MAX_SPEED_M_S:g} m/s (the unit is m/s: "
+            f"{motion.speed:g} mm/s is {motion.speed * 1e-3:g})",
+        )
+    if motion.sample_rate_hz > MAX_SAMPLE_RATE_HZ:
+        raise _error(
+            file,
+            "motion.sample_rate_hz",
+            f"{motion.sample_rate_hz:g} Hz is more than {MAX_SAMPLE_RATE_HZ:g} Hz",
+        )
     if motion.speed_reference not in ("tcp", "flange"):
         raise _error(
             file, "motion.speed_reference", f"{motion.speed_reference!r} (use tcp or flange)"
@@ -75,6 +94,15 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     if not motion.clearance >= 0:
         raise _error(file, "motion.clearance", f"must be ≥ 0 m, got {motion.clearance}")
     _check_shapes(file, cell)
+
+
+def _check_data_file(file: Path, key: str, data_file: Path) -> None:
+    """A path or mesh file exists and is at most MAX_DATA_FILE_BYTES."""
+    if not data_file.is_file():
+        raise _error(file, key, f"file {data_file} does not exist")
+    size = data_file.stat().st_size
+    if size > MAX_DATA_FILE_BYTES:
+        raise _error(file, key, f"{data_file}: {size:,} bytes, more than {MAX_DATA_FILE_BYTES:,}")
 
 
 def _check_shapes(file: Path, cell: Cell) -> None:
@@ -99,10 +127,8 @@ def _check_shapes(file: Path, cell: Cell) -> None:
                 )
             if shape.mesh_units not in UNIT_SCALE:
                 raise _error(file, f"{where}.mesh_units", f"{shape.mesh_units!r} (use m or mm)")
-            if shape.shape == "mesh" and not (shape.mesh and (file.parent / shape.mesh).is_file()):
-                raise _error(
-                    file, f"{where}.mesh", f"file {file.parent / (shape.mesh or '')} does not exist"
-                )
+            if shape.shape == "mesh":
+                _check_data_file(file, f"{where}.mesh", file.parent / (shape.mesh or ""))
     for i, pair in enumerate(cell.allowed_contact):
         if len(pair) != 2:
             raise _error(file, f"allowed_contact[{i}]", f"expected [name, name], got {pair}")
