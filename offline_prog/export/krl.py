@@ -31,10 +31,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.density import (
-    DEFAULT_ANGLE_TOL_RAD,
-    DEFAULT_CHORD_TOL_M,
-)
+from offline_prog.export.densify import densify
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.header import header_lines
 from offline_prog.export.krl_points import process_points
 from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn
@@ -217,7 +215,12 @@ def write_krl(
     robot = load_robot(data.robot)
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
-    idx, max_chord, max_angle = process_points(data, style, chord_tol_m, angle_tol_rad)
+    dense = densify(data, chord_tol_m, angle_tol_rad)
+    data = dense.data
+    idx, max_chord, max_angle = process_points(
+        data, style, *dense.selection_tolerances(chord_tol_m, angle_tol_rad)
+    )
+    max_chord, max_angle = dense.bound(max_chord, max_angle)
     off = np.eye(4)
     off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
     X_PF_off = data.X_PF[[0, -1]] @ off  # approach, retract
@@ -245,7 +248,9 @@ def write_krl(
     parts = _process_lines(names, idx, speed, line_limit)
     subs = [f"{name}_{k + 1}" for k in range(len(parts))] if len(parts) > 1 else []
     conventions = _conventions(style, tcp_pose_convention, len(idx), chord_tol_m, angle_tol_rad)
-    conventions[-2] += f" (achieved {max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg)."
+    conventions[-2] += (
+        f" (achieved {max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg, {dense.basis})."
+    )
     head = _comments(header_lines(data, conventions=conventions, forced=forced))
     src = _MAIN.format(
         name=name,

@@ -27,6 +27,7 @@ import numpy as np
 from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
+from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines
 from offline_prog.export.program import ProgramData
@@ -201,9 +202,13 @@ def write_rapid(
     j23 = robot.j23_coupled if j23_coupled is None else j23_coupled
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
+    dense = densify(data, chord_tol_m, angle_tol_rad)
+    data = dense.data
+    chord_sel, angle_sel = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
     p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
-    sel = select_points(p_PF, R_PF, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
+    sel = select_points(p_PF, R_PF, chord_tol_m=chord_sel, angle_tol_rad=angle_sel)
     idx, n = sel.indices, len(sel.indices)
+    max_chord, max_angle = dense.bound(sel.max_chord_m, sel.max_angle_rad)
     conf, speeds = confdata(robot, data.q[idx]), segment_speeds_mms(data, idx)
     tool = identifier_from("tool", data.tool, max_chars=NAME_MAX)
     wobj = identifier_from("wobj", data.part, max_chars=NAME_MAX)
@@ -249,8 +254,8 @@ def write_rapid(
         "  oframe = I; robtarget = tool on the part; flange = tframe * rt^-1 * uframe^-1.",
         "Axes: URDF joints" + (", axis 3 = q2 + q3 (J2/J3 linkage)" if j23 else "") + "; conf: "
         "cf1/4/6 = floor(axis/90 deg), cfx = RAPID confdata table.",
-        f"Points: {n} of {len(data.t)} samples, LIN deviation <= {sel.max_chord_m * 1e3:.4f} mm, "
-        f"{np.rad2deg(sel.max_angle_rad):.4f} deg; v_tcp = planned mean on each segment.",
+        f"Points: {n} of {len(data.t)} samples, LIN deviation <= {max_chord * 1e3:.4f} mm, "
+        f"{np.rad2deg(max_angle):.4f} deg ({dense.basis}); v_tcp = planned mean on each segment.",
         f"Approach/retract: {approach}"
         + (" (OUT OF REACH)" if approach_m and not off else "")
         + ", not collision-checked. tload: PLACEHOLDER 5 kg gripper; part load: GripLoad.",
@@ -281,4 +286,4 @@ def write_rapid(
     listing = "".join(f"  <Module>{file.name}</Module>\n" for file in files)
     files.append(Path(out_dir) / f"{module}.pgf")
     write_atomic(files[-1], f"{PGF_HEAD}<Program>\n{listing}</Program>\n")
-    return RapidResult(tuple(files), n, idx, sel.max_chord_m, sel.max_angle_rad)
+    return RapidResult(tuple(files), n, idx, max_chord, max_angle)

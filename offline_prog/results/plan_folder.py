@@ -26,6 +26,7 @@ from offline_prog.atomic import (
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
+from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
@@ -94,6 +95,10 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
     X_BT = X_BI @ transform(cell.tool.X_IT).GetAsMatrix4()
     X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
     X_PF = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)
+    s_dense = dense_grid(plan.path.length)
+    dense = plan.flange(s_dense)
+    X_BE_dense = X_BI @ _poses(dense.p_IE, dense.R_IE)
+    X_PF_dense = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE_dense @ X_EP)
     return ProgramData(
         cell_name=cell.name or plan.cell_file.stem,
         cell_file=str(plan.cell_file),
@@ -121,6 +126,8 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         qd_max=plan.robot.qd_max,
         j23_coupled=plan.robot.j23_coupled,
         language=plan.robot.language,
+        sigma_dense=s_dense,
+        X_PF_dense=X_PF_dense,
     )
 
 
