@@ -35,7 +35,7 @@ from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.header import header_lines
 from offline_prog.export.krl_points import process_points
-from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn
+from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn, vel_cp
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import krl_comment
 from offline_prog.robot.model import load_robot
@@ -47,8 +47,6 @@ STYLES = ("external_tcp", "flange")
 TCP_POSE_CONVENTIONS = ("X_TP", "X_PF")
 MAX_NAME_CHARS = 24  # KRL names (KSS 8 KRL quick guide)
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
-VEL_CP_STEP_M_S = 1e-4  # $VEL.CP is floored to 0.1 mm/s: never above the plan
-VEL_CP_MIN_M_S = 1e-3
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 20, 50  # the joint move to the approach pose [%]
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
@@ -104,10 +102,6 @@ def _frame(X: np.ndarray) -> str:
     return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))
 
 
-def _vel_cp(speed_m_s: float) -> float:
-    return max(np.floor(speed_m_s / VEL_CP_STEP_M_S + 1e-6) * VEL_CP_STEP_M_S, VEL_CP_MIN_M_S)
-
-
 def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
     """``$VEL.CP`` and ``LIN`` lines to XP2..XPn, in parts of at most line_limit lines.
 
@@ -116,7 +110,7 @@ def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
     """
     parts, v_now = [[]], None
     for m in range(1, len(idx)):
-        v = _vel_cp(speed[idx[m - 1] : idx[m] + 1].max())
+        v = vel_cp(speed[idx[m - 1] : idx[m] + 1].max())
         lin = f"LIN {names[m]}" + (" C_DIS" if m < len(idx) - 1 else "")
         block = [f"$VEL.CP={v:.4f}", lin] if v != v_now else [lin]
         if parts[-1] and len(parts[-1]) + len(block) > line_limit:
@@ -262,7 +256,7 @@ def write_krl(
         ori=max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S),
         cdis=blend_m * 1e3,
         approach=approach_m * 1e3,
-        v=_vel_cp(data.process_speed_m_s),
+        v=vel_cp(data.process_speed_m_s),
         process="\n".join([f"{sub}( )" for sub in subs] or parts[0]),
     )
     axes = ",".join(f"A{i + 1} {_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_approach)))

@@ -39,6 +39,7 @@ START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ
 APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retract
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
+MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
 # PLACEHOLDER gripper load (tload of a stationary tool): 5 kg, 100 mm along tool0's z.
 GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
@@ -98,7 +99,13 @@ def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
         np.trapezoid(v[a : b + 1], t[a : b + 1]) / (t[b] - t[a]) if t[b] > t[a] else v[b]
         for a, b in zip(indices[:-1], indices[1:], strict=True)
     ]
-    return np.maximum(np.round(np.asarray(mean) * 1e4) / 10.0, MIN_SPEED_MMS)
+    speeds = np.maximum(np.round(np.asarray(mean) * 1e4) / 10.0, MIN_SPEED_MMS)
+    if not np.all(speeds <= MAX_SPEED_MMS):  # NaN too
+        raise ValueError(
+            f"write_rapid: v_tcp {np.nanmax(speeds):g} mm/s is beyond {MAX_SPEED_MMS:g} mm/s "
+            "(the plan's speeds are m/s, not mm/s)"
+        )
+    return speeds
 
 
 def approach_and_retract(robot: RobotModel, data: ProgramData, distance_m: float):

@@ -31,6 +31,7 @@ SERVOJ_GAIN = 300
 NAME_MAX = 63  # our bound for the program's function name
 MOVEL_ACCEL_M_S2 = 1.0
 MOVEL_MIN_SPEED_M_S = 1e-4
+MOVEL_MAX_SPEED_M_S = 3.0  # beyond any UR arm's tool speed (e-Series safety limit: 5 m/s)
 START_SPEED_RAD_S = 0.5  # movej to the start
 START_ACCEL_RAD_S2 = 1.0
 # The controller's base frame C in the URDF base_link B: turned π about z.
@@ -77,6 +78,11 @@ def movel_points(data: ProgramData, chord_tol_m: float, angle_tol_rad: float):
     )
     X_CP = np.linalg.inv(X_BC) @ plan.X_BE[idx] @ plan.X_EP
     v = np.linalg.norm(np.diff(X_CP[:, :3, 3], axis=0), axis=1) / np.diff(plan.t[idx])
+    if not np.all(v <= MOVEL_MAX_SPEED_M_S):  # NaN too
+        raise ValueError(
+            f"URScript movel: v {np.nanmax(v):g} m/s is beyond {MOVEL_MAX_SPEED_M_S:g} m/s "
+            "(the plan's speeds are m/s, not mm/s)"
+        )
     return X_CP, np.maximum(v, MOVEL_MIN_SPEED_M_S)
 
 
