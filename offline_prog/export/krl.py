@@ -143,7 +143,13 @@ def _conventions(style: str, convention: str, n: int, chord_tol_m, angle_tol_rad
         "Status: bit0 wrist centre behind A1 (overhead), bit1 wrist centre above the A2-A3 line "
         "(elbow up), bit2 A5 < 0. Turn: bit i set when A(i+1) < 0.",
         f"{n} process points: chord <= {chord_tol_m * 1e3:g} mm, orientation <= "
-        f"{np.rad2deg(angle_tol_rad):g} deg",
+        f"{np.rad2deg(angle_tol_rad):g} deg"
+        + (
+            " both if the controller moves the tool in straight lines across the part and if "
+            "it interpolates the written poses"
+            if style == "external_tcp"
+            else " for the tool's curve on the part while the part frame moves linearly"
+        ),
         "Not set here: $LOAD (gripper + part), process I/O. Approach and retract moves are not "
         "collision-checked.",
     ]
@@ -211,9 +217,8 @@ def write_krl(
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
     dense = densify(data, chord_tol_m, angle_tol_rad)
     data = dense.data
-    idx, max_chord, max_angle = process_points(
-        data, style, *dense.selection_tolerances(chord_tol_m, angle_tol_rad)
-    )
+    tolerances = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
+    idx, max_chord, max_angle = process_points(data, style, *tolerances, tcp_pose_convention)
     max_chord, max_angle = dense.bound(max_chord, max_angle)
     off = np.eye(4)
     off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
