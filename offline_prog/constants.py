@@ -35,3 +35,5 @@ MAX_SAMPLE_RATE_HZ = 10_000.0  # controllers interpolate at 0.25-4 kHz
 LIMIT_CHECK_RATE_HZ = 1000.0  # joint speed/acceleration checked at this rate
 MAX_SPEED_M_S = 2.0  # motion.speed: process speeds are mm/s to ~1 m/s; above is a unit slip
 MAX_VALUE_CHARS = 80  # a value quoted in an error message is cut to this
+MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this package drives
+MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin

@@ -68,6 +68,17 @@ class PartConfig:
     mesh: str | None = None  # STL/OBJ/PLY in P, relative to the cell file
     mesh_units: str = "m"
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
+    mass_kg: float | None = None  # payload: the part's mass ...
+    center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
+
+
+@dataclasses.dataclass
+class GripperConfig:
+    """The robot-held gripper that holds the part: its mass and centre of mass in the
+    flange frame E (payload statements of the programs)."""
+
+    mass_kg: float = required()
+    center_of_mass_mm: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 @dataclasses.dataclass
@@ -120,6 +131,7 @@ class Cell:
     motion: MotionConfig = dataclasses.field(default_factory=MotionConfig, metadata=REQUIRED)
     name: str = ""
     description: str = ""
+    gripper: GripperConfig | None = None
     obstacles: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in I
     # Pairs of shape names whose contact is intended (the tool tip on the part).
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)

@@ -11,7 +11,9 @@ import numpy as np
 
 from offline_prog.config.cell import Cell
 from offline_prog.constants import (
+    MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
+    MAX_PAYLOAD_KG,
     MAX_SAMPLE_RATE_HZ,
     MAX_SPEED_M_S,
     UNIT_SCALE,
@@ -93,7 +95,24 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
     if not motion.clearance >= 0:
         raise _error(file, "motion.clearance", f"must be ≥ 0 m, got {motion.clearance}")
+    _check_payload(file, cell)
     _check_shapes(file, cell)
+
+
+def _check_payload(file: Path, cell: Cell) -> None:
+    """Masses within [0, MAX_PAYLOAD_KG], centres of mass 3 numbers within reach."""
+    loads = [("part", cell.part.mass_kg, cell.part.center_of_mass_mm)]
+    if cell.gripper is not None:
+        loads.append(("gripper", cell.gripper.mass_kg, cell.gripper.center_of_mass_mm))
+    for owner, mass, com in loads:
+        if mass is not None and not 0.0 <= mass <= MAX_PAYLOAD_KG:
+            raise _error(file, f"{owner}.mass_kg", f"must be within [0, {MAX_PAYLOAD_KG:g}] kg")
+        if com is not None and not (len(com) == 3 and np.linalg.norm(com) <= MAX_CENTER_OF_MASS_MM):
+            raise _error(
+                file,
+                f"{owner}.center_of_mass_mm",
+                f"expected [x, y, z] within {MAX_CENTER_OF_MASS_MM:g} mm, got {com}",
+            )
 
 
 def _check_data_file(file: Path, key: str, data_file: Path) -> None:

@@ -70,3 +70,17 @@ def joints_near(robot, X_BE, q_ref, data, what: str) -> np.ndarray:
     if not ok.any():
         raise ValueError(f"write_krl: the {what} pose is out of reach (approach_m too large?)")
     return q[ok][np.abs(q[ok] - q_ref).max(axis=1).argmin()]
+
+
+def krl_num(value: float, digits: int) -> str:
+    """A KRL number with ``digits`` decimals, never "-0.0..."."""
+    text = f"{value:.{digits}f}"
+    return text[1:] if float(text) == 0.0 and text.startswith("-") else text
+
+
+def krl_frame(X: np.ndarray) -> str:
+    """``X .., Y .., Z .., A .., B .., C ..`` of a pose (4, 4) [m] in mm and degrees."""
+    values = [krl_num(v, 4) for v in X[:3, 3] * 1e3] + [
+        krl_num(v, 5) for v in kuka_abc_deg(X[None, :3, :3])[0]
+    ]
+    return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))

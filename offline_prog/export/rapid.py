@@ -27,9 +27,11 @@ import numpy as np
 from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
+from offline_prog.export.abb import abb_axes_deg, confdata
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines
+from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.robot.model import RobotModel, load_robot
@@ -40,7 +42,8 @@ APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retra
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
 MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
-# PLACEHOLDER gripper load (tload of a stationary tool): 5 kg, 100 mm along tool0's z.
+# PLACEHOLDER gripper load (tload of a stationary tool) when the cell gives no payload:
+# 5 kg, 100 mm along tool0's z (the header warns: PAYLOAD NOT SET).
 GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
@@ -59,35 +62,6 @@ class RapidResult:
     indices: np.ndarray
     max_chord_m: float
     max_angle_rad: float
-
-
-def abb_axes_deg(q: np.ndarray, *, j23_coupled: bool) -> np.ndarray:
-    """Controller axis values (N, 6) [deg] from URDF joint positions q (N, 6) [rad]."""
-    axes = np.rad2deg(np.asarray(q, dtype=float))
-    if j23_coupled:
-        axes[:, 2] += axes[:, 1]
-    return axes
-
-
-def confdata(robot: RobotModel, q: np.ndarray) -> np.ndarray:
-    """``[cf1, cf4, cf6, cfx]`` (N, 4) for URDF joints q (N, 6) [rad] of an OPW robot.
-
-    cfN = floor(axis N / 90°): 0 for [0°, 90°), -1 for [-90°, 0°), 1 for [90°, 180°) ...
-    cfx = 4·a + 2·b + c (RAPID TRM, confdata, 6-axis robots, table of 8 configurations):
-    a = wrist centre behind axis 1, b = wrist centre behind the lower arm (the line
-    axis 2 → axis 3), c = axis 5 value negative. In OPW terms (wrist centre in the arm plane):
-    a ⇔ x of the wrist centre in the frame turned by θ1 < 0; b ⇔ sin(θ3 + ψ3) < 0 with
-    ψ3 = atan2(a2, c3), the side of the lower-arm line the wrist centre is on.
-    """
-    p = robot.params
-    cf = np.floor(np.rad2deg(q[:, [0, 3, 5]]) / 90.0).astype(int)
-    theta = q * np.asarray(p.sign_corrections, float) - np.asarray(p.offsets, float)
-    t2, t23 = theta[:, 1], theta[:, 1] + theta[:, 2]
-    psi3, k = np.arctan2(p.a2, p.c3), np.hypot(p.a2, p.c3)
-    behind_axis1 = p.c2 * np.sin(t2) + k * np.sin(t23 + psi3) + p.a1 < 0.0
-    behind_lower_arm = np.sin(theta[:, 2] + psi3) < 0.0
-    cfx = 4 * behind_axis1 + 2 * behind_lower_arm + (q[:, 4] < 0.0)
-    return np.column_stack([cf, cfx]).astype(int)
 
 
 def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
@@ -140,6 +114,12 @@ def _pose(X: np.ndarray) -> str:
     q = RotationMatrix(X[:3, :3]).ToQuaternion().wxyz()
     q *= np.sign(q[0] + (q[0] == 0.0)) / np.linalg.norm(q)
     return f"[{_list(X[:3, 3] * 1e3, MM_DIGITS)},{_list(q, QUAT_DIGITS)}]"
+
+
+def _load(mass_kg: float, p_m: np.ndarray) -> str:
+    """loaddata ``[mass, cog [mm], [1,0,0,0], 0, 0, 0]`` of a point mass (no inertia);
+    RAPID needs mass > 0, so 0 kg is written as 0.001 kg."""
+    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[1,0,0,0],0,0,0]"
 
 
 def _robtarget(name: str, X: np.ndarray, conf: np.ndarray) -> str:
@@ -236,15 +216,24 @@ def write_rapid(
             for i in points
         ]
 
+    # Loads (RAPID TRM loaddata: a stationary tool's tload is the gripper, cog in tool0;
+    # GripLoad's cog is in the object frame of the robot-held wobj, here P).
+    load = payload(data.payload)
+    gripper_load, grip = GRIPPER_LOAD, []
+    if load is not None:
+        gripper_load = _load(load.gripper_mass_kg, load.p_EG)
+        grip = [f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};"]
     # Start (MoveAbsJ, then the linear approach) and retract.
     head = [
-        f"PERS tooldata {tool} := [FALSE,{_pose(data.X_BT)},{GRIPPER_LOAD}];",
+        f"PERS tooldata {tool} := [FALSE,{_pose(data.X_BT)},{gripper_load}];",
         f'PERS wobjdata {wobj} := [TRUE,TRUE,"",{_pose(data.X_EP)},[[0,0,0],[1,0,0,0]]];',
         _robtarget(names[0], data.X_PF[idx[0]], conf[0]),
     ]
     off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
     (_, q_start), (X_PT_ret, q_ret) = off or [(None, data.q[0]), (None, None)]
-    first, last = ["ConfJ \\On;", "ConfL \\On;"], []
+    first = ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * bool(grip)
+    last = []  # the part stays gripped after the program: its load stays set
+    head += grip
     if off:  # else: out of reach or not wanted, so start at the first process point
         head.append(_robtarget("pRetract", X_PT_ret, confdata(robot, q_ret[None])[0]))
         last.append(f"MoveL pRetract, {APPROACH_SPEED}, fine{tail}")
@@ -265,7 +254,12 @@ def write_rapid(
         f"{np.rad2deg(max_angle):.4f} deg ({dense.basis}); v_tcp = planned mean on each segment.",
         f"Approach/retract: {approach}"
         + (" (OUT OF REACH)" if approach_m and not off else "")
-        + ", not collision-checked. tload: PLACEHOLDER 5 kg gripper; part load: GripLoad.",
+        + ", not collision-checked. "
+        + (
+            "tload = gripper, GripLoad partLoad = part (see Payload above)."
+            if load
+            else "tload: PLACEHOLDER 5 kg gripper, no GripLoad (PAYLOAD NOT SET)."
+        ),
     ]
     header = header_lines(data, conventions=conventions, forced=forced)
     head = ["! " + rapid_comment(line) for line in header] + head

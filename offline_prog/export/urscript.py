@@ -22,6 +22,7 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.densify import densify
 from offline_prog.export.header import header_lines
 from offline_prog.export.krl_points import process_points
+from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import identifier, urscript_comment
 
@@ -117,6 +118,9 @@ def urscript_text(
     header = header_lines(data, conventions=conventions, forced=forced)
     lines = [f"# {urscript_comment(line)}" for line in header]
     lines.append(f"def {name}():")
+    if (load := payload(data.payload)) is not None:  # gripper + part, CoG in the flange
+        mass, p_EC = load.total(data.X_EP)
+        lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
     q0 = data.q[0]
     lines.append(f"  movej({_list(q0)}, a={START_ACCEL_RAD_S2}, v={START_SPEED_RAD_S})")
     if mode == "servoj":

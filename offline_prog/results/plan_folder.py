@@ -28,6 +28,7 @@ from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
 from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
+from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
 from offline_prog.results.report import report
@@ -126,6 +127,7 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         qd_max=plan.robot.qd_max,
         j23_coupled=plan.robot.j23_coupled,
         language=plan.robot.language,
+        payload=payload_record(cell),
         sigma_dense=s_dense,
         X_PF_dense=X_PF_dense,
     )
