@@ -98,3 +98,14 @@ def test_export_out_is_an_existing_file(capsys, planned_folder, tmp_path):
     plan_dir = planned_folder("seal_plate_kr16")[1]
     code, err = run(capsys, "export", plan_dir, "--format", "csv", "--out", tmp_path / "file")
     assert code == 2 and len(err) == 1 and str(tmp_path / "file") in err[0], err
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".ply", ".obj"])
+def test_corrupt_part_mesh_is_one_line_exit_2(capsys, tmp_path, suffix):
+    from config.test_cell_errors import BASE, write_cell  # tests/config
+
+    cell = write_cell(tmp_path, BASE.replace("part:\n", f"part:\n  mesh: part{suffix}\n", 1))
+    (tmp_path / f"part{suffix}").write_bytes(b"solid x\n\x00\xff\xfe garbage" * 50)
+    code, err = run(capsys, "plan", cell, "--out", tmp_path / "out")
+    assert code == 2 and len(err) == 1 and "part.mesh" in err[0], err
+    assert not (tmp_path / "out").exists()
