@@ -8,7 +8,7 @@ and exit code 3 (``--debug`` shows the traceback).
 
 from __future__ import annotations
 
-import argparse
+import errno
 import logging
 import sys
 import time
@@ -17,89 +17,17 @@ from pathlib import Path
 import numpy as np
 from rich.console import Console
 
+from offline_prog.cli_flags import EXIT_BAD_INPUT, one_line, parser
+
 EXIT_PLAN_FAILED = 1
-EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130  # Ctrl-C, as shells report SIGINT
-
-
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="offline-prog",
-        description="Plan robot motions that carry a part past a spatially fixed tool.",
-    )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
-    commands = parser.add_subparsers(dest="command", required=True)
-    plan = commands.add_parser("plan", help="plan a cell and write the outputs")
-    plan.add_argument("cell", type=Path, help="work-cell YAML file")
-    plan.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
-    )
-    plan.add_argument(
-        "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
-    )
-    plan.add_argument("--port", type=int, default=7000, help="MeshCat port for --preview")
-    preview = commands.add_parser("preview", help="plan a cell and show it in MeshCat")
-    preview.add_argument("cell", type=Path, help="work-cell YAML file")
-    preview.add_argument("--port", type=int, default=7000, help="MeshCat port (default 7000)")
-    preview.add_argument(
-        "--seconds",
-        type=float,
-        default=None,
-        help="keep the server this long (default: until Ctrl-C)",
-    )
-    robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
-    robot_commands = robots.add_subparsers(dest="robots_command", required=True)
-    robot_commands.add_parser("list", help="the robots in offline_prog/robots")
-    matrix = robot_commands.add_parser(
-        "self-collision",
-        help="sample configurations and write robots/<robot>/self_collision.yaml",
-    )
-    matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
-    matrix.add_argument("--samples", type=int, default=10_000, help="configurations (10000)")
-    matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
-    export = commands.add_parser("export", help="re-export programs from a finished plan")
-    export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
-    export.add_argument(
-        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
-    )
-    export.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"
-    )
-    export.add_argument(
-        "--force", action="store_true", help="export even if the plan failed (the header says so)"
-    )
-    export.add_argument(
-        "--style",
-        choices=["external_tcp", "flange"],
-        default=None,
-        help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
-    )
-    export.add_argument(
-        "--mode",
-        choices=["servoj", "movel"],
-        default=None,
-        help="URScript: joint trajectory (servoj) or movel poses",
-    )
-    export.add_argument(
-        "--chord-tol-mm",
-        type=float,
-        default=None,
-        help="Cartesian point density: chordal tolerance [mm] (default 0.05)",
-    )
-    export.add_argument(
-        "--angle-tol-deg",
-        type=float,
-        default=None,
-        help="Cartesian point density: orientation tolerance [deg] (default 0.1)",
-    )
-    export.add_argument(
-        "--line-limit",
-        type=int,
-        default=None,
-        help="split programs longer than this (KRL 1400, RAPID 5000)",
-    )
-    return parser
+# OSErrors the user's machine causes, not our code: exit 2 naming the path.
+USER_ERRNOS = {
+    errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.ENOTDIR,
+    errno.EISDIR, errno.EEXIST, errno.ENOENT, errno.ENAMETOOLONG, errno.EMFILE, errno.EXDEV,
+    errno.ELOOP, errno.EIO,
+}  # fmt: skip
 
 
 def _export_options(args) -> dict:
@@ -129,8 +57,6 @@ def _run_robots(args, console: Console) -> None:
         return
     from offline_prog.scene.self_collision import write_matrix
 
-    if args.samples < 1:
-        raise InputError("--samples", "", f"must be at least 1, got {args.samples}")
     try:
         robot = load_robot(args.robot)
     except ValueError as error:
@@ -193,22 +119,25 @@ def exit_code(error: BaseException, args) -> tuple[int, str]:
         args.command == "export" and isinstance(error, ValueError)
     ):
         return EXIT_BAD_INPUT, f"error: {error}"
+    if isinstance(error, OSError) and error.errno in USER_ERRNOS:  # disk full, permissions
+        where = error.filename or getattr(args, "out", None) or ""
+        return EXIT_BAD_INPUT, f"error: {where}: {error.strerror}"
     return EXIT_INTERNAL, f"internal error: {type(error).__name__}: {error} (rerun with --debug)"
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    args = parser().parse_args(argv)
     console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
     started = time.perf_counter()
 
     def fail(message: str, code: int) -> int:
         """One plain line on stderr (no rich markup), and the exit code."""
-        errors.print(message, markup=False, highlight=False)
+        errors.print(one_line(message), markup=False, highlight=False)
         return code
 
     try:
         from offline_prog.plan import plan_cell
-        from offline_prog.results.plan_folder import write_outputs
+        from offline_prog.results.plan_folder import check_out_dir, write_outputs
         from offline_prog.results.summary import print_summary
 
         # After pydrake's import (it sets the level): its INFO lines would break
@@ -223,9 +152,11 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "preview":
             args.preview, args.out = True, None
+        out = args.out or Path("out") / args.cell.stem
+        if args.command == "plan":
+            check_out_dir(out)  # before planning: a bad --out is known now
         with errors.status("planning") as status:
             plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
-            out = args.out or Path("out") / args.cell.stem
             status.update("writing outputs")
             if args.command == "plan":
                 files, report = write_outputs(plan, out)

@@ -23,3 +23,17 @@ CUSP_PEAK_RATIO = 3.0
 
 # Length units a cell file may use, in metres per unit.
 UNIT_SCALE = {"m": 1.0, "mm": 1e-3}
+
+# Input limits: no hang and no runaway memory on a hostile or mistaken input. Each is
+# named here once; the message that enforces it quotes it.
+MAX_CELL_FILE_BYTES = 1_000_000  # a cell file is a few kB; larger is not a cell file
+MAX_DATA_FILE_BYTES = 200_000_000  # path CSV / DXF and meshes
+MAX_YAML_NODES = 100_000  # values in a cell file, aliases expanded (alias bombs)
+MAX_YAML_DEPTH = 50  # nesting of a cell file's lists and mappings
+MAX_SAMPLES = 2_000_000  # trajectory samples of one plan (duration x sample rate)
+MAX_SAMPLE_RATE_HZ = 10_000.0  # controllers interpolate at 0.25-4 kHz
+LIMIT_CHECK_RATE_HZ = 1000.0  # joint speed/acceleration checked at this rate
+MAX_SPEED_M_S = 2.0  # motion.speed: process speeds are mm/s to ~1 m/s; above is a unit slip
+MAX_VALUE_CHARS = 80  # a value quoted in an error message is cut to this
+MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this package drives
+MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin

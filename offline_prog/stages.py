@@ -18,6 +18,7 @@ from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_too
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
+from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
 from offline_prog.errors import InputError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
 from offline_prog.path.arc_length import ArcLengthPath
@@ -190,6 +191,15 @@ def attempt_motion(
     nominal = sin2_time_law(
         parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
     )
+    samples = nominal.duration * max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ)
+    if samples > MAX_SAMPLES:  # memory: every sample holds poses, joints, distances
+        raise InputError(
+            inputs.file,
+            "motion",
+            f"{nominal.duration:.0f} s at {max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ):g} Hz"
+            f" is {samples:,.0f} samples, more than {MAX_SAMPLES:,}; raise motion.speed or "
+            "lower motion.sample_rate_hz",
+        )
     joints = plan_joint_trajectory(
         inputs.robot,
         inputs.X_IB,

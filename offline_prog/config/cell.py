@@ -13,11 +13,12 @@ import types
 import typing
 from pathlib import Path
 
-import yaml
 from pydrake.common.schema import Transform
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform
 
+from offline_prog.config import safe_yaml
+from offline_prog.config.safe_yaml import short_repr
 from offline_prog.errors import InputError
 
 REQUIRED = {"required": True}
@@ -67,6 +68,17 @@ class PartConfig:
     mesh: str | None = None  # STL/OBJ/PLY in P, relative to the cell file
     mesh_units: str = "m"
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
+    mass_kg: float | None = None  # payload: the part's mass ...
+    center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
+
+
+@dataclasses.dataclass
+class GripperConfig:
+    """The robot-held gripper that holds the part: its mass and centre of mass in the
+    flange frame E (payload statements of the programs)."""
+
+    mass_kg: float = required()
+    center_of_mass_mm: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 @dataclasses.dataclass
@@ -87,7 +99,7 @@ class AnalyticPath:
 @dataclasses.dataclass
 class PathConfig:
     units: str = required()  # m | mm
-    closed: bool = required()
+    closed: bool = False  # a closed contour (periodic spline): the ends must meet
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
@@ -120,33 +132,29 @@ class Cell:
     motion: MotionConfig = dataclasses.field(default_factory=MotionConfig, metadata=REQUIRED)
     name: str = ""
     description: str = ""
+    gripper: GripperConfig | None = None
     obstacles: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in I
     # Pairs of shape names whose contact is intended (the tool tip on the part).
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
-
-
-class _TagTolerantLoader(yaml.SafeLoader):
-    """Reads Drake's tagged nodes (``!Rpy {...}``) as {"__tag__": tag, **mapping}."""
-
-
-def _construct_tagged(loader, tag_suffix, node):
-    if isinstance(node, yaml.MappingNode):
-        return {"__tag__": "!" + tag_suffix, **loader.construct_mapping(node, deep=True)}
-    return {"__tag__": "!" + tag_suffix}
-
-
-_TagTolerantLoader.add_multi_constructor("!", _construct_tagged)
 
 
 def _is_number(value) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
+def _is_float_text(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _check_vector(file, key, value, size):
     if not (isinstance(value, list) and len(value) == size and all(map(_is_number, value))):
-        raise InputError(file, key, f"expected a list of {size} numbers, got {value!r}")
+        raise InputError(file, key, f"expected a list of {size} numbers, got {short_repr(value)}")
     if not all(math.isfinite(v) for v in value):
-        raise InputError(file, key, f"NaN or infinity in {value!r}")
+        raise InputError(file, key, f"NaN or infinity in {short_repr(value)}")
 
 
 def _check_transform(file, key, raw):
@@ -193,15 +201,15 @@ def _check_value(file, key, raw, schema):
         )
     ):
         if not isinstance(raw, list):
-            raise InputError(file, key, f"expected a list, got {raw!r}")
+            raise InputError(file, key, f"expected a list, got {short_repr(raw)}")
         for i, item in enumerate(raw):
             _check_value(file, f"{key}[{i}]", item, args[0])
         return
     if origin is list:
         if not (isinstance(raw, list) and all(map(_is_number, raw))):
-            raise InputError(file, key, f"expected a list of numbers, got {raw!r}")
+            raise InputError(file, key, f"expected a list of numbers, got {short_repr(raw)}")
         if not all(math.isfinite(v) for v in raw):
-            raise InputError(file, key, f"NaN or infinity in {raw!r}")
+            raise InputError(file, key, f"NaN or infinity in {short_repr(raw)}")
         return
     expected = {
         float: _is_number,
@@ -210,7 +218,10 @@ def _check_value(file, key, raw, schema):
         str: lambda v: isinstance(v, str),
     }[schema]
     if not expected(raw):
-        raise InputError(file, key, f"expected {schema.__name__}, got {raw!r}")
+        hint = ""
+        if schema is float and isinstance(raw, str) and _is_float_text(raw):
+            hint = f" (YAML reads {raw} as text: write {float(raw):.1e})"
+        raise InputError(file, key, f"expected {schema.__name__}, got {short_repr(raw)}{hint}")
     if schema is float and not math.isfinite(raw):
         raise InputError(file, key, f"{raw} is not a finite number")
 
@@ -240,18 +251,8 @@ def load_cell(file: str | os.PathLike) -> Cell:
         InputError: with a one-line message naming the file, key and reason.
     """
     file = Path(file)
-    try:
-        text = file.read_text()
-    except OSError as error:
-        raise InputError(file, "", f"cannot read ({error.strerror})") from None
-    try:
-        raw = yaml.load(text, Loader=_TagTolerantLoader)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        line = f"line {mark.line + 1}: " if mark else ""
-        raise InputError(
-            file, "", f"{line}not valid YAML ({getattr(error, 'problem', error)})"
-        ) from None
+    text = safe_yaml.read_text(file)  # size, encoding
+    raw = safe_yaml.load(file, text)  # aliases, depth, duplicate keys
     _check_mapping(file, "", raw, Cell)
     try:
         return yaml_load_typed(schema=Cell, data=text)

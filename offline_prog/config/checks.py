@@ -10,7 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cell import Cell
-from offline_prog.constants import UNIT_SCALE
+from offline_prog.constants import (
+    MAX_CENTER_OF_MASS_MM,
+    MAX_DATA_FILE_BYTES,
+    MAX_PAYLOAD_KG,
+    MAX_SAMPLE_RATE_HZ,
+    MAX_SPEED_M_S,
+    UNIT_SCALE,
+)
 from offline_prog.errors import InputError
 
 
@@ -41,12 +48,13 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             "path",
             f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
         )
-    for key in ("points", "dxf"):
-        value = getattr(path, key)
-        if value is not None and not (file.parent / value).is_file():
-            raise _error(file, f"path.{key}", f"file {file.parent / value} does not exist")
-    if cell.part.mesh is not None and not (file.parent / cell.part.mesh).is_file():
-        raise _error(file, "part.mesh", f"file {file.parent / cell.part.mesh} does not exist")
+    for key, value in (
+        ("path.points", path.points),
+        ("path.dxf", path.dxf),
+        ("part.mesh", cell.part.mesh),
+    ):
+        if value is not None:
+            _check_data_file(file, key, file.parent / value)
     if path.normal_from_mesh and cell.part.mesh is None:
         raise _error(file, "path.normal_from_mesh", "needs part.mesh")
     if path.normal is not None and np.linalg.norm(path.normal) < 1e-9:
@@ -62,6 +70,19 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     ):
         if not value > 0:
             raise _error(file, key, f"must be > 0, got {value}")
+    if motion.speed > MAX_SPEED_M_S:
+        raise _error(
+            file,
+            "motion.speed",
+            f"{motion.speed:g} m/s is more than {MAX_SPEED_M_S:g} m/s (the unit is m/s: "
+            f"{motion.speed:g} mm/s is {motion.speed * 1e-3:g})",
+        )
+    if motion.sample_rate_hz > MAX_SAMPLE_RATE_HZ:
+        raise _error(
+            file,
+            "motion.sample_rate_hz",
+            f"{motion.sample_rate_hz:g} Hz is more than {MAX_SAMPLE_RATE_HZ:g} Hz",
+        )
     if motion.speed_reference not in ("tcp", "flange"):
         raise _error(
             file, "motion.speed_reference", f"{motion.speed_reference!r} (use tcp or flange)"
@@ -75,7 +96,33 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     for key in ("clearance", "self_clearance"):
         if not getattr(motion, key) >= 0:
             raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
+    _check_payload(file, cell)
     _check_shapes(file, cell)
+
+
+def _check_payload(file: Path, cell: Cell) -> None:
+    """Masses within [0, MAX_PAYLOAD_KG], centres of mass 3 numbers within reach."""
+    loads = [("part", cell.part.mass_kg, cell.part.center_of_mass_mm)]
+    if cell.gripper is not None:
+        loads.append(("gripper", cell.gripper.mass_kg, cell.gripper.center_of_mass_mm))
+    for owner, mass, com in loads:
+        if mass is not None and not 0.0 <= mass <= MAX_PAYLOAD_KG:
+            raise _error(file, f"{owner}.mass_kg", f"must be within [0, {MAX_PAYLOAD_KG:g}] kg")
+        if com is not None and not (len(com) == 3 and np.linalg.norm(com) <= MAX_CENTER_OF_MASS_MM):
+            raise _error(
+                file,
+                f"{owner}.center_of_mass_mm",
+                f"expected [x, y, z] within {MAX_CENTER_OF_MASS_MM:g} mm, got {com}",
+            )
+
+
+def _check_data_file(file: Path, key: str, data_file: Path) -> None:
+    """A path or mesh file exists and is at most MAX_DATA_FILE_BYTES."""
+    if not data_file.is_file():
+        raise _error(file, key, f"file {data_file} does not exist")
+    size = data_file.stat().st_size
+    if size > MAX_DATA_FILE_BYTES:
+        raise _error(file, key, f"{data_file}: {size:,} bytes, more than {MAX_DATA_FILE_BYTES:,}")
 
 
 def _check_shapes(file: Path, cell: Cell) -> None:
@@ -100,10 +147,8 @@ def _check_shapes(file: Path, cell: Cell) -> None:
                 )
             if shape.mesh_units not in UNIT_SCALE:
                 raise _error(file, f"{where}.mesh_units", f"{shape.mesh_units!r} (use m or mm)")
-            if shape.shape == "mesh" and not (shape.mesh and (file.parent / shape.mesh).is_file()):
-                raise _error(
-                    file, f"{where}.mesh", f"file {file.parent / (shape.mesh or '')} does not exist"
-                )
+            if shape.shape == "mesh":
+                _check_data_file(file, f"{where}.mesh", file.parent / (shape.mesh or ""))
     for i, pair in enumerate(cell.allowed_contact):
         if len(pair) != 2:
             raise _error(file, f"allowed_contact[{i}]", f"expected [name, name], got {pair}")

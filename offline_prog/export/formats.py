@@ -1,9 +1,21 @@
-"""One entry point for every export format, and which ones a robot gets by default."""
+"""One entry point for every export format, and which ones a robot gets by default.
+
+A format's files are written into a temporary folder inside ``out_dir`` and moved into
+place; the folder's manifest (``atomic.MANIFEST``) lists them by format, so a re-export
+removes the files its previous run wrote and this one did not (``name_3.src`` after a
+split into fewer parts), and never a file we did not write.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
+from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_manifest
 from offline_prog.export.program import ProgramData
 
 FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
@@ -40,8 +52,41 @@ def export(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"
         )
+    return replace_owned(Path(out_dir), fmt, lambda folder: _write(data, fmt, folder, **options))
+
+
+def replace_owned(out_dir: Path, group: str, write: Callable[[Path], list[Path]]) -> list[Path]:
+    """Run ``write(folder)`` on an empty temporary folder, move the files it wrote into
+    out_dir, and remove the files the manifest listed under ``group`` that it did not
+    write again. Returns the files in out_dir.
+
+    Order: the manifest first lists old and new names (a crash then leaves no file we
+    do not know of), the files move, then the manifest lists the new names only and the
+    stale ones go.
+    """
+    out_dir.mkdir(parents=True, exist_ok=True)
+    remove_stale(out_dir)
+    staging = Path(tempfile.mkdtemp(dir=out_dir, prefix=temp_prefix("export")))
+    try:
+        names = [file.name for file in write(staging)]
+        owned = (read_manifest(out_dir) or {}).get("files", {})
+        old = owned.get(group, [])
+        write_manifest(out_dir, {**owned, group: sorted(set(old) | set(names))})
+        for name in names:
+            os.replace(staging / name, out_dir / name)
+        write_manifest(out_dir, {**owned, group: names})
+        others = {n for g, listed in owned.items() if g != group for n in listed}
+        for name in set(old) - set(names) - others:
+            with contextlib.suppress(FileNotFoundError):
+                (out_dir / name).unlink()
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return [out_dir / name for name in names]
+
+
+def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
+    """Write one format's files into out_dir (a fresh folder)."""
     forced = not data.feasible
-    out_dir = Path(out_dir)
     if fmt == "csv":
         from offline_prog.export.joint_files import write_joint_csv
 

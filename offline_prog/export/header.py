@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime
 
 from offline_prog import __version__
+from offline_prog.export.payload import payload_note
 from offline_prog.export.program import ProgramData
 
 
@@ -28,4 +29,5 @@ def header_lines(data: ProgramData, *, conventions: list[str], forced: bool = Fa
     ]
     if forced or not data.feasible:
         lines.append(f"WARNING: EXPORTED WITH --force FROM A FAILED PLAN: {data.failure}")
+    lines.append(payload_note(data.payload, data.X_EP))
     return lines + conventions

@@ -24,20 +24,26 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import textwrap
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.density import (
-    DEFAULT_ANGLE_TOL_RAD,
-    DEFAULT_CHORD_TOL_M,
-)
+from offline_prog.export.densify import densify
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.header import header_lines
+from offline_prog.export.krl_header import krl_comments, krl_conventions
 from offline_prog.export.krl_points import process_points
-from offline_prog.export.kuka import X_KE, joints_near, kuka_abc_deg, status_turn
+from offline_prog.export.kuka import (
+    X_KE,
+    joints_near,
+    krl_frame,
+    krl_num,
+    status_turn,
+    vel_cp,
+)
+from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.robot.model import load_robot
 
@@ -48,8 +54,6 @@ STYLES = ("external_tcp", "flange")
 TCP_POSE_CONVENTIONS = ("X_TP", "X_PF")
 MAX_NAME_CHARS = 24  # KRL names (KSS 8 KRL quick guide)
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
-VEL_CP_STEP_M_S = 1e-4  # $VEL.CP is floored to 0.1 mm/s: never above the plan
-VEL_CP_MIN_M_S = 1e-3
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 20, 50  # the joint move to the approach pose [%]
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
@@ -57,7 +61,7 @@ _MAIN = """DEF {name}( )
 {ext};FOLD INI
 BAS(#INITMOV,0)
 ;ENDFOLD (INI)
-$BASE={base}
+{load}$BASE={base}
 $TOOL=PART_ON_FLANGE
 $IPO_MODE={ipo}
 $ORI_TYPE=#VAR
@@ -92,23 +96,6 @@ class KrlResult:
     max_angle_rad: float
 
 
-def _num(value: float, digits: int) -> str:
-    text = f"{value:.{digits}f}"
-    return text[1:] if float(text) == 0.0 and text.startswith("-") else text
-
-
-def _frame(X: np.ndarray) -> str:
-    """``X .., Y .., Z .., A .., B .., C ..`` of a pose (4, 4) [m] in mm and degrees."""
-    values = [_num(v, 4) for v in X[:3, 3] * 1e3] + [
-        _num(v, 5) for v in kuka_abc_deg(X[None, :3, :3])[0]
-    ]
-    return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))
-
-
-def _vel_cp(speed_m_s: float) -> float:
-    return max(np.floor(speed_m_s / VEL_CP_STEP_M_S + 1e-6) * VEL_CP_STEP_M_S, VEL_CP_MIN_M_S)
-
-
 def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
     """``$VEL.CP`` and ``LIN`` lines to XP2..XPn, in parts of at most line_limit lines.
 
@@ -117,7 +104,7 @@ def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
     """
     parts, v_now = [[]], None
     for m in range(1, len(idx)):
-        v = _vel_cp(speed[idx[m - 1] : idx[m] + 1].max())
+        v = vel_cp(speed[idx[m - 1] : idx[m] + 1].max())
         lin = f"LIN {names[m]}" + (" C_DIS" if m < len(idx) - 1 else "")
         block = [f"$VEL.CP={v:.4f}", lin] if v != v_now else [lin]
         if parts[-1] and len(parts[-1]) + len(block) > line_limit:
@@ -126,39 +113,6 @@ def _process_lines(names, idx, speed, line_limit: int) -> list[list[str]]:
         parts[-1] += block
         v_now = v
     return parts
-
-
-def _conventions(style: str, convention: str, n: int, chord_tol_m, angle_tol_rad) -> list[str]:
-    """Header lines stating units, frames and conventions (the caller appends the
-    achieved deviation to the second last)."""
-    if style == "flange":
-        points = "Style flange: $IPO_MODE=#BASE, $BASE=$NULLFRAME ($ROBROOT), $TOOL = part P in "
-        points += "$FLANGE; points: pose of P in $ROBROOT."
-    else:
-        points = "Style external_tcp: $IPO_MODE=#TCP, $BASE = fixed tool T in $ROBROOT, $TOOL = "
-        points += "part P in $FLANGE; points: " + (
-            "pose of P in T (X_TP), flange = $BASE:POS:inv($TOOL)."
-            if convention == "X_TP"
-            else "pose of T in P (X_PF), flange = $BASE:inv(POS):inv($TOOL)."
-        )
-    return [
-        "KRL for KSS 8. X, Y, Z in mm; A, B, C in deg, R = Rz(A)*Ry(B)*Rx(C) (Z-Y'-X''); "
-        "$VEL.CP in m/s; $APO.CDIS in mm.",
-        "E6AXIS A1..A6 = URDF joints 1..6 in deg (KUKA signs and zeros). $WORLD = $ROBROOT = "
-        "URDF base_link (check on the controller). $FLANGE = URDF tool0 (z out of the flange).",
-        points,
-        "Status: bit0 wrist centre behind A1 (overhead), bit1 wrist centre above the A2-A3 line "
-        "(elbow up), bit2 A5 < 0. Turn: bit i set when A(i+1) < 0.",
-        f"{n} process points: chord <= {chord_tol_m * 1e3:g} mm, orientation <= "
-        f"{np.rad2deg(angle_tol_rad):g} deg",
-        "Not set here: $LOAD (gripper + part), process I/O. Approach and retract moves are not "
-        "collision-checked.",
-    ]
-
-
-def _comments(lines: list[str]) -> list[str]:
-    ascii_lines = [line.encode("ascii", "replace").decode() for line in lines]
-    return ["; " + part for line in ascii_lines for part in textwrap.wrap(line, 100) or [""]]
 
 
 def _check(name: str, style: str, convention: str, line_limit: int, tolerances) -> None:
@@ -215,7 +169,11 @@ def write_krl(
     robot = load_robot(data.robot)
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
-    idx, max_chord, max_angle = process_points(data, style, chord_tol_m, angle_tol_rad)
+    dense = densify(data, chord_tol_m, angle_tol_rad)
+    data = dense.data
+    tolerances = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
+    idx, max_chord, max_angle = process_points(data, style, *tolerances, tcp_pose_convention)
+    max_chord, max_angle = dense.bound(max_chord, max_angle)
     off = np.eye(4)
     off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
     X_PF_off = data.X_PF[[0, -1]] @ off  # approach, retract
@@ -235,18 +193,21 @@ def write_krl(
     status, turn = status_turn(robot.params, np.vstack([data.q[idx], q_retract]))
     names = [f"XP{k + 1}" for k in range(len(idx))] + ["XRETRACT"]
     decl = {
-        n: f"DECL E6POS {n}={{{_frame(X)},S {s},T {t}{_ZEROS}}}"
+        n: f"DECL E6POS {n}={{{krl_frame(X)},S {s},T {t}{_ZEROS}}}"
         for n, X, s, t in zip(names, poses, status, turn, strict=True)
     }
     R = data.X_BE[:, :3, :3]
     omega = Rotation.from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]).magnitude() / np.diff(data.t)
     parts = _process_lines(names, idx, speed, line_limit)
     subs = [f"{name}_{k + 1}" for k in range(len(parts))] if len(parts) > 1 else []
-    conventions = _conventions(style, tcp_pose_convention, len(idx), chord_tol_m, angle_tol_rad)
-    conventions[-2] += f" (achieved {max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg)."
-    head = _comments(header_lines(data, conventions=conventions, forced=forced))
+    conventions = krl_conventions(style, tcp_pose_convention, len(idx), chord_tol_m, angle_tol_rad)
+    conventions[-2] += (
+        f" (achieved {max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg, {dense.basis})."
+    )
+    head = krl_comments(header_lines(data, conventions=conventions, forced=forced))
     src = _MAIN.format(
         name=name,
+        load=_load(data),
         ext="".join(f"EXT {sub}( )\n" for sub in subs),
         base=base,
         ipo=ipo,
@@ -255,15 +216,15 @@ def write_krl(
         ori=max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S),
         cdis=blend_m * 1e3,
         approach=approach_m * 1e3,
-        v=_vel_cp(data.process_speed_m_s),
+        v=vel_cp(data.process_speed_m_s),
         process="\n".join([f"{sub}( )" for sub in subs] or parts[0]),
     )
-    axes = ",".join(f"A{i + 1} {_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_approach)))
+    axes = ",".join(f"A{i + 1} {krl_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_approach)))
     dat = [
         f"DEFDAT {name}",
         "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
-        f"DECL FRAME PART_ON_FLANGE={{{_frame(X_KE @ data.X_EP)}}}",
-        *([f"DECL FRAME FIXED_TOOL={{{_frame(data.X_BT)}}}"] if style != "flange" else []),
+        f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ data.X_EP)}}}",
+        *([f"DECL FRAME FIXED_TOOL={{{krl_frame(data.X_BT)}}}"] if style != "flange" else []),
         f"DECL E6AXIS XAPPROACH={{{axes}{_ZEROS}}}",
         decl["XP1"],
         decl["XRETRACT"],
@@ -280,6 +241,18 @@ def write_krl(
             [*part_head, f"DEFDAT {sub}", *points, "ENDDAT"],
         )
     return KrlResult(files, len(idx), idx, max_chord, max_angle)
+
+
+def _load(data: ProgramData) -> str:
+    """``$LOAD`` (gripper + part on $FLANGE = E, point mass) when the cell gives both."""
+    load = payload(data.payload)
+    if load is None:
+        return ""  # the header warns: PAYLOAD NOT SET
+    mass, p_EC = load.total(data.X_EP)
+    x, y, z = (krl_num(v, 1) for v in (X_KE[:3, :3] @ p_EC + X_KE[:3, 3]) * 1e3)
+    return (
+        f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A 0,B 0,C 0}},J {{X 0,Y 0,Z 0}}}}\n"
+    )
 
 
 def _write(folder: Path, name: str, src: list[str], dat: list[str]) -> list[Path]:

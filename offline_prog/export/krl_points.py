@@ -41,28 +41,39 @@ def _nozzle_deviation(X_BP, X_BT, X_PF, i: int, j: int) -> tuple[float, float]:
     return float(gap.min(axis=1).max()), float(angle.max())
 
 
-def process_points(data: ProgramData, style: str, chord_tol_m: float, angle_tol_rad: float):
+def process_points(
+    data: ProgramData,
+    style: str,
+    chord_tol_m: float,
+    angle_tol_rad: float,
+    convention: str = "X_TP",
+):
     """The samples that become LIN points, and the worst deviation [m, rad].
 
-    ``external_tcp``: the controller moves the fixed TCP in straight lines across the
-    part, so the process frames X_PF (N, 4, 4) are thinned to the tolerances.
-    ``flange``: each LIN segment of X_BP is split until the nozzle's curve on the part
-    also stays within them.
+    ``external_tcp``: the points hold the tolerances both if the controller moves the
+    fixed TCP in straight lines across the part (the process frames X_PF interpolated)
+    and if it interpolates the written poses (X_TP = P in T for the "X_TP" convention:
+    the tool's curve on the part then bends with the part's rotation). ``flange``: each
+    LIN segment of X_BP is split until the nozzle's curve on the part also stays within
+    them.
 
     Returns:
         (indices (K,), max chord [m], max angle [rad]).
     """
     p, R = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
     chosen = select_points(p, R, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
-    if style == "external_tcp":
+    if style == "external_tcp" and convention == "X_PF":  # the written poses are X_PF
         return chosen.indices, chosen.max_chord_m, chosen.max_angle_rad
-    X_BP = data.X_BE @ data.X_EP
+    if style == "flange":  # the controller interpolates P in B; the tool is fixed in B
+        X_BP, X_BT = data.X_BE @ data.X_EP, data.X_BT
+    else:  # it interpolates P in T, the tool at T's origin
+        X_BP, X_BT = np.linalg.inv(data.X_PF), np.eye(4)
     indices, worst = [int(chosen.indices[0])], np.zeros(2)
     stack = list(zip(chosen.indices[1:], chosen.indices[:-1], strict=True))[::-1]
     while stack:  # split each LIN segment until the nozzle curve on P fits as well
         j, i = (int(v) for v in stack.pop())
         deviation = np.maximum(
-            segment_deviation(p, R, i, j), _nozzle_deviation(X_BP, data.X_BT, data.X_PF, i, j)
+            segment_deviation(p, R, i, j), _nozzle_deviation(X_BP, X_BT, data.X_PF, i, j)
         )
         if j - i > 1 and (deviation[0] > chord_tol_m or deviation[1] > angle_tol_rad):
             stack += [(j, (i + j) // 2), ((i + j) // 2, i)]

@@ -12,6 +12,24 @@ from offline_prog.robot.kinematics_opw import OpwParameters, wrap_to_pi
 # URDF tool0 E in KUKA's $FLANGE K: the same frame (kuka_experimental marks tool0 as
 # "the $FLANGE coordinate system in KUKA KRC controllers").
 X_KE = np.eye(4)
+VEL_CP_STEP_M_S = 1e-4  # $VEL.CP is floored to 0.1 mm/s: never above the plan
+VEL_CP_MIN_M_S = 1e-3
+# $VEL.CP is in m/s; KSS accepts at most 3 m/s ($VEL_MA.CP, KSS 8 system variables).
+VEL_CP_MAX_M_S = 3.0
+
+
+def vel_cp(speed_m_s: float) -> float:
+    """``$VEL.CP`` [m/s] for a planned speed: floored to 0.1 mm/s, at least 1 mm/s.
+
+    Raises:
+        ValueError: the speed is not finite or above VEL_CP_MAX_M_S (a unit slip: mm/s).
+    """
+    if not 0.0 <= speed_m_s <= VEL_CP_MAX_M_S:
+        raise ValueError(
+            f"write_krl: speed {speed_m_s:g} m/s is beyond $VEL.CP's {VEL_CP_MAX_M_S:g} m/s "
+            "(speeds are m/s, not mm/s)"
+        )
+    return max(np.floor(speed_m_s / VEL_CP_STEP_M_S + 1e-6) * VEL_CP_STEP_M_S, VEL_CP_MIN_M_S)
 
 
 def kuka_abc_deg(R: np.ndarray) -> np.ndarray:
@@ -52,3 +70,17 @@ def joints_near(robot, X_BE, q_ref, data, what: str) -> np.ndarray:
     if not ok.any():
         raise ValueError(f"write_krl: the {what} pose is out of reach (approach_m too large?)")
     return q[ok][np.abs(q[ok] - q_ref).max(axis=1).argmin()]
+
+
+def krl_num(value: float, digits: int) -> str:
+    """A KRL number with ``digits`` decimals, never "-0.0..."."""
+    text = f"{value:.{digits}f}"
+    return text[1:] if float(text) == 0.0 and text.startswith("-") else text
+
+
+def krl_frame(X: np.ndarray) -> str:
+    """``X .., Y .., Z .., A .., B .., C ..`` of a pose (4, 4) [m] in mm and degrees."""
+    values = [krl_num(v, 4) for v in X[:3, 3] * 1e3] + [
+        krl_num(v, 5) for v in kuka_abc_deg(X[None, :3, :3])[0]
+    ]
+    return ",".join(f"{key} {v}" for key, v in zip("XYZABC", values, strict=True))

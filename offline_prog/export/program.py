@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.atomic import atomic_stream
+
 PLAN_FILE = "plan.npz"
 _ARRAYS = (
     "t",
@@ -30,6 +32,8 @@ _ARRAYS = (
     "q_upper",
     "qd_max",
 )
+# The continuous path on a fine grid of s (plans written before it existed lack it).
+_DENSE_ARRAYS = ("sigma_dense", "X_PF_dense")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -52,6 +56,9 @@ class ProgramData:
         q_lower, q_upper, qd_max: (6,) joint limits [rad, rad/s] of the controller's
             joints (see j23_coupled).
         generated: ISO time the plan was made.
+        sigma_dense: (M,) a fine grid of s [m] over the whole path (export.densify).
+        X_PF_dense: (M, 4, 4) the process frames of the continuous plan at sigma_dense,
+            so that point selection measures deviations between the samples too.
     """
 
     cell_name: str
@@ -80,6 +87,9 @@ class ProgramData:
     qd_max: np.ndarray
     j23_coupled: bool = False  # the controller counts axis 3 as q2 + q3 (ABB IRB 2400)
     language: str | None = None  # the controller's program format (robot.yaml)
+    payload: dict | None = None  # export.payload.payload_record (None: plan before payloads)
+    sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
+    X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
 
     def controller_column(self, col: dict, prefix: str, j: int) -> np.ndarray:
         """Column ``<prefix><j+1>`` of a trajectory table as the controller counts it
@@ -89,21 +99,19 @@ class ProgramData:
 
     def save(self, folder: Path) -> Path:
         """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
-        import os
-        import tempfile
-
         meta = {
-            f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in _ARRAYS
+            f.name: getattr(self, f.name)
+            for f in dataclasses.fields(self)
+            if f.name not in _ARRAYS + _DENSE_ARRAYS
         }
         meta["joint_names"] = list(self.joint_names)
         target = Path(folder) / PLAN_FILE
-        target.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=target.parent, suffix=".npz.tmp")
-        with os.fdopen(handle, "wb") as stream:
+        with atomic_stream(target) as stream:
             np.savez_compressed(
-                stream, meta=json.dumps(meta), **{name: getattr(self, name) for name in _ARRAYS}
+                stream,
+                meta=json.dumps(meta),
+                **{name: getattr(self, name) for name in _ARRAYS + _DENSE_ARRAYS},
             )
-        os.replace(temp, target)
         return target
 
     @classmethod
@@ -118,7 +126,13 @@ class ProgramData:
             with np.load(file) as data:
                 meta = json.loads(str(data["meta"]))
                 arrays = {name: np.asarray(data[name]) for name in _ARRAYS}
-        except (OSError, KeyError, ValueError) as error:
-            raise ValueError(f"{file}: not a plan folder ({error})") from None
-        meta["joint_names"] = tuple(meta["joint_names"])
-        return cls(**meta, **arrays)
+                arrays |= {name: np.asarray(data[name]) for name in _DENSE_ARRAYS if name in data}
+        except FileNotFoundError:
+            raise ValueError(f"{file}: not a plan folder (no {PLAN_FILE})") from None
+        except Exception as error:  # truncated or foreign: zipfile, zlib, pickle, json ...
+            raise ValueError(f"{file}: unreadable, not a complete plan ({error})") from None
+        try:
+            meta["joint_names"] = tuple(meta["joint_names"])
+            return cls(**meta, **arrays)
+        except (KeyError, TypeError) as error:
+            raise ValueError(f"{file}: not a plan of this version ({error})") from None

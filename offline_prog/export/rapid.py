@@ -21,16 +21,19 @@ Units at this edge: mm, degrees, quaternions ``[q1, q2, q3, q4] = [w, x, y, z]``
 from __future__ import annotations
 
 import dataclasses
-import re
 from pathlib import Path
 
 import numpy as np
 from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
+from offline_prog.export.abb import abb_axes_deg, confdata
+from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines
+from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
+from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.robot.model import RobotModel, load_robot
 
 DEFAULT_APPROACH_M = 0.02  # approach / retract along -y of F (y = pressing direction n)
@@ -38,15 +41,15 @@ START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ
 APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retract
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
-# PLACEHOLDER gripper load (tload of a stationary tool): 5 kg, 100 mm along tool0's z.
+MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
+# PLACEHOLDER gripper load (tload of a stationary tool) when the cell gives no payload:
+# 5 kg, 100 mm along tool0's z (the header warns: PAYLOAD NOT SET).
 GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
 NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 _PART_OVERHEAD = 6  # MODULE, comment, zone, PROC, ENDPROC, ENDMODULE
-_ASCII = {"°": " deg", "σ": "sigma", "≤": "<=", "≥": ">=", "×": "x", "π": "pi", "→": "->"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -61,35 +64,6 @@ class RapidResult:
     max_angle_rad: float
 
 
-def abb_axes_deg(q: np.ndarray, *, j23_coupled: bool) -> np.ndarray:
-    """Controller axis values (N, 6) [deg] from URDF joint positions q (N, 6) [rad]."""
-    axes = np.rad2deg(np.asarray(q, dtype=float))
-    if j23_coupled:
-        axes[:, 2] += axes[:, 1]
-    return axes
-
-
-def confdata(robot: RobotModel, q: np.ndarray) -> np.ndarray:
-    """``[cf1, cf4, cf6, cfx]`` (N, 4) for URDF joints q (N, 6) [rad] of an OPW robot.
-
-    cfN = floor(axis N / 90°): 0 for [0°, 90°), -1 for [-90°, 0°), 1 for [90°, 180°) ...
-    cfx = 4·a + 2·b + c (RAPID TRM, confdata, 6-axis robots, table of 8 configurations):
-    a = wrist centre behind axis 1, b = wrist centre behind the lower arm (the line
-    axis 2 → axis 3), c = axis 5 value negative. In OPW terms (wrist centre in the arm plane):
-    a ⇔ x of the wrist centre in the frame turned by θ1 < 0; b ⇔ sin(θ3 + ψ3) < 0 with
-    ψ3 = atan2(a2, c3), the side of the lower-arm line the wrist centre is on.
-    """
-    p = robot.params
-    cf = np.floor(np.rad2deg(q[:, [0, 3, 5]]) / 90.0).astype(int)
-    theta = q * np.asarray(p.sign_corrections, float) - np.asarray(p.offsets, float)
-    t2, t23 = theta[:, 1], theta[:, 1] + theta[:, 2]
-    psi3, k = np.arctan2(p.a2, p.c3), np.hypot(p.a2, p.c3)
-    behind_axis1 = p.c2 * np.sin(t2) + k * np.sin(t23 + psi3) + p.a1 < 0.0
-    behind_lower_arm = np.sin(theta[:, 2] + psi3) < 0.0
-    cfx = 4 * behind_axis1 + 2 * behind_lower_arm + (q[:, 4] < 0.0)
-    return np.column_stack([cf, cfx]).astype(int)
-
-
 def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
     """(n-1,) planned TCP speed on each LIN segment [mm/s]: the time mean of
     ``data.tcp_speed`` between its end samples (= planned length / duration), so the
@@ -99,7 +73,13 @@ def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
         np.trapezoid(v[a : b + 1], t[a : b + 1]) / (t[b] - t[a]) if t[b] > t[a] else v[b]
         for a, b in zip(indices[:-1], indices[1:], strict=True)
     ]
-    return np.maximum(np.round(np.asarray(mean) * 1e4) / 10.0, MIN_SPEED_MMS)
+    speeds = np.maximum(np.round(np.asarray(mean) * 1e4) / 10.0, MIN_SPEED_MMS)
+    if not np.all(speeds <= MAX_SPEED_MMS):  # NaN too
+        raise ValueError(
+            f"write_rapid: v_tcp {np.nanmax(speeds):g} mm/s is beyond {MAX_SPEED_MMS:g} mm/s "
+            "(the plan's speeds are m/s, not mm/s)"
+        )
+    return speeds
 
 
 def approach_and_retract(robot: RobotModel, data: ProgramData, distance_m: float):
@@ -136,15 +116,15 @@ def _pose(X: np.ndarray) -> str:
     return f"[{_list(X[:3, 3] * 1e3, MM_DIGITS)},{_list(q, QUAT_DIGITS)}]"
 
 
+def _load(mass_kg: float, p_m: np.ndarray) -> str:
+    """loaddata ``[mass, cog [mm], [1,0,0,0], 0, 0, 0]`` of a point mass (no inertia);
+    RAPID needs mass > 0, so 0 kg is written as 0.001 kg."""
+    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[1,0,0,0],0,0,0]"
+
+
 def _robtarget(name: str, X: np.ndarray, conf: np.ndarray) -> str:
     cf = ",".join(str(int(c)) for c in conf)
     return f"LOCAL CONST robtarget {name} := [{_pose(X)[1:-1]},[{cf}],{EXTAX}];"
-
-
-def _ascii(line: str) -> str:
-    for old, new in _ASCII.items():
-        line = line.replace(old, new)
-    return " ".join(line.split()).encode("ascii", "replace").decode()
 
 
 def _module_text(name: str, body: list[str], procs: dict[str, list[str]]) -> str:
@@ -201,8 +181,7 @@ def write_rapid(
     Raises:
         ValueError: naming the bad argument.
     """
-    if not _NAME.match(module) or len(module) > NAME_MAX - 6:
-        raise ValueError(f"module={module!r}: need a RAPID name of at most {NAME_MAX - 6} chars")
+    identifier(module, max_chars=NAME_MAX - 6, what="module")
     if not (chord_tol_m > 0 and angle_tol_rad > 0 and zone_mm >= 0 and approach_m >= 0):
         raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0, zone_mm >= 0, approach_m >= 0")
     robot = load_robot(data.robot)
@@ -210,14 +189,16 @@ def write_rapid(
     j23 = robot.j23_coupled if j23_coupled is None else j23_coupled
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
+    dense = densify(data, chord_tol_m, angle_tol_rad)
+    data = dense.data
+    chord_sel, angle_sel = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
     p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
-    sel = select_points(p_PF, R_PF, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
+    sel = select_points(p_PF, R_PF, chord_tol_m=chord_sel, angle_tol_rad=angle_sel)
     idx, n = sel.indices, len(sel.indices)
+    max_chord, max_angle = dense.bound(sel.max_chord_m, sel.max_angle_rad)
     conf, speeds = confdata(robot, data.q[idx]), segment_speeds_mms(data, idx)
-    tool, wobj = (
-        re.sub(r"[^A-Za-z0-9_]", "_", f"{k}_{s}")[:NAME_MAX]
-        for k, s in [("tool", data.tool), ("wobj", data.part)]
-    )
+    tool = identifier_from("tool", data.tool, max_chars=NAME_MAX)
+    wobj = identifier_from("wobj", data.part, max_chars=NAME_MAX)
     tail = f", {tool}\\WObj:={wobj};"
     names = [f"p{i:0{max(4, len(str(n - 1)))}d}" for i in range(n)]
     z = _list((zone_mm,) * 3 + (zone_mm / 10, zone_mm, zone_mm / 10), 5)[1:-1]
@@ -235,15 +216,24 @@ def write_rapid(
             for i in points
         ]
 
+    # Loads (RAPID TRM loaddata: a stationary tool's tload is the gripper, cog in tool0;
+    # GripLoad's cog is in the object frame of the robot-held wobj, here P).
+    load = payload(data.payload)
+    gripper_load, grip = GRIPPER_LOAD, []
+    if load is not None:
+        gripper_load = _load(load.gripper_mass_kg, load.p_EG)
+        grip = [f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};"]
     # Start (MoveAbsJ, then the linear approach) and retract.
     head = [
-        f"PERS tooldata {tool} := [FALSE,{_pose(data.X_BT)},{GRIPPER_LOAD}];",
+        f"PERS tooldata {tool} := [FALSE,{_pose(data.X_BT)},{gripper_load}];",
         f'PERS wobjdata {wobj} := [TRUE,TRUE,"",{_pose(data.X_EP)},[[0,0,0],[1,0,0,0]]];',
         _robtarget(names[0], data.X_PF[idx[0]], conf[0]),
     ]
     off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
     (_, q_start), (X_PT_ret, q_ret) = off or [(None, data.q[0]), (None, None)]
-    first, last = ["ConfJ \\On;", "ConfL \\On;"], []
+    first = ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * bool(grip)
+    last = []  # the part stays gripped after the program: its load stays set
+    head += grip
     if off:  # else: out of reach or not wanted, so start at the first process point
         head.append(_robtarget("pRetract", X_PT_ret, confdata(robot, q_ret[None])[0]))
         last.append(f"MoveL pRetract, {APPROACH_SPEED}, fine{tail}")
@@ -260,14 +250,19 @@ def write_rapid(
         "  oframe = I; robtarget = tool on the part; flange = tframe * rt^-1 * uframe^-1.",
         "Axes: URDF joints" + (", axis 3 = q2 + q3 (J2/J3 linkage)" if j23 else "") + "; conf: "
         "cf1/4/6 = floor(axis/90 deg), cfx = RAPID confdata table.",
-        f"Points: {n} of {len(data.t)} samples, LIN deviation <= {sel.max_chord_m * 1e3:.4f} mm, "
-        f"{np.rad2deg(sel.max_angle_rad):.4f} deg; v_tcp = planned mean on each segment.",
+        f"Points: {n} of {len(data.t)} samples, LIN deviation <= {max_chord * 1e3:.4f} mm, "
+        f"{np.rad2deg(max_angle):.4f} deg ({dense.basis}); v_tcp = planned mean on each segment.",
         f"Approach/retract: {approach}"
         + (" (OUT OF REACH)" if approach_m and not off else "")
-        + ", not collision-checked. tload: PLACEHOLDER 5 kg gripper; part load: GripLoad.",
+        + ", not collision-checked. "
+        + (
+            "tload = gripper, GripLoad partLoad = part (see Payload above)."
+            if load
+            else "tload: PLACEHOLDER 5 kg gripper, no GripLoad (PAYLOAD NOT SET)."
+        ),
     ]
     header = header_lines(data, conventions=conventions, forced=forced)
-    head = ["! " + _ascii(line) for line in header] + head
+    head = ["! " + rapid_comment(line) for line in header] + head
 
     decls, moves = part(range(1, n))
     texts = {module: _module_text(module, head + decls, {"main": first + moves + last})}
@@ -292,4 +287,4 @@ def write_rapid(
     listing = "".join(f"  <Module>{file.name}</Module>\n" for file in files)
     files.append(Path(out_dir) / f"{module}.pgf")
     write_atomic(files[-1], f"{PGF_HEAD}<Program>\n{listing}</Program>\n")
-    return RapidResult(tuple(files), n, idx, sel.max_chord_m, sel.max_angle_rad)
+    return RapidResult(tuple(files), n, idx, max_chord, max_angle)

@@ -19,13 +19,20 @@ from scipy.interpolate import CubicHermiteSpline
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.density import select_points
+from offline_prog.export.densify import densify
 from offline_prog.export.header import header_lines
+from offline_prog.export.krl_points import process_points
+from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
+from offline_prog.export.text import identifier, urscript_comment
 
 E_SERIES_PERIOD_S = 0.002
 SERVOJ_LOOKAHEAD_S = 0.1
 SERVOJ_GAIN = 300
+NAME_MAX = 63  # our bound for the program's function name
+MOVEL_ACCEL_M_S2 = 1.0
+MOVEL_MIN_SPEED_M_S = 1e-4
+MOVEL_MAX_SPEED_M_S = 3.0  # beyond any UR arm's tool speed (e-Series safety limit: 5 m/s)
 START_SPEED_RAD_S = 0.5  # movej to the start
 START_ACCEL_RAD_S2 = 1.0
 # The controller's base frame C in the URDF base_link B: turned π about z.
@@ -56,6 +63,30 @@ def _pose(X: np.ndarray) -> str:
     return "p" + _list(np.concatenate([X[:3, 3], rotvec]))
 
 
+def movel_points(data: ProgramData, chord_tol_m: float, angle_tol_rad: float):
+    """The movel targets and speeds: (X_CP (K, 4, 4) part frame P in the controller
+    base C, v (K-1,) [m/s] on each segment).
+
+    movel moves the set_tcp point (P) in straight lines in C, so the points are chosen
+    as for KRL's flange style (the nozzle's curve on the part within the tolerances,
+    against the continuous plan), and v is what the controller interpolates: the
+    length of the segment of P over its planned duration (keeps the planned timing).
+    """
+    dense = densify(data, chord_tol_m, angle_tol_rad)
+    plan = dense.data
+    idx, _, _ = process_points(
+        plan, "flange", *dense.selection_tolerances(chord_tol_m, angle_tol_rad)
+    )
+    X_CP = np.linalg.inv(X_BC) @ plan.X_BE[idx] @ plan.X_EP
+    v = np.linalg.norm(np.diff(X_CP[:, :3, 3], axis=0), axis=1) / np.diff(plan.t[idx])
+    if not np.all(v <= MOVEL_MAX_SPEED_M_S):  # NaN too
+        raise ValueError(
+            f"URScript movel: v {np.nanmax(v):g} m/s is beyond {MOVEL_MAX_SPEED_M_S:g} m/s "
+            "(the plan's speeds are m/s, not mm/s)"
+        )
+    return X_CP, np.maximum(v, MOVEL_MIN_SPEED_M_S)
+
+
 def urscript_text(
     data: ProgramData,
     *,
@@ -79,11 +110,17 @@ def urscript_text(
             f"servoj every {period_s} s (joint trajectory resampled from the plan)."
             if mode == "servoj"
             else "movel poses of the part frame (set_tcp) in the controller base frame "
-            "(URDF base_link turned pi about z), rotation vectors."
+            "(URDF base_link turned pi about z), rotation vectors. v = speed of the part origin "
+            "(the set_tcp point) on each segment: its length / planned time."
         ),
     ]
-    lines = [f"# {line}" for line in header_lines(data, conventions=conventions, forced=forced)]
+    identifier(name, max_chars=NAME_MAX, what="name")
+    header = header_lines(data, conventions=conventions, forced=forced)
+    lines = [f"# {urscript_comment(line)}" for line in header]
     lines.append(f"def {name}():")
+    if (load := payload(data.payload)) is not None:  # gripper + part, CoG in the flange
+        mass, p_EC = load.total(data.X_EP)
+        lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
     q0 = data.q[0]
     lines.append(f"  movej({_list(q0)}, a={START_ACCEL_RAD_S2}, v={START_SPEED_RAD_S})")
     if mode == "servoj":
@@ -96,21 +133,14 @@ def urscript_text(
         lines.append("  stopj(2.0)")
         count = len(q) - 1
     elif mode == "movel":
-        X_CB = np.linalg.inv(X_BC)
         lines.append(f"  set_tcp({_pose(data.X_EP)})")  # the part frame P in the flange
-        X_CP = X_CB @ data.X_BE @ data.X_EP
-        chosen = select_points(
-            data.X_PF[:, :3, 3],
-            data.X_PF[:, :3, :3],
-            chord_tol_m=chord_tol_m,
-            angle_tol_rad=angle_tol_rad,
-        ).indices
-        for i in chosen[1:]:
+        X_CP, v = movel_points(data, chord_tol_m, angle_tol_rad)
+        for X, speed in zip(X_CP[1:], v, strict=True):
             lines.append(
-                f"  movel({_pose(X_CP[i])}, a=1.0, v={max(data.tcp_speed[i], 1e-4):.5f}, "
+                f"  movel({_pose(X)}, a={MOVEL_ACCEL_M_S2}, v={speed:.5f}, "
                 f"r={min(chord_tol_m, 0.001):.5f})"
             )
-        count = len(chosen) - 1
+        count = len(X_CP) - 1
     else:
         raise ValueError(f"URScript mode must be 'servoj' or 'movel', got {mode!r}")
     lines.append("end")

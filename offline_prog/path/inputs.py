@@ -67,11 +67,22 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     try:
         if path.points:
             return path_sources.read_csv_points(
-                file.parent / source, units=path.units, closed=path.closed
+                file.parent / source,
+                units=path.units,
+                closed=path.closed,
+                close_tolerance_m=path.fit_tolerance_mm * 1e-3,
             )
         return path_sources.read_dxf_points(
             file.parent / source, layer=path.dxf_layer, closed=path.closed, units=path.units
         )
+    except path_sources.OpenEndsError as error:
+        raise _error(
+            file,
+            "path.closed",
+            f"true, but the ends of {source} are {error.gap_m * 1e3:.3f} mm apart (more than "
+            f"path.fit_tolerance_mm {path.fit_tolerance_mm:g}): end the points where they "
+            "start, or set closed: false",
+        ) from None
     except ValueError as error:
         raise _error(file, key, f"{source}: {error}") from None
 

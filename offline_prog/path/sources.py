@@ -22,6 +22,14 @@ CURVE_SAMPLE_SPACING_M = 1e-3
 DUPLICATE_POINT_M = 1e-9
 
 
+class OpenEndsError(ValueError):
+    """A closed path whose points do not come back to the first: gap_m [m] apart."""
+
+    def __init__(self, gap_m: float, tolerance_m: float):
+        self.gap_m, self.tolerance_m = gap_m, tolerance_m
+        super().__init__(f"the ends are {gap_m * 1e3:.3f} mm apart")
+
+
 @dataclasses.dataclass(frozen=True)
 class PathPoints:
     """Points on the part: p_PR (N, 3) in P [m]; normals_P (N, 3) unit or None."""
@@ -41,8 +49,14 @@ def clean_points(p, normals, *, closed: bool) -> PathPoints:
     return PathPoints(p, normals, closed)
 
 
-def read_csv_points(file: Path, *, units: str, closed: bool) -> PathPoints:
-    """Read ``x,y,z[,nx,ny,nz]`` rows (header required) in P, scaled to metres."""
+def read_csv_points(
+    file: Path, *, units: str, closed: bool, close_tolerance_m: float = DUPLICATE_POINT_M
+) -> PathPoints:
+    """Read ``x,y,z[,nx,ny,nz]`` rows (header required) in P, scaled to metres.
+
+    A closed path's last row repeats its first (within close_tolerance_m [m]); that
+    row is dropped. Otherwise OpenEndsError: closing it would add a stroke no one drew.
+    """
     with open(file, newline="") as stream:
         reader = csv.reader(row for row in stream if row.strip() and not row.startswith("#"))
         header = [h.strip().lower() for h in next(reader, [])]
@@ -71,6 +85,11 @@ def read_csv_points(file: Path, *, units: str, closed: bool) -> PathPoints:
         if lengths.min() < 1e-9:
             raise ValueError(f"line {int(np.argmin(lengths)) + 2}: normal (nx,ny,nz) is zero")
         normals = data[:, 3:] / lengths[:, None]
+    if closed and len(p) > 1:
+        gap = float(np.linalg.norm(p[-1] - p[0]))
+        if gap > close_tolerance_m:
+            raise OpenEndsError(gap, close_tolerance_m)
+        p, normals = p[:-1], None if normals is None else normals[:-1]
     return clean_points(p, normals, closed=closed)
 
 

@@ -1,21 +1,34 @@
 """The plan folder: trajectory.csv, report.json, collisions, programs, preview, report.html.
 
-Every file is written to a temporary name in the target folder and renamed into
-place, so a crash never leaves a half-written file that looks complete.
+The whole folder is written as a temporary sibling and swapped in at the end
+(``atomic.staged_folder``): a crash or Ctrl-C leaves the previous complete folder, and a
+re-plan leaves no file of an older run. The folder's manifest lists what we wrote; a
+folder holding anything else is not replaced (we delete only our own files).
 """
 
 from __future__ import annotations
 
 import io
 import json
+import os
 from pathlib import Path
 
 import numpy as np
 
-from offline_prog.atomic import write_atomic
+from offline_prog.atomic import (
+    MANIFEST,
+    TEMP_PREFIX,
+    read_manifest,
+    staged_folder,
+    write_atomic,
+    write_manifest,
+)
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
+from offline_prog.errors import InputError
+from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
+from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import Plan
 from offline_prog.results.report import report
@@ -83,6 +96,10 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
     X_BT = X_BI @ transform(cell.tool.X_IT).GetAsMatrix4()
     X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
     X_PF = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)
+    s_dense = dense_grid(plan.path.length)
+    dense = plan.flange(s_dense)
+    X_BE_dense = X_BI @ _poses(dense.p_IE, dense.R_IE)
+    X_PF_dense = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE_dense @ X_EP)
     return ProgramData(
         cell_name=cell.name or plan.cell_file.stem,
         cell_file=str(plan.cell_file),
@@ -110,16 +127,60 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         qd_max=plan.robot.qd_max,
         j23_coupled=plan.robot.j23_coupled,
         language=plan.robot.language,
+        payload=payload_record(cell),
+        sigma_dense=s_dense,
+        X_PF_dense=X_PF_dense,
     )
 
 
+def check_out_dir(out_dir: Path) -> None:
+    """Refuse an --out that is a file, or a folder with files we did not write.
+
+    Raises:
+        InputError: naming the folder and what is in the way.
+    """
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(out_dir, "--out", "exists and is not a folder")
+    parent = out_dir.absolute().parent  # the folder is swapped in there
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(out_dir, "--out", f"cannot write into {parent} (permission denied)")
+    if not out_dir.is_dir():
+        return
+    entries = {e.name for e in out_dir.iterdir() if not e.name.startswith(TEMP_PREFIX)}
+    manifest = read_manifest(out_dir)
+    owned = set((manifest or {}).get("files", {}).get("plan", [])) | {MANIFEST}
+    foreign = sorted(entries - owned)
+    if foreign:
+        raise InputError(
+            out_dir,
+            "--out",
+            f"holds files offline_prog did not write ({', '.join(foreign[:3])}"
+            f"{', ...' if len(foreign) > 3 else ''}); choose an empty or new folder",
+        )
+
+
 def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
-    """Write trajectory.csv and report.json into ``out_dir``.
+    """Write the plan folder ``out_dir`` (replacing an earlier plan folder there).
 
     Returns:
-        The written files by name, and the report that went into report.json.
+        The written files by name (paths in out_dir), and the report in report.json.
+
+    Raises:
+        InputError: out_dir is a file, or a folder with files we did not write.
     """
     out_dir = Path(out_dir)
+    check_out_dir(out_dir)
+    with staged_folder(out_dir) as folder:
+        files, summary = _write_all(plan, folder)
+        names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
+        write_manifest(folder, {"plan": names})
+    return {key: out_dir / path.relative_to(folder) for key, path in files.items()}, summary
+
+
+def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
+    """Every output of the plan, into the (fresh) folder out_dir."""
     files = {
         "trajectory": out_dir / "trajectory.csv",
         "report": out_dir / "report.json",

@@ -12,6 +12,7 @@ import datetime
 import numpy as np
 
 from offline_prog import __version__
+from offline_prog.export.payload import payload, payload_note, payload_record
 from offline_prog.plan import Plan
 
 
@@ -120,6 +121,14 @@ def collision_summary(plan: Plan) -> dict:
     }
 
 
+def payload_summary(cell) -> dict:
+    """The payload the programs set, or ``set: false`` and a warning (export.payload)."""
+    record = payload_record(cell)
+    complete = payload(record) is not None
+    warning = None if complete else payload_note(record, np.eye(4)).removeprefix("WARNING: ")
+    return {"set": complete, "warning": warning, **record}
+
+
 def report(plan: Plan) -> dict:
     """The machine-readable plan summary (SI units unless the key says otherwise)."""
     cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
@@ -139,6 +148,7 @@ def report(plan: Plan) -> dict:
         "robot": cell.robot.model,
         "tool": cell.tool.name,
         "part": cell.part.name,
+        "payload": payload_summary(cell),
         "path": {
             "source": source,
             "n_points": int(len(plan.points.p_PR)),

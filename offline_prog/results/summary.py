@@ -25,6 +25,8 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
         f"{traj['n_samples']} samples, speed error "
         f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
     )
+    if not report["payload"]["set"]:
+        console.print(f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]")
     robot = report["robot_motion"]
     reductions = robot["speed_reductions"]
     console.print(

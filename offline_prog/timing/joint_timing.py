@@ -18,6 +18,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.arrays import true_runs
+from offline_prog.constants import LIMIT_CHECK_RATE_HZ
 from offline_prog.timing.time_law import Sin2TimeLaw, sin2_plateau_law
 
 # Share of a joint's speed limit the planner may use, and of its acceleration
@@ -131,7 +132,7 @@ def retime(
     *,
     qd_max: np.ndarray,
     qdd_max: np.ndarray,
-    check_rate_hz: float = 1000.0,
+    check_rate_hz: float = LIMIT_CHECK_RATE_HZ,
 ) -> Retiming:
     """Lower the process speed only where the joints cannot follow (see module doc).
 

@@ -193,7 +193,11 @@ def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[St
     scene = StaticScene()
     bodies = _draw_cell(scene, drake)
     extra = overlays(plan, near_collision)
-    part = next(p for p, b in bodies.items() if b.name() == "part")
+    part = next((p for p, b in bodies.items() if b.name() == "part"), None)
+    if part is None:  # a part without geometry: its frame still carries the path
+        body = plant.GetBodyByName("part")
+        part = f"/drake/{plant.GetModelInstanceName(body.model_instance())}/part"
+        bodies[part] = body
     scene.set_lines(f"{part}/processing_path", extra.p_P_path, PATH_COLOR)
     for axis, segments in enumerate(extra.triads):
         scene.set_lines(f"{part}/frames/{'xyz'[axis]}", segments.reshape(-1, 3), AXIS_COLORS[axis],

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from offline_prog.atomic import write_atomic
+from offline_prog.atomic import MANIFEST, write_atomic
 from offline_prog.export.program import ProgramData
 from offline_prog.viz.report_plots import (
     PLOT_SCRIPT,
@@ -51,7 +51,9 @@ def load_plan_folder(plan_dir: Path) -> tuple[dict, dict[str, np.ndarray], Progr
     except (OSError, ValueError) as error:
         raise ValueError(f"{file}: not readable as a plan output ({error})") from None
     columns = {name: table[:, i] for i, name in enumerate(header)}
-    programs = sorted(p for p in (plan_dir / PROGRAMS_DIR).glob("**/*") if p.is_file())
+    programs = sorted(
+        p for p in (plan_dir / PROGRAMS_DIR).glob("**/*") if p.is_file() and p.name != MANIFEST
+    )
     return report, columns, ProgramData.load(plan_dir), programs
 
 

@@ -95,6 +95,7 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ("X_IT: {", "symmetry_axis: w\n  X_IT: {", "tool.symmetry_axis", "use x, y or z"),
     ("model: kuka_kr16_2", "model: no_such_robot", "robot.model", "not a robot folder"),
     ("closed: false", "closed: maybe", "path.closed", "expected bool"),
+    ("closed: false", "closed: true", "path.closed", "ends of path.csv are 78.119 mm apart"),
     ("  normal: [0, 0, 1]\n", "", "path.normal", "exactly one way"),
     ("normal: [0, 0, 1]", "normal: [1, 0, 0]", "path.normal", "tangent"),
     ("normal: [0, 0, 1]", "normal: [0, 0, 0]", "path.normal", "zero vector"),
@@ -121,6 +122,12 @@ def test_bad_cell_names_file_key_and_reason(tmp_path, old, new, key, reason):
     assert message.startswith(str(cell))
     assert f": {key}:" in message or message.split(": ")[1] == key
     assert reason in message
+
+
+def test_closed_defaults_to_false(tmp_path):
+    assert (
+        load_cell(write_cell(tmp_path, BASE.replace("  closed: false\n", ""))).path.closed is False
+    )
 
 
 def test_speed_reference_must_be_tcp_or_flange(tmp_path):

@@ -261,7 +261,7 @@ def test_forced_export_of_a_failed_plan_warns_in_the_header(data, tmp_path):
     assert any("WARNING: EXPORTED WITH --force FROM A FAILED PLAN" in line for line in header)
     assert any("sigma = 0.120 m (>= 120 deg)" in line for line in header)
     assert text.isascii() and all(line.startswith("  !") for line in header[:5])
-    assert "tool_D_se_1" in parse_rapid(result.files).data
+    assert "tool_Duse_1" in parse_rapid(result.files).data
 
 
 def test_unreachable_approach_starts_at_the_first_point(data, tmp_path):

@@ -96,6 +96,27 @@ def test_movel_poses_put_the_flange_on_the_plan(data, tmp_path):
     assert nearest[-1] == len(data.t) - 1
 
 
+def test_movel_speed_is_the_set_tcp_speed_that_keeps_the_planned_timing(data, tmp_path):
+    """Replay the program as the controller reads it: the set_tcp point (the part
+    origin) moves in straight lines in the base frame at v; each segment then takes
+    |Δp| / v, which must be the plan's time between its end poses (v was the speed of
+    the part point under the tool before, a different point on a rotating part)."""
+    (file,) = export(data, "urscript", tmp_path, mode="movel")
+    text = file.read_text()
+    poses = np.array(parse_calls(text, "movel"))
+    speeds = np.array([float(v) for v in re.findall(rf"movel\(.*v=({NUMBER}),", text)])
+    X_CP = np.linalg.inv(X_BC) @ data.X_BE @ data.X_EP
+    start = X_CP[0, :3, 3]
+    p = np.vstack([start, poses[:, :3]])
+    seconds = np.linalg.norm(np.diff(p, axis=0), axis=1) / speeds
+    # The planned time of each target: the sample whose part origin it is.
+    nearest = np.linalg.norm(X_CP[None, :, :3, 3] - p[:, None], axis=2).argmin(axis=1)
+    planned = np.diff(data.t[nearest])
+    moving = planned > 0.05  # skip the few rest-to-rest ends where v is floored
+    np.testing.assert_allclose(seconds[moving], planned[moving], rtol=2e-3)
+    assert abs(seconds.sum() - data.t[-1]) < 0.01 * data.t[-1]
+
+
 def test_joint_csv_and_ros_json(data, plan_dir):
     lines = (plan_dir / "programs" / "joint_trajectory.csv").read_text().splitlines()
     assert lines[0] == "t_s," + ",".join(f"{n}_rad" for n in data.joint_names)

@@ -1,0 +1,139 @@
+"""The command line's flags: argparse with checked numbers and one-line errors.
+
+Every numeric flag has a type function that refuses NaN, infinity and values out of
+range; any parse error is one line, ``error: <message> (see offline-prog <cmd> --help)``,
+and exit code 2 (not argparse's usage block).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+EXIT_BAD_INPUT = 2
+MAX_MESSAGE_CHARS = 500  # one stderr line, however long the cause's text
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``error: <message> (see offline-prog <cmd> --help)``
+    and exit code 2, instead of the usage block."""
+
+    def error(self, message: str):
+        self.exit(EXIT_BAD_INPUT, f"error: {one_line(message)} (see {self.prog} --help)\n")
+
+
+def one_line(message: str) -> str:
+    """Whitespace (newlines too) collapsed, cut to MAX_MESSAGE_CHARS."""
+    text = " ".join(str(message).split())
+    return text if len(text) <= MAX_MESSAGE_CHARS else text[: MAX_MESSAGE_CHARS - 3] + "..."
+
+
+def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
+    """An argparse type: a finite ``kind`` (float or int) above ``low`` (or equal to it
+    when inclusive), at most ``high``; ArgumentTypeError otherwise."""
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a {kind.__name__}") from None
+        if not (math.isfinite(value) and low <= value <= high) or (value == low and not inclusive):
+            bound = (f">= {low:g}" if inclusive else f"> {low:g}") + (
+                f" and <= {high:g}" if high < math.inf else ""
+            )
+            raise argparse.ArgumentTypeError(f"{text!r}: need a finite number {bound}")
+        return value
+
+    parse.__name__ = kind.__name__  # argparse names the type in its messages
+    return parse
+
+
+POSITIVE = _number(float, low=0.0, inclusive=False)
+PORT = _number(int, low=1, inclusive=True, high=65535)
+MIN_LINE_LIMIT = 20  # the smallest program part the writers can split into
+MAX_MATRIX_SAMPLES = 10_000_000  # self-collision samples (10⁴ take ~3 s)
+
+
+def parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="offline-prog",
+        description="Plan robot motions that carry a part past a spatially fixed tool.",
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    plan = commands.add_parser("plan", help="plan a cell and write the outputs")
+    plan.add_argument("cell", type=Path, help="work-cell YAML file")
+    plan.add_argument(
+        "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
+    )
+    plan.add_argument(
+        "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
+    )
+    plan.add_argument("--port", type=PORT, default=7000, help="MeshCat port for --preview")
+    preview = commands.add_parser("preview", help="plan a cell and show it in MeshCat")
+    preview.add_argument("cell", type=Path, help="work-cell YAML file")
+    preview.add_argument("--port", type=PORT, default=7000, help="MeshCat port (default 7000)")
+    preview.add_argument(
+        "--seconds",
+        type=_number(float, low=0.0, inclusive=True),
+        default=None,
+        help="keep the server this long (default: until Ctrl-C)",
+    )
+    robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
+    robot_commands = robots.add_subparsers(
+        dest="robots_command", required=True, parser_class=_Parser
+    )
+    robot_commands.add_parser("list", help="the robots in offline_prog/robots")
+    matrix = robot_commands.add_parser(
+        "self-collision",
+        help="sample configurations and write robots/<robot>/self_collision.yaml",
+    )
+    matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
+    matrix.add_argument(
+        "--samples", type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
+        default=10_000, help="configurations (10000)",
+    )  # fmt: skip
+    matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    export = commands.add_parser("export", help="re-export programs from a finished plan")
+    export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
+    export.add_argument(
+        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
+    )
+    export.add_argument(
+        "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"
+    )
+    export.add_argument(
+        "--force", action="store_true", help="export even if the plan failed (the header says so)"
+    )
+    export.add_argument(
+        "--style",
+        choices=["external_tcp", "flange"],
+        default=None,
+        help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
+    )
+    export.add_argument(
+        "--mode",
+        choices=["servoj", "movel"],
+        default=None,
+        help="URScript: joint trajectory (servoj) or movel poses",
+    )
+    export.add_argument(
+        "--chord-tol-mm",
+        type=POSITIVE,
+        default=None,
+        help="Cartesian point density: chordal tolerance [mm] (default 0.05)",
+    )
+    export.add_argument(
+        "--angle-tol-deg",
+        type=POSITIVE,
+        default=None,
+        help="Cartesian point density: orientation tolerance [deg] (default 0.1)",
+    )
+    export.add_argument(
+        "--line-limit",
+        type=_number(int, low=MIN_LINE_LIMIT, inclusive=True),
+        default=None,
+        help="split programs longer than this (KRL 1400, RAPID 5000)",
+    )
+    return parser

@@ -1,0 +1,81 @@
+"""The load the robot carries: the gripper (fixed to the flange E) and the part (P).
+
+Cell keys: ``gripper: {mass_kg, center_of_mass_mm}`` (centre of mass in E) and
+``part: {mass_kg, center_of_mass_mm}`` (in P). A program states the load only when
+both masses are given; otherwise every program header and report.json say that the
+payload is not set, so that nobody runs the robot with a wrong load unknowingly.
+Inertia is not given: the programs write point masses (zero inertia).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+
+@dataclasses.dataclass(frozen=True)
+class Payload:
+    """Masses [kg] and centres of mass [m]: the gripper's p_EG in E, the part's p_PC in P."""
+
+    gripper_mass_kg: float
+    p_EG: np.ndarray
+    part_mass_kg: float
+    p_PC: np.ndarray
+
+    def total(self, X_EP: np.ndarray) -> tuple[float, np.ndarray]:
+        """(mass [kg], centre of mass (3,) in E [m]) of gripper and part together,
+        the part frame P at X_EP (4, 4) in E."""
+        mass = self.gripper_mass_kg + self.part_mass_kg
+        p_EC = X_EP[:3, :3] @ self.p_PC + X_EP[:3, 3]
+        weighted = self.gripper_mass_kg * self.p_EG + self.part_mass_kg * p_EC
+        return mass, weighted / mass if mass > 0 else np.zeros(3)
+
+
+def payload_record(cell) -> dict:
+    """The payload keys the cell gives, as plan.npz stores them (SI units)."""
+    record = {}
+    if cell.gripper is not None:
+        record["gripper_mass_kg"] = cell.gripper.mass_kg
+        record["gripper_com_E_m"] = [v * 1e-3 for v in cell.gripper.center_of_mass_mm]
+    if cell.part.mass_kg is not None:
+        record["part_mass_kg"] = cell.part.mass_kg
+        record["part_com_P_m"] = [v * 1e-3 for v in (cell.part.center_of_mass_mm or [0, 0, 0])]
+    return record
+
+
+def payload(record: dict | None) -> Payload | None:
+    """The Payload of a stored record, or None unless both masses are given."""
+    record = record or {}
+    if "gripper_mass_kg" not in record or "part_mass_kg" not in record:
+        return None
+    return Payload(
+        float(record["gripper_mass_kg"]),
+        np.asarray(record["gripper_com_E_m"], float),
+        float(record["part_mass_kg"]),
+        np.asarray(record["part_com_P_m"], float),
+    )
+
+
+def payload_note(record: dict | None, X_EP: np.ndarray) -> str:
+    """One header line: the payload written, or a warning naming the missing keys."""
+    load = payload(record)
+    if load is None:
+        missing = [
+            key
+            for key, name in (
+                ("gripper_mass_kg", "gripper.mass_kg"),
+                ("part_mass_kg", "part.mass_kg"),
+            )
+            if key not in (record or {})
+        ]
+        return (
+            f"WARNING: PAYLOAD NOT SET (the cell gives no {' / '.join(missing)}): "
+            "set the load of gripper and part on the controller before running."
+        )
+    mass, p_EC = load.total(X_EP)
+    return (
+        f"Payload: gripper {load.gripper_mass_kg:g} kg + part {load.part_mass_kg:g} kg = "
+        f"{mass:g} kg, centre of mass [{', '.join(f'{v:.1f}' for v in p_EC * 1e3)}] mm in the "
+        "flange frame; inertia not given (point mass)."
+    )

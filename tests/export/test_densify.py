@@ -1,0 +1,163 @@
+"""Point selection holds the tolerance against the continuous plan, at any sample rate.
+
+Reproduction: with motion.sample_rate_hz: 1 a KRL program left the plan by 11 mm
+between its samples while its header claimed 0.0000 mm. Here the true deviation is
+measured against the plan's own flange path on a grid 5x finer than the stored one.
+"""
+
+import re
+import shutil
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from offline_prog.config.cell import transform
+from offline_prog.export.densify import densify
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
+from offline_prog.export.krl import write_krl
+from offline_prog.export.rapid import write_rapid
+from offline_prog.plan import plan_cell
+from offline_prog.results.plan_folder import program_data
+from offline_prog.results.report import report
+
+from conftest import CELLS
+
+TRUE_SPACING_M = 2e-5
+HEADER_ROUNDING_MM = 1e-4  # the header prints 4 decimals
+
+
+def plan_at(tmp_path_factory, name: str, rate_hz: float):
+    """(plan, ProgramData) of a demo cell planned at rate_hz."""
+    folder = tmp_path_factory.mktemp(f"{name}_{rate_hz:g}hz")
+    if (CELLS / "data").is_dir():
+        shutil.copytree(CELLS / "data", folder / "data")
+    text = (CELLS / f"{name}.yaml").read_text()
+    text = text.replace("  max_jerk:", f"  sample_rate_hz: {rate_hz}\n  max_jerk:", 1)
+    (folder / "cell.yaml").write_text(text)
+    plan = plan_cell(folder / "cell.yaml")
+    return plan, program_data(plan, report(plan))
+
+
+def true_frames(plan, data):
+    """(s (M,), X_PF (M, 4, 4)) of the continuous plan, finely, as program_data does."""
+    s = np.linspace(0.0, plan.path.length, int(plan.path.length / TRUE_SPACING_M) + 1)
+    flange = plan.flange(s)
+    X_BE = np.zeros((len(s), 4, 4))
+    X_BE[:, :3, :3], X_BE[:, :3, 3], X_BE[:, 3, 3] = flange.R_IE, flange.p_IE, 1.0
+    X_BE = transform(plan.cell.robot.X_IB).inverse().GetAsMatrix4() @ X_BE  # X_IE → X_BE
+    return s, np.linalg.inv(np.linalg.inv(data.X_BT) @ X_BE @ data.X_EP)
+
+
+def true_deviation(plan, data, s_points, X_points) -> tuple[float, float]:
+    """Largest distance [m] / angle [rad] of the continuous X_PF from the LIN segments
+    between consecutive program points (s_points (K,), X_points (K, 4, 4)): the tool moves
+    in a straight line across the part, orientation by slerp at the same share."""
+    s, X = true_frames(plan, data)
+    segment = np.clip(np.searchsorted(s_points, s, side="right") - 1, 0, len(s_points) - 2)
+    a, b = X_points[segment, :3, 3], X_points[segment + 1, :3, 3]
+    chord = b - a
+    lam = np.clip(np.einsum("kc,kc->k", X[:, :3, 3] - a, chord) / (chord * chord).sum(1), 0, 1)
+    distance = np.linalg.norm(X[:, :3, 3] - a - lam[:, None] * chord, axis=1)
+    R_a, R_b = X_points[segment, :3, :3], X_points[segment + 1, :3, :3]
+    rotvec = Rotation.from_matrix(np.swapaxes(R_a, 1, 2) @ R_b).as_rotvec()
+    R_lam = R_a @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
+    angle = Rotation.from_matrix(np.swapaxes(R_lam, 1, 2) @ X[:, :3, :3]).magnitude()
+    return float(distance.max()), float(angle.max())
+
+
+def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> float:
+    """Largest distance [m] of the tool's trace on the part from the continuous path when
+    the controller interpolates the written KRL poses X_TP = X_PF⁻¹ (P in T: position
+    linear, orientation slerp) between consecutive points."""
+    s, X = true_frames(plan, data)
+    lam = np.linspace(0.0, 1.0, grid + 1)
+    worst = 0.0
+    for a, b in zip(range(len(s_points) - 1), range(1, len(s_points)), strict=True):
+        X_TP_a, X_TP_b = np.linalg.inv(X_points[a]), np.linalg.inv(X_points[b])
+        rotvec = Rotation.from_matrix(X_TP_a[:3, :3].T @ X_TP_b[:3, :3]).as_rotvec()
+        R_TP = X_TP_a[:3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
+        p_TP = X_TP_a[:3, 3] + lam[:, None] * (X_TP_b[:3, 3] - X_TP_a[:3, 3])
+        trace = -np.einsum("nji,nj->ni", R_TP, p_TP)  # the tool's origin in P: p_PT
+        inside = (s >= s_points[a]) & (s <= s_points[b])
+        path = X[inside, :3, 3]
+        start, step = path[:-1], np.diff(path, axis=0)
+        u = np.einsum("gkc,kc->gk", trace[:, None] - start, step) / (step * step).sum(1)
+        gap = np.linalg.norm(trace[:, None] - start - np.clip(u, 0, 1)[..., None] * step, axis=2)
+        worst = max(worst, float(gap.min(axis=1).max()))
+    return worst
+
+
+@pytest.fixture(scope="module", params=[1.0, 10.0])
+def kuka(request, tmp_path_factory):
+    return plan_at(tmp_path_factory, "seal_plate_kr16", request.param)
+
+
+def test_samples_alone_miss_the_plan_at_low_rates(tmp_path_factory):
+    plan, data = plan_at(tmp_path_factory, "seal_plate_kr16", 1.0)
+    chosen = select_points(data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]).indices
+    chord, _ = true_deviation(plan, data, data.sigma[chosen], data.X_PF[chosen])
+    assert chord > 100 * DEFAULT_CHORD_TOL_M  # the bug this module fixes: 11 mm at 1 Hz
+
+
+def test_krl_holds_the_tolerance_and_says_so(kuka, tmp_path):
+    plan, data = kuka
+    result = write_krl(data, tmp_path)
+    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
+    chord, angle = true_deviation(
+        plan, data, dense.sigma[result.indices], dense.X_PF[result.indices]
+    )
+    assert chord <= DEFAULT_CHORD_TOL_M and angle <= DEFAULT_ANGLE_TOL_RAD
+    assert result.max_chord_m >= chord and result.max_angle_rad >= angle * (1 - 1e-6)
+    comments = [line[2:] for line in result.files[0].read_text().splitlines() if line[:2] == "; "]
+    header = re.search(r"achieved ([\d.]+) mm, ([\d.]+) deg", " ".join(comments))
+    assert float(header.group(1)) + HEADER_ROUNDING_MM >= chord * 1e3
+    assert float(header.group(2)) + HEADER_ROUNDING_MM >= np.rad2deg(angle)
+
+
+def test_krl_points_also_hold_when_the_written_poses_are_interpolated(kuka, tmp_path):
+    plan, data = kuka
+    result = write_krl(data, tmp_path)
+    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
+    s_points, X_points = dense.sigma[result.indices], dense.X_PF[result.indices]
+    assert pose_interpolation_deviation(plan, data, s_points, X_points) <= DEFAULT_CHORD_TOL_M
+    text = result.files[0].read_text()
+    assert "and if it interpolates the written poses" in " ".join(text.replace("; ", "").split())
+    # Thinned for straight lines across the part only, the same plan misses by more.
+    chosen = select_points(dense.X_PF[:, :3, 3], dense.X_PF[:, :3, :3]).indices
+    missed = pose_interpolation_deviation(plan, data, dense.sigma[chosen], dense.X_PF[chosen])
+    assert missed > 2 * DEFAULT_CHORD_TOL_M
+
+
+def test_rapid_holds_the_tolerance_and_says_so(tmp_path_factory, tmp_path):
+    plan, data = plan_at(tmp_path_factory, "weld_seam_irb2400", 1.0)
+    result = write_rapid(data, tmp_path)
+    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
+    chord, angle = true_deviation(
+        plan, data, dense.sigma[result.indices], dense.X_PF[result.indices]
+    )
+    assert chord <= DEFAULT_CHORD_TOL_M and angle <= DEFAULT_ANGLE_TOL_RAD
+    header = re.search(r"LIN deviation <= ([\d.]+) mm", result.files[0].read_text())
+    assert float(header.group(1)) + HEADER_ROUNDING_MM >= chord * 1e3
+
+
+def test_inserted_rows_are_on_the_plan(kuka):
+    """Inserted joints reproduce the inserted flange poses (the plan's branch)."""
+    from offline_prog.robot.model import load_robot
+
+    plan, data = kuka
+    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
+    d = dense.data
+    assert np.all(np.diff(d.sigma) >= 0) and np.all(np.diff(d.t) >= 0)
+    X_BE = load_robot(d.robot).forward(d.q)
+    assert np.abs(X_BE[:, :3, 3] - d.X_BE[:, :3, 3]).max() < 1e-6
+    assert np.abs(np.diff(d.q, axis=0)).max() < 0.2  # no branch switch
+
+
+def test_old_plan_files_say_they_are_measured_at_samples(kuka, tmp_path):
+    import dataclasses
+
+    _, data = kuka
+    old = dataclasses.replace(data, sigma_dense=np.empty(0), X_PF_dense=np.empty((0, 4, 4)))
+    text = write_krl(old, tmp_path).files[0].read_text()
+    assert "measured at the plan samples only" in text

@@ -1,0 +1,97 @@
+"""Payload statements: KRL $LOAD, RAPID tload + GripLoad, URScript set_payload; a
+prominent warning in every header and report.json when the cell gives none."""
+
+import dataclasses
+import json
+import re
+
+import numpy as np
+import pytest
+from config.test_cell_errors import BASE, write_cell  # tests/config
+
+from offline_prog.config.cell import load_cell
+from offline_prog.config.checks import check_cell
+from offline_prog.errors import InputError
+from offline_prog.export.krl import write_krl
+from offline_prog.export.program import ProgramData
+from offline_prog.export.rapid import write_rapid
+from offline_prog.export.urscript import write_urscript
+from offline_prog.robot.model import ROBOTS_DIR
+
+RECORD = {  # gripper 4 kg 80 mm down the flange axis; part 2 kg at (10, 0, 5) mm in P
+    "gripper_mass_kg": 4.0,
+    "gripper_com_E_m": [0.0, 0.0, 0.08],
+    "part_mass_kg": 2.0,
+    "part_com_P_m": [0.01, 0.0, 0.005],
+}
+
+
+def expected_total(data):
+    p_EC = data.X_EP[:3, :3] @ np.array(RECORD["part_com_P_m"]) + data.X_EP[:3, 3]
+    return 6.0, (4.0 * np.array(RECORD["gripper_com_E_m"]) + 2.0 * p_EC) / 6.0
+
+
+@pytest.fixture(scope="module")
+def plans(planned_folder):
+    names = ("seal_plate_kr16", "weld_seam_irb2400", "tape_cylinder_ur10e")
+    return [ProgramData.load(planned_folder(name)[1]) for name in names]
+
+
+def test_cell_keys(tmp_path):
+    text = BASE.replace("part:\n", "gripper: {mass_kg: 4, center_of_mass_mm: [0, 0, 80]}\npart:\n")
+    text = text.replace("part:\n", "part:\n  mass_kg: 2.0\n  center_of_mass_mm: [10, 0, 5]\n", 1)
+    cell = load_cell(write_cell(tmp_path, text))
+    check_cell(tmp_path / "cell.yaml", cell, ROBOTS_DIR)
+    assert cell.gripper.mass_kg == 4 and cell.part.center_of_mass_mm == [10, 0, 5]
+    for bad, key in [("mass_kg: 2.0", "part.mass_kg"), ("[10, 0, 5]", "part.center_of_mass_mm")]:
+        wrong = text.replace(bad, {"mass_kg: 2.0": "mass_kg: -1"}.get(bad, "[1, 2]"))
+        with pytest.raises(InputError, match=key):
+            check_cell(tmp_path / "cell.yaml", load_cell(write_cell(tmp_path, wrong)), ROBOTS_DIR)
+
+
+def test_krl_load(plans, tmp_path):
+    data = dataclasses.replace(plans[0], payload=RECORD)
+    text = write_krl(data, tmp_path).files[0].read_text()
+    m = re.search(r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0,B 0,C 0\}", text, re.M)
+    mass, p_EC = expected_total(data)
+    assert float(m.group(1)) == pytest.approx(mass)
+    np.testing.assert_allclose([float(m.group(i)) for i in (2, 3, 4)], p_EC * 1e3, atol=0.06)
+    assert text.index("$LOAD=") < text.index("PTP XAPPROACH")
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
+def test_rapid_loads(plans, tmp_path):
+    data = dataclasses.replace(plans[1], payload=RECORD)
+    files = write_rapid(data, tmp_path).files
+    text = files[0].read_text()
+    assert re.search(r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", text)
+    assert "PERS loaddata partLoad := [2,[10,0,5],[1,0,0,0],0,0,0];" in text
+    assert text.index("GripLoad partLoad;") < text.index("MoveAbsJ")
+    rapidchecker = pytest.importorskip("rapidchecker.cli")
+    assert [str(e) for e in rapidchecker.check_file(text)] == []
+
+
+def test_urscript_payload(plans, tmp_path):
+    data = dataclasses.replace(plans[2], payload=RECORD)
+    text = write_urscript(data, tmp_path).file.read_text()
+    m = re.search(r"^  set_payload\(([\d.]+), \[(.*)\]\)$", text, re.M)
+    mass, p_EC = expected_total(data)
+    assert float(m.group(1)) == pytest.approx(mass)
+    np.testing.assert_allclose([float(v) for v in m.group(2).split(",")], p_EC, atol=1e-4)
+    assert text.index("set_payload") < text.index("movej")
+
+
+def test_without_payload_every_header_and_the_report_warn(plans, planned_folder, tmp_path):
+    kuka, abb, ur = plans
+    texts = [
+        write_krl(kuka, tmp_path / "k").files[0].read_text(),
+        write_rapid(abb, tmp_path / "r").files[0].read_text(),
+        write_urscript(ur, tmp_path / "u").file.read_text(),
+    ]
+    for text in texts:
+        assert "WARNING: PAYLOAD NOT SET" in text
+        assert "$LOAD={" not in text and "GripLoad partLoad" not in text
+        assert "set_payload(" not in text
+    report = json.loads((planned_folder("seal_plate_kr16")[1] / "report.json").read_text())
+    assert report["payload"]["set"] is False and "PAYLOAD NOT SET" in report["payload"]["warning"]
+    assert list(report).index("payload") < 10  # near the top: prominent

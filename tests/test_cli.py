@@ -1,0 +1,111 @@
+"""The command line: bad flags and user-caused errors are one line and exit 2."""
+
+import argparse
+import errno
+import os
+import re
+import shutil
+
+import pytest
+
+from offline_prog.cli import exit_code, main
+
+from conftest import CELLS
+
+
+def run(capsys, *argv) -> tuple[int, list[str]]:
+    """Exit code and stderr lines of ``offline-prog argv``."""
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exit:
+        code = exit.code
+    return code, capsys.readouterr().err.splitlines()
+
+
+BAD_FLAGS = [
+    ["--chord-tol-mm", "nan"],
+    ["--chord-tol-mm", "-1"],
+    ["--chord-tol-mm", "inf"],
+    ["--chord-tol-mm", "0"],
+    ["--angle-tol-deg", "1e400"],
+    ["--angle-tol-deg", "x"],
+    ["--line-limit", "0"],
+    ["--line-limit", "-5"],
+    ["--line-limit", "2.5"],
+    ["--format", "gcode"],
+    ["--bogus"],
+]
+
+
+@pytest.mark.parametrize("flags", BAD_FLAGS)
+def test_bad_export_flags_are_one_line_exit_2(capsys, tmp_path, flags):
+    argv = ["export", tmp_path, *(["--format", "krl"] if "--format" not in flags else []), *flags]
+    code, err = run(capsys, *argv)
+    assert code == 2 and len(err) == 1, err
+    assert re.fullmatch(r"error: .+ \(see offline-prog( export)? --help\)", err[0]), err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [[], ["plan"], ["plan", "a.yaml", "--port", "0"], ["plan", "a.yaml", "--port", "99999"]],
+)
+def test_bad_commands_are_one_line_exit_2(capsys, argv):
+    code, err = run(capsys, *argv)
+    assert code == 2 and len(err) == 1 and err[0].startswith("error: "), err
+
+
+def test_out_is_an_existing_file(capsys, tmp_path):
+    (tmp_path / "out").write_text("x")
+    code, err = run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", tmp_path / "out")
+    assert code == 2 and err == [f"error: {tmp_path / 'out'}: --out: exists and is not a folder"]
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")
+def test_out_in_a_folder_without_write_permission(capsys, tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    code, err = run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", locked / "out")
+    assert code == 2 and len(err) == 1 and "permission denied" in err[0]
+
+
+def test_disk_full_names_the_path():
+    args = argparse.Namespace(command="plan", out=None, cell="c.yaml")
+    error = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), "/data/out/trajectory.csv")
+    assert exit_code(error, args) == (2, "error: /data/out/trajectory.csv: No space left on device")
+    assert exit_code(RuntimeError("bug"), args)[0] == 3
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garbage", "empty", "missing"])
+def test_damaged_plan_npz_is_exit_2(capsys, planned_folder, tmp_path, damage):
+    folder = tmp_path / "plan"
+    shutil.copytree(planned_folder("seal_plate_kr16")[1], folder)
+    npz = folder / "plan.npz"
+    content = npz.read_bytes()
+    if damage == "missing":
+        npz.unlink()
+    else:
+        npz.write_bytes(
+            {"truncate": content[: len(content) // 2], "garbage": b"PK\x03\x04" + b"\x00" * 99}.get(
+                damage, b""
+            )
+        )
+    code, err = run(capsys, "export", folder, "--format", "csv")
+    assert code == 2 and len(err) == 1 and str(npz) in err[0], err
+
+
+def test_export_out_is_an_existing_file(capsys, planned_folder, tmp_path):
+    (tmp_path / "file").write_text("x")
+    plan_dir = planned_folder("seal_plate_kr16")[1]
+    code, err = run(capsys, "export", plan_dir, "--format", "csv", "--out", tmp_path / "file")
+    assert code == 2 and len(err) == 1 and str(tmp_path / "file") in err[0], err
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".ply", ".obj"])
+def test_corrupt_part_mesh_is_one_line_exit_2(capsys, tmp_path, suffix):
+    from config.test_cell_errors import BASE, write_cell  # tests/config
+
+    cell = write_cell(tmp_path, BASE.replace("part:\n", f"part:\n  mesh: part{suffix}\n", 1))
+    (tmp_path / f"part{suffix}").write_bytes(b"solid x\n\x00\xff\xfe garbage" * 50)
+    code, err = run(capsys, "plan", cell, "--out", tmp_path / "out")
+    assert code == 2 and len(err) == 1 and "part.mesh" in err[0], err
+    assert not (tmp_path / "out").exists()
