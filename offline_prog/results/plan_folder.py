@@ -11,6 +11,7 @@ from __future__ import annotations
 import io
 import json
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -186,6 +187,9 @@ def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
         "report": out_dir / "report.json",
         "collisions": out_dir / "collisions.json",
     }
+    # preview.html needs nothing the other outputs write: the second core draws it.
+    files["preview"] = out_dir / "preview.html"
+    wait_for_preview = in_parallel(lambda: write_preview_html(plan, files["preview"]))
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
     write_collisions_json(plan.collisions, files["collisions"])
@@ -199,7 +203,50 @@ def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
         for fmt in default_formats(data.language):
             for file in export(data, fmt, out_dir / PROGRAMS_DIR):
                 files[f"{fmt}:{file.name}"] = file
-    files["preview"] = out_dir / "preview.html"
-    write_preview_html(plan, files["preview"])
-    files["report_html"] = write_report_html(out_dir)  # last: it lists the programs
+    files["report_html"] = write_report_html(out_dir)  # after the programs: it lists them
+    wait_for_preview()
     return files, summary
+
+
+def in_parallel(function) -> Callable[[], None]:
+    """Start ``function()`` in a forked child process and return ``wait()``, which
+    blocks until it is done and raises the child's error here (as it was, so an
+    OSError still names its path; RuntimeError if it cannot travel).
+
+    Forking shares the plan copy-on-write: nothing is pickled. Where fork is not
+    available, ``function`` runs here and now.
+    """
+    import multiprocessing
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        function()
+        return lambda: None
+    context = multiprocessing.get_context("fork")
+    receive, send = context.Pipe(duplex=False)
+
+    def child() -> None:
+        try:
+            function()
+            send.send("")
+        except BaseException as error:  # raised by wait(), in the parent
+            try:
+                send.send(error)
+            except Exception:  # not picklable: its text
+                send.send(f"{type(error).__name__}: {error}")
+
+    process = context.Process(target=child, daemon=True)
+    process.start()
+    send.close()
+
+    def wait() -> None:
+        try:
+            message = receive.recv()
+        except EOFError:
+            message = "the writer process ended without a word"
+        process.join()
+        if isinstance(message, BaseException):
+            raise message
+        if message or process.exitcode != 0:
+            raise RuntimeError(message or f"writer process exit code {process.exitcode}")
+
+    return wait
