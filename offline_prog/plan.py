@@ -29,6 +29,7 @@ from pathlib import Path
 from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell
+from offline_prog.errors import Failure
 from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
@@ -80,6 +81,12 @@ class Plan:
     def failure(self) -> str:
         """Why the plan failed, one line ("" if it did not)."""
         return self.collisions.message
+
+    @property
+    def failure_kind(self) -> Failure | None:
+        """The Failure of a finished plan that fails a check (a collision), or None.
+        Failures that leave no plan (reach, limits, singularities) are PlanFailedErrors."""
+        return None if self.feasible else Failure.COLLISION
 
 
 def plan_cell(

@@ -117,6 +117,7 @@ def collision_summary(plan: Plan) -> dict:
         ],
         "feasible": plan.feasible,
         "failure": plan.failure,
+        "failure_kind": None if plan.failure_kind is None else plan.failure_kind.value,
         "collision_avoidance": plan.avoidance,
     }
 
