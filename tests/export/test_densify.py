@@ -115,6 +115,7 @@ def test_krl_holds_the_tolerance_and_says_so(kuka, tmp_path):
     assert float(header.group(2)) + HEADER_ROUNDING_MM >= np.rad2deg(angle)
 
 
+@pytest.mark.slow
 def test_krl_points_also_hold_when_the_written_poses_are_interpolated(kuka, tmp_path):
     plan, data = kuka
     result = write_krl(data, tmp_path)

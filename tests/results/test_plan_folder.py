@@ -35,6 +35,7 @@ def abb(planned_folder):
     return planned_folder("weld_seam_irb2400")
 
 
+@pytest.mark.slow
 def test_replanning_another_cell_leaves_only_its_files(kuka, abb, tmp_path):
     out = tmp_path / "out"
     write_outputs(kuka[0], out)
@@ -47,6 +48,7 @@ def test_replanning_another_cell_leaves_only_its_files(kuka, abb, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no temporary sibling left
 
 
+@pytest.mark.slow
 def test_a_crash_mid_write_leaves_the_previous_folder(kuka, abb, tmp_path, monkeypatch):
     out = tmp_path / "out"
     write_outputs(kuka[0], out)
