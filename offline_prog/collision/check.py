@@ -73,11 +73,17 @@ class _Pairs:
                 self.names.append((a.name, b.name))
             self.ids.append((r.id_A, r.id_B))
             shape_of.append(self.names.index((a.name, b.name)))
-            c.append(1.0 if a.body in fixed or b.body in fixed else 2.0)
+            # How fast the distance can change per unit of motion bound (0: both fixed).
+            c.append(0.0 if a.body in fixed and b.body in fixed else
+                     1.0 if a.body in fixed or b.body in fixed else 2.0)  # fmt: skip
         self.shape_of, self.c = np.array(shape_of, dtype=int), np.array(c)
         robot = {label.name for label in cell.labels.values() if label.owner == "robot"}
         # Robot link vs robot link: held to the self-clearance, per shape pair s.
         self.is_self = np.array([a in robot and b in robot for a, b in self.names], dtype=bool)
+        # Fixed layout (robot base, tool, obstacles): never moves, held to contact only.
+        fixed_s = np.ones(len(self.names), dtype=bool)
+        fixed_s[self.shape_of[self.c > 0]] = False
+        self.is_fixed = fixed_s
         owner = {label.name: label.owner for label in cell.labels.values()}
         self.groups = [
             "robot-self" if owner[a] == owner[b] else f"{owner[a]}-{owner[b]}"
@@ -163,6 +169,7 @@ def check_trajectory(
     start = time.perf_counter()
     pairs, rho = _Pairs(cell), cell.motion_radii()
     clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
+    clear_s = np.where(pairs.is_fixed, 0.0, clear_s)  # a base on its floor touches it
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]
     step = np.abs(np.diff(q, axis=0)) @ rho  # (N - 1,) motion bound of each step [m]
     cumulative = np.concatenate([[0.0], np.cumsum(step)])
@@ -189,9 +196,11 @@ def check_trajectory(
         pairs.set(q[i])
         d = np.array([pairs.distance(g) for g in now], dtype=float)
         found.append((now, np.full(len(now), float(i)), d))
-        budget = (d - clear_g[now] - margin) / pairs.c[now]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            budget = (d - clear_g[now] - margin) / pairs.c[now]
         reach = np.searchsorted(cumulative, cumulative[i] + budget, side="right") - 1
         due[now] = np.where(reach >= n - 1, n, np.maximum(reach, i + 1))
+        due[now[pairs.c[now] == 0.0]] = n  # nothing moves: measured once
         lower = (last_d[now] + d - pairs.c[now] * step[i - 1]) / 2 if i else d
         split = (last_i[now] == i - 1) & (lower < clear_g[now])  # steps to bisect
         for g, d_g in zip(now[split], d[split], strict=True):
@@ -204,10 +213,10 @@ def check_trajectory(
     rows = np.flatnonzero(np.r_[True, (s[1:] != s[:-1]) | (x[1:] != x[:-1])])
     s, x, d = s[rows], x[rows], np.minimum.reduceat(d, rows)
     clearances = (clearance, self_clearance, clear_s)
-    return _result(cell, pairs, (s, x, d), q, t, sigma, clearances, n_worst, rho, start)
+    return _result(cell, pairs, (s, x, d), q, t, sigma, clearances, n_worst, rho, start, margin)
 
 
-def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start):
+def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, margin):
     """The CollisionResult of the evaluated table (mesh pairs refined with FCL)."""
     s, x, drake = table
     clearance, self_clearance, clear_s = clearances
@@ -240,6 +249,11 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start):
                 worst.a, worst.b, worst.group, first.sample, last.sample,
                 first.sigma_m, last.sigma_m, first.t_s, last.t_s, worst,
             ))  # fmt: skip
+    measured = np.bincount(s[x == np.floor(x)], minlength=len(pairs.names))  # per pair
+    for pair in minima:  # a pair pruned somewhere: its minimum there is only bounded
+        index = pairs.names.index((pair.a, pair.b))
+        if measured[index] < len(t) and not pairs.is_fixed[index]:
+            pair.lower_bound_m = float(clear_s[index] + margin)
     minima.sort(key=lambda pair: pair.distance_m)
     stretches.sort(key=lambda stretch: stretch.sample_start)
     for pair in minima[:n_worst]:
@@ -254,7 +268,10 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start):
     first = entry(overlaps[0]) if overlaps else None
     stretch = next((r for r in stretches if first and (r.a, r.b) == (first.a, first.b)
                     and r.sample_start <= first.sample <= r.sample_end), None)  # fmt: skip
-    closest = minima[0] if minima else None
+    # The closest approach of what moves; the fixed layout (a base on its floor) is
+    # listed with the pairs and fails only by overlapping.
+    moving = [m for m in minima if not pairs.is_fixed[pairs.names.index((m.a, m.b))]]
+    closest = moving[0] if moving else (minima[0] if minima else None)
     min_distance = closest.distance_m if closest else np.inf
     evaluated = np.unique(x)
     samples = int(np.sum(evaluated == np.floor(evaluated)))

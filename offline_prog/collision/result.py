@@ -26,6 +26,10 @@ class PairMinimum:
         drake_distance_m: SceneGraph's (convex pieces); exact_distance_m: FCL's on the
             original shapes where computed (0.0 for meshes in contact: depth unknown).
         depth_m: penetration depth, max(0, −distance_m).
+        lower_bound_m: None when distance_m is the pair's minimum over every sample and
+            step; else the pair was not evaluated where it was certified farther than
+            this [m] (pruning): its true minimum lies in [min(lower_bound_m, distance_m),
+            distance_m].
     """
 
     a: str
@@ -39,6 +43,7 @@ class PairMinimum:
     depth_m: float = 0.0
     exact_distance_m: float | None = None
     note: str = ""
+    lower_bound_m: float | None = None
 
 
 @dataclasses.dataclass

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from pydrake.geometry import CollisionFilterDeclaration, GeometryId, GeometrySet, Rgba
+from pydrake.geometry import GeometryId, Rgba
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, SpatialInertia
@@ -30,7 +30,7 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.scene.exact_distance import bounding_radius
-from offline_prog.scene.self_collision import read_matrix
+from offline_prog.scene.filters import allow_fixed_layout, filter_contacts, filter_self_pairs
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
 PART_COLOR = Rgba(0.85, 0.55, 0.15, 1.0)
@@ -140,55 +140,6 @@ def _register(plant, body, shape: CellShape, color) -> list[GeometryId]:
     ]
 
 
-def _filter(scene_graph, plant, labels, part, allowed_contact) -> None:
-    """Part vs the bodies it is welded to (the gripper), and each allowed pair."""
-    by_name: dict[str, list[GeometryId]] = {}
-    for geometry_id, label in labels.items():
-        by_name.setdefault(label.name, []).append(geometry_id)
-    manager = scene_graph.collision_filter_manager()
-    holders = [b for b in plant.GetBodiesWeldedTo(part) if b.index() != part.index()]
-    part_ids = [g for g, label in labels.items() if label.owner == "part"]
-    holder_ids = [g for b in holders for g in plant.GetCollisionGeometriesForBody(b)]
-    if part_ids and holder_ids:
-        manager.Apply(
-            CollisionFilterDeclaration().ExcludeBetween(
-                GeometrySet(part_ids), GeometrySet(holder_ids)
-            )
-        )
-    for i, pair in enumerate(allowed_contact):
-        for name in pair:
-            if name not in by_name:
-                known = ", ".join(sorted(by_name))
-                raise ShapeError(
-                    f"allowed_contact[{i}]", f"unknown shape {name!r} (known: {known})"
-                )
-        a, b = (GeometrySet(by_name[name]) for name in pair)
-        manager.Apply(CollisionFilterDeclaration().ExcludeBetween(a, b))
-
-
-def _filter_self_pairs(scene_graph, plant, model, robot: RobotModel):
-    """Exclude the robot's link pairs that its self-collision matrix does not mark
-    ``check``; returns those pairs (None: the robot has no matrix, all are checked)."""
-    try:
-        pairs = read_matrix(robot.urdf_path.parent)
-    except ValueError as error:
-        raise ShapeError("robot.model", str(error)) from None
-    if pairs is None:
-        return None
-    manager = scene_graph.collision_filter_manager()
-    skipped = [p for p in pairs if p.kind != "check"]
-    for pair in skipped:
-        a, b = (plant.GetBodyByName(name, model) for name in (pair.a, pair.b))
-        ids = [plant.GetCollisionGeometriesForBody(body) for body in (a, b)]
-        if all(ids):
-            manager.Apply(
-                CollisionFilterDeclaration().ExcludeBetween(
-                    GeometrySet(ids[0]), GeometrySet(ids[1])
-                )
-            )
-    return skipped
-
-
 def build_drake_cell(
     robot: RobotModel,
     *,
@@ -253,8 +204,9 @@ def build_drake_cell(
     for body in (plant.get_body(b) for b in plant.GetBodyIndices(model)):
         for geometry_id in plant.GetCollisionGeometriesForBody(body):
             labels[geometry_id] = GeometryLabel("robot", body.name(), body.name())
-    _filter(builder.scene_graph(), plant, labels, part, allowed_contact)
-    skipped = _filter_self_pairs(builder.scene_graph(), plant, model, robot)
+    allow_fixed_layout(builder.scene_graph(), plant, model, labels)
+    filter_contacts(builder.scene_graph(), plant, labels, part, allowed_contact)
+    skipped = filter_self_pairs(builder.scene_graph(), plant, model, robot)
     visualizer = None
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams

@@ -70,3 +70,43 @@ def test_self_pairs_are_held_to_the_self_clearance():
     _, loose = _check(robot, [], np.zeros((2, 6)), clearance=1.0, self_clearance=closest - 1e-3)
     assert not strict.collision_free and strict.message.startswith("clearance:")
     assert loose.collision_free
+
+
+def test_the_fixed_layout_is_checked_a_duct_through_the_base_fails(tmp_path):
+    """Drake filters pairs of bodies welded together (robot base, tool, obstacles); a
+    cable duct through the KR 16's base must still fail the plan, while the base
+    resting on the floor (1 mm above it) and the tool on its stand do not."""
+    from offline_prog.plan import plan_cell
+
+    from conftest import CELLS
+
+    text = (CELLS / "seal_plate_kr16.yaml").read_text().replace(": data/", f": {CELLS}/data/")
+    assert "obstacles:   # in I" in text
+    file = tmp_path / "duct.yaml"
+    file.write_text(text.replace("obstacles:   # in I", "obstacles:   # in I\n"
+        "  - {name: cable_duct, shape: box, size_mm: [200, 200, 150], "
+        "pose: {translation: [-0.25, 0.0, 0.25]}}"))  # fmt: skip
+    plan = plan_cell(file)
+    assert not plan.feasible and plan.failure.startswith("collision: base_link vs cable_duct")
+    pairs = {(p.a, p.b): p.distance_m for p in plan.collisions.pairs}
+    assert pairs[("base_link", "cable_duct")] < -0.05  # overlapping by centimetres
+    clear = plan_cell(CELLS / "seal_plate_kr16.yaml")
+    fixed = {(p.a, p.b): p.distance_m for p in clear.collisions.pairs}
+    assert clear.feasible and 0.0 <= fixed[("base_link", "floor")] < 0.005  # held to contact
+    assert clear.collisions.closest.a != "base_link"  # the closest approach is of what moves
+
+
+def test_pruned_pair_minima_are_labelled_as_bounds():
+    """A pair certified far away is not measured at every sample, so its reported
+    minimum is an upper bound of the true one: collisions.json says so."""
+    from offline_prog.plan import plan_cell
+
+    from conftest import CELLS
+
+    plan = plan_cell(CELLS / "seal_plate_kr16.yaml")
+    bounded = [p for p in plan.collisions.pairs if p.lower_bound_m is not None]
+    exact = [p for p in plan.collisions.pairs if p.lower_bound_m is None]
+    assert bounded and exact
+    clearance = plan.cell.motion.clearance
+    for pair in bounded:  # certified: the true minimum is above clearance + margin
+        assert pair.lower_bound_m > clearance and pair.distance_m >= pair.lower_bound_m
