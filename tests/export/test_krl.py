@@ -4,11 +4,10 @@ Status/Turn (URDF link geometry), point density, splitting, linting, forced head
 
 import dataclasses
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from krl_lint import assert_krllint_clean
 from scipy.spatial.transform import Rotation
 
 from offline_prog.export.krl import write_krl
@@ -330,22 +329,8 @@ def test_files_are_plain_krl(data, tmp_path):
 
 
 def test_krllint_finds_nothing(data, tmp_path):
-    pytest.importorskip("krllint", reason="krllint (PyPI, KRL style checker) is not installed")
     write_krl(data, tmp_path / "krl", line_limit=60)
-    config = tmp_path / "krllint_config.py"
-    config.write_text(
-        "from krllint.reporter import TextReporter\n"
-        "INDENT_CHAR = ' '\nINDENT_SIZE = 3\nDISABLE = []\nREPORTER = TextReporter\n"
-    )
-    run = subprocess.run(
-        [sys.executable, "-m", "krllint", "--config", str(config), str(tmp_path / "krl")],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    counts = re.findall(r"^(\d+) (?:violated|possible|found|fatal)", run.stdout, re.M)
-    assert "Error" not in run.stdout and len(counts) == 5, run.stdout
-    assert all(int(c) == 0 for c in counts), run.stdout
+    assert_krllint_clean(tmp_path / "krl", tmp_path)
 
 
 def test_forced_export_says_so_in_every_file(data, tmp_path):

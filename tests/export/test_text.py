@@ -2,11 +2,10 @@
 
 import dataclasses
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from krl_lint import assert_krllint_clean
 
 from offline_prog.export.krl import write_krl
 from offline_prog.export.program import ProgramData
@@ -145,22 +144,8 @@ def test_program_names_are_identifiers(kuka, abb, ur, tmp_path):
 
 
 def test_krllint_accepts_hostile_headers(kuka, tmp_path):
-    pytest.importorskip("krllint", reason="krllint (PyPI, KRL style checker) is not installed")
     write_krl(hostile(kuka, "".join(HOSTILE)), tmp_path / "krl", forced=True)
-    config = tmp_path / "krllint_config.py"
-    config.write_text(
-        "from krllint.reporter import TextReporter\n"
-        "INDENT_CHAR = ' '\nINDENT_SIZE = 3\nDISABLE = []\nREPORTER = TextReporter\n"
-    )
-    run = subprocess.run(
-        [sys.executable, "-m", "krllint", "--config", str(config), str(tmp_path / "krl")],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    counts = re.findall(r"^(\d+) (?:violated|possible|found|fatal)", run.stdout, re.M)
-    assert "Error" not in run.stdout and len(counts) == 5, run.stdout
-    assert all(int(c) == 0 for c in counts), run.stdout
+    assert_krllint_clean(tmp_path / "krl", tmp_path)
 
 
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
