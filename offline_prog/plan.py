@@ -35,6 +35,7 @@ from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
 from offline_prog.path.fixed_tcp import FlangePath
+from offline_prog.path.inputs import NormalFit
 from offline_prog.path.sources import PathPoints
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.stages import (
@@ -71,6 +72,7 @@ class Plan:
     avoidance: dict | None = None  # what the collision avoidance tried and changed
     # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
     clearance_profile: tuple | None = None
+    normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
 
     @property
     def feasible(self) -> bool:
@@ -149,4 +151,5 @@ def plan_cell(
         chosen.collisions,
         avoidance,
         profile,
+        fit.normal_fit,
     )

@@ -25,7 +25,7 @@ from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.path.inputs import load_points, normal_field
+from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
 from offline_prog.path.process_frames import NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.robot.model import RobotModel, load_robot
@@ -63,6 +63,7 @@ class FittedPath:
     fitted: FittedSpline
     path: ArcLengthPath
     normal: object  # normal field n(σ) in P, see offline_prog.path.process_frames
+    normal_fit: NormalFit  # the angle from each given normal to the fitted field
 
 
 @dataclasses.dataclass
@@ -128,7 +129,9 @@ def fit_path(inputs: Inputs) -> FittedPath:
         raise InputError(file, "path", str(error)) from None
     path = ArcLengthPath(fitted)
     _check_turns(file, path)
-    return FittedPath(fitted, path, normal_field(file, inputs.cell, inputs.points, path))
+    normal = normal_field(file, inputs.cell, inputs.points, path)
+    normal_fit = check_normal_fit(file, inputs.cell, inputs.points, path, normal)
+    return FittedPath(fitted, path, normal, normal_fit)
 
 
 def flange_paths(inputs: Inputs, fit: FittedPath) -> FlangePaths:

@@ -108,6 +108,7 @@ class PathConfig:
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5
     fit_tolerance_mm: float = 0.1
+    normal_tolerance_deg: float = 2.0  # max angle, given (CSV) to fitted normal
     n_control_points: int | None = None
 
 

@@ -63,6 +63,7 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "path.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
     for key, value in (
         ("path.fit_tolerance_mm", path.fit_tolerance_mm),
+        ("path.normal_tolerance_deg", path.normal_tolerance_deg),
         ("motion.speed", motion.speed),
         ("motion.max_acceleration", motion.max_acceleration),
         ("motion.max_jerk", motion.max_jerk),

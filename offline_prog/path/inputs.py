@@ -6,6 +6,7 @@ and the surface-normal field. Every failure is a InputError naming the file and 
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,27 @@ from offline_prog.config.cell import Cell
 from offline_prog.errors import InputError
 from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
-from offline_prog.path.process_frames import constant_normal, mesh_normals, spline_normal
+from offline_prog.path.process_frames import (
+    constant_normal,
+    mesh_normals,
+    normal_fit_angles,
+    spline_normal,
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class NormalFit:
+    """How far the fitted normal field is from the given normals [deg].
+
+    source: "points" (CSV nx,ny,nz: measured), "constant" (path.normal: exact, 0) or
+    "mesh" (part.mesh: not measured, None). worst_row: 1-based CSV data row of the
+    largest angle (row 1 is the first point after the header), or None.
+    """
+
+    source: str
+    max_error_deg: float | None
+    rms_error_deg: float | None
+    worst_row: int | None = None
 
 
 def _error(file, key, reason) -> InputError:
@@ -114,3 +135,29 @@ def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
     mesh = trimesh.load(file.parent / cell.part.mesh, force="mesh")
     mesh.apply_scale(path_sources.UNIT_SCALE[cell.part.mesh_units])
     return spline_normal(path, mesh_normals(mesh, points.p_PR))
+
+
+def check_normal_fit(file: Path, cell: Cell, points, path: ArcLengthPath, field) -> NormalFit:
+    """Measure the normal-fit residual; InputError above path.normal_tolerance_deg.
+
+    The normal field has as few control points as the position fit needs, so a few
+    wrong normals tilt the tool along the whole path; this makes that loud.
+    """
+    if cell.path.normal is not None:
+        return NormalFit("constant", 0.0, 0.0)
+    if points.normals_P is None:
+        return NormalFit("mesh", None, None)
+    angles = np.rad2deg(normal_fit_angles(path, points.normals_P, field))
+    worst = int(np.argmax(angles))
+    row = int(points.rows[worst] if points.rows is not None else worst) + 1
+    fit = NormalFit("points", float(angles[worst]), float(np.sqrt(np.mean(angles**2))), row)
+    tolerance = cell.path.normal_tolerance_deg
+    if fit.max_error_deg > tolerance:
+        raise _error(
+            file,
+            "path.normal_tolerance_deg",
+            f"the fitted surface normal is {fit.max_error_deg:.2f}° off the normal given at "
+            f"row {row} of {cell.path.points} (file line {row + 1}), more than {tolerance:g}° "
+            f"(RMS {fit.rms_error_deg:.2f}°): check the normals near that row",
+        )
+    return fit

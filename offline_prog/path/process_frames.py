@@ -79,6 +79,18 @@ def spline_normal(path: ArcLengthPath, normals_P: np.ndarray) -> NormalField:
     return field
 
 
+def normal_fit_angles(path: ArcLengthPath, normals_P: np.ndarray, field: NormalField):
+    """(N,) angle [rad] between each given normal and the fitted field at that point.
+
+    The point's place on the path is the fit's own parameter of it (u_data, the
+    parameter spline_normal fitted at), mapped to arc length.
+    """
+    given = normals_P / np.linalg.norm(normals_P, axis=1, keepdims=True)
+    fitted = field(path.map.s_of_u(path.fitted.u_data))[0]
+    sin = np.linalg.norm(np.cross(given, fitted), axis=1)
+    return np.arctan2(sin, np.einsum("ij,ij->i", given, fitted))
+
+
 def mesh_normals(mesh, points_P: np.ndarray) -> np.ndarray:
     """(N, 3) normals into the surface of a trimesh part at its closest points.
 

@@ -32,11 +32,13 @@ class OpenEndsError(ValueError):
 
 @dataclasses.dataclass(frozen=True)
 class PathPoints:
-    """Points on the part: p_PR (N, 3) in P [m]; normals_P (N, 3) unit or None."""
+    """Points on the part: p_PR (N, 3) in P [m]; normals_P (N, 3) unit or None;
+    rows (N,) each point's 0-based data row in its source (repeats dropped)."""
 
     p_PR: np.ndarray
     normals_P: np.ndarray | None
     closed: bool
+    rows: np.ndarray | None = None
 
 
 def clean_points(p, normals, *, closed: bool) -> PathPoints:
@@ -46,7 +48,7 @@ def clean_points(p, normals, *, closed: bool) -> PathPoints:
         keep[-1] = False
     p = p[keep]
     normals = None if normals is None else normals[keep]
-    return PathPoints(p, normals, closed)
+    return PathPoints(p, normals, closed, np.flatnonzero(keep))
 
 
 def read_csv_points(

@@ -130,6 +130,19 @@ def payload_summary(cell) -> dict:
     return {"set": complete, "warning": warning, **record}
 
 
+def normal_fit_summary(plan: Plan) -> dict:
+    """report.json's normal-fit keys: the angle from the given normals to the fitted
+    field [deg] (0 for a constant path.normal, None for normals from part.mesh)."""
+    fit = plan.normal_fit
+    return {
+        "normal_source": None if fit is None else fit.source,
+        "normal_tolerance_deg": plan.cell.path.normal_tolerance_deg,
+        "normal_max_error_deg": None if fit is None else fit.max_error_deg,
+        "normal_rms_error_deg": None if fit is None else fit.rms_error_deg,
+        "normal_worst_row": None if fit is None else fit.worst_row,
+    }
+
+
 def report(plan: Plan) -> dict:
     """The machine-readable plan summary (SI units unless the key says otherwise)."""
     cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
@@ -163,6 +176,7 @@ def report(plan: Plan) -> dict:
             "tolerance_mm": cell.path.fit_tolerance_mm,
             "max_error_mm": fitted.max_error_m * 1e3,
             "rms_error_mm": fitted.rms_error_m * 1e3,
+            **normal_fit_summary(plan),
         },
         "motion": {
             "speed_reference": tr.reference,
