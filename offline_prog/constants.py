@@ -37,3 +37,5 @@ MAX_SPEED_M_S = 2.0  # motion.speed: process speeds are mm/s to ~1 m/s; above is
 MAX_VALUE_CHARS = 80  # a value quoted in an error message is cut to this
 MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this package drives
 MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin
+# A cell's mesh larger than this across is a unit slip (a mm file read as m: 1000×).
+MAX_MESH_EXTENT_M = 20.0

@@ -21,6 +21,7 @@ from pydrake.geometry import Box, Capsule, Convex, Cylinder, Mesh, Shape, Sphere
 from pydrake.math import RigidTransform
 
 from offline_prog.config.cell import Cell, transform
+from offline_prog.constants import MAX_MESH_EXTENT_M
 from offline_prog.scene.mesh_cache import as_obj, convex_pieces
 
 if TYPE_CHECKING:  # trimesh costs ~0.5 s to import; loaded where a mesh is used
@@ -140,6 +141,14 @@ def mesh_shape(
         reason = (str(error).splitlines() or [""])[0] or type(error).__name__
         raise ShapeError(key, f"cannot read {str(file)!r} for {name!r} ({reason})") from None
     mesh.apply_scale(scale)
+    extent = float(max(mesh.extents))
+    if extent > MAX_MESH_EXTENT_M:  # before CoACD, which would take minutes on it
+        hint = " (the file looks like mm: set mesh_units: mm)" if extent / 1000 < 5 else ""
+        raise ShapeError(
+            key,
+            f"{str(file)!r} for {name!r} is {extent:.4g} m across, more than "
+            f"{MAX_MESH_EXTENT_M:g} m{hint}",
+        )
     visual = as_obj(file, scale)
     pieces = (visual,) if mesh.is_convex else convex_pieces(file, scale, mesh)
     return CellShape(name, "mesh", X_OG or RigidTransform(), (), mesh, pieces, visual)

@@ -323,3 +323,14 @@ def test_motion_bound_holds_for_random_joint_steps(kr16, rng):
             p_IQ_b = plant.EvalBodyPoseInWorld(context, body) @ p_BQ
             moved = max(moved, np.linalg.norm(p_IQ_b - p_IQ_a, axis=0).max())
         assert moved <= np.abs(q_b - q_a) @ rho
+
+
+def test_a_mesh_in_mm_declared_as_metres_is_refused_at_once(tmp_path):
+    """cylinder_shell.stl is in mm: read as metres it is hundreds of metres across, which
+    CoACD would grind on for minutes; it is one line naming the key, with the hint."""
+    with pytest.raises(ShapeError) as error:
+        mesh_shape("shell", DATA / "data" / "cylinder_shell.stl", 1.0, key="part.mesh")
+    message = str(error.value)
+    assert message.startswith("part.mesh: ") and "set mesh_units: mm" in message
+    assert "\n" not in message
+    assert mesh_shape("shell", DATA / "data" / "cylinder_shell.stl", 1e-3).kind == "mesh"
