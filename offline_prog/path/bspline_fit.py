@@ -229,6 +229,14 @@ def fit_bspline(
             break
         lo_m = m
         if m == m_max:
+            extent = float(np.ptp(points, axis=0).max())
+            if not np.isfinite(trial.max_error_m) or trial.max_error_m > extent:
+                # An error beyond the points' own size: the fit diverged, not a tolerance.
+                raise ValueError(
+                    f"the points do not trace a curve a spline can follow (the fit "
+                    f"diverges with {m_max} control points); check for repeated, "
+                    "back-and-forth or scattered points"
+                )
             raise ValueError(
                 f"cannot fit within {tolerance_m * 1e3:.3g} mm even with {m_max} control "
                 f"points (best {trial.max_error_m * 1e3:.3g} mm); raise the tolerance "

@@ -74,3 +74,18 @@ def test_rejects_low_degree_and_too_few_points(rng):
         fit_bspline(points[:4], closed=False)
     with pytest.raises(ValueError, match="n_control_points"):
         fit_bspline(points, closed=False, n_control_points=2)
+
+
+def test_points_no_spline_can_follow_get_a_plain_reason_not_an_absurd_error(rng):
+    """Scattered or back-and-forth points made the fit diverge and the message quote
+    'best 2.22e+87 mm'; now it says what is wrong with the points."""
+    import warnings
+
+    scattered = rng.uniform(0.0, 0.2, size=(300, 3))
+    zigzag = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]] * 100) + rng.normal(0, 1e-6, (200, 3))
+    for points in (scattered, zigzag):
+        with warnings.catch_warnings(), pytest.raises(ValueError) as error:
+            warnings.simplefilter("ignore", RuntimeWarning)
+            fit_bspline(points, closed=False, tolerance_m=1e-4)
+        message = str(error.value)
+        assert "do not trace a curve" in message and "e+" not in message
