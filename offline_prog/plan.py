@@ -29,7 +29,7 @@ from pathlib import Path
 from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell
-from offline_prog.errors import Failure
+from offline_prog.errors import Failure, PlanFailedError
 from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
@@ -45,6 +45,7 @@ from offline_prog.stages import (
     fit_path,
     flange_paths,
     load_inputs,
+    with_normal_hint,
 )
 from offline_prog.timing.trajectory import WorkspaceTrajectory
 
@@ -123,10 +124,13 @@ def plan_cell(
     flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
     scene = stage("scene", "building the Drake cell", build_scene, inputs)
     rotation, flange = flanges.rotations[0]
-    first = stage(
-        "joints", "joint trajectory and collision check", attempt_motion, inputs, scene,
-        rotation, flange,
-    )  # fmt: skip
+    try:
+        first = stage(
+            "joints", "joint trajectory and collision check", attempt_motion, inputs, scene,
+            rotation, flange,
+        )  # fmt: skip
+    except PlanFailedError as error:
+        raise with_normal_hint(error, inputs, fit, scene) from None
     chosen, avoidance = stage(
         "collision", "collision avoidance", avoid, inputs, fit, flanges, scene, first, progress
     )

@@ -19,7 +19,7 @@ from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
-from offline_prog.errors import InputError
+from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
@@ -246,3 +246,25 @@ def avoid(
         progress("collision avoidance: Drake IK with a minimum-distance constraint")
         chosen = turn_tool_along_path(chosen, record, attempt, scene, fit.path, fit.normal, inputs)
     return chosen, record
+
+
+def with_normal_hint(error: PlanFailedError, inputs: Inputs, fit: FittedPath, scene):
+    """``error``, with a hint when the same path is feasible with the surface normal
+    reversed: a normal pointing out of the surface (not into it) turns the tool frame
+    over and reads as out of reach or a singularity. Costs one more joint plan, and
+    only on failure."""
+
+    def flipped(s):
+        return [-v for v in fit.normal(s)]
+
+    try:
+        flange = FlangePath(fit.path, flipped, X_IT=inputs.X_IT, X_PE=inputs.X_PE)
+        attempt_motion(inputs, scene, 0.0, flange)
+    except (PlanFailedError, NormalTangentError, InputError):
+        return error
+    failure = error.failure
+    hint = (
+        "; with the path's normals reversed the robot can follow it: check that they "
+        "point into the surface (path.normal, the CSV's nx,ny,nz or the mesh)"
+    )
+    return PlanFailedError(dataclasses.replace(failure, reason=failure.reason + hint))

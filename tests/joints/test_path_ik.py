@@ -121,3 +121,19 @@ def test_abb_axis_3_limits_apply_to_q2_plus_q3():
     assert np.rad2deg(coupled.margin_rad) == pytest.approx(np.rad2deg(-0.7) + 60, abs=0.5)
     uncoupled = generating(branch_results(dataclasses.replace(robot, j23_coupled=False), X_BE))
     assert not uncoupled.feasible and uncoupled.reason == "joint limit on axis 3"
+
+
+def test_a_reversed_normal_is_named_not_only_out_of_reach(tmp_path):
+    """The seal demo with its normal pointing out of the plate instead of into it: the
+    tool frame turns over and the path is out of reach; the message says the normal is
+    the likely cause (the same path with it reversed is feasible)."""
+    text = (CELLS / "seal_plate_kr16.yaml").read_text().replace(": data/", f": {CELLS}/data/")
+    flipped = text.replace("  normal: [0, 0, 1]", "  normal: [0, 0, -1]")
+    assert flipped != text
+    file = tmp_path / "flipped.yaml"
+    file.write_text(flipped)
+    with pytest.raises(PlanFailedError) as error:
+        plan_cell(file)
+    message = str(error.value)
+    assert "out of reach" in message and "normals reversed the robot can follow it" in message
+    assert error.value.failure.kind.value == "out_of_reach"
