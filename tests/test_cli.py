@@ -109,3 +109,29 @@ def test_corrupt_part_mesh_is_one_line_exit_2(capsys, tmp_path, suffix):
     code, err = run(capsys, "plan", cell, "--out", tmp_path / "out")
     assert code == 2 and len(err) == 1 and "part.mesh" in err[0], err
     assert not (tmp_path / "out").exists()
+
+
+def test_ctrl_c_while_writing_is_exit_130_one_line_and_no_half_folder(
+    capsys, tmp_path, monkeypatch
+):
+    """Ctrl-C during the writes: one line, exit 130, no traceback, and the folder
+    holds the previous complete plan (nothing of the interrupted one)."""
+    import offline_prog.results.plan_folder as plan_folder
+
+    out = tmp_path / "out"
+    assert run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", out)[0] == 0
+    before = sorted(p.relative_to(out) for p in out.rglob("*"))
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(plan_folder, "write_report_html", interrupted)
+    code, err = run(capsys, "plan", CELLS / "tape_cylinder_ur10e.yaml", "--out", out)
+    assert code == 130 and err == ["interrupted"]
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staged sibling left
+
+
+def test_out_under_proc_is_one_line_exit_2(capsys):
+    code, err = run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", "/proc/offline_prog")
+    assert code == 2 and len(err) == 1 and err[0].startswith("error: /proc")

@@ -11,7 +11,6 @@ from __future__ import annotations
 import io
 import json
 import os
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -189,7 +188,17 @@ def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     }
     # preview.html needs nothing the other outputs write: the second core draws it.
     files["preview"] = out_dir / "preview.html"
-    wait_for_preview = in_parallel(lambda: write_preview_html(plan, files["preview"]))
+    preview = InParallel(lambda: write_preview_html(plan, files["preview"]))
+    try:
+        summary = _write_rest(plan, out_dir, files)
+        preview.wait()
+    finally:
+        preview.cancel()  # an error or Ctrl-C here: stop it before the folder goes
+    return files, summary
+
+
+def _write_rest(plan: Plan, out_dir: Path, files: dict[str, Path]) -> dict:
+    """Everything but preview.html, into ``files``; returns the report."""
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
     write_collisions_json(plan.collisions, files["collisions"])
@@ -204,49 +213,58 @@ def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
             for file in export(data, fmt, out_dir / PROGRAMS_DIR):
                 files[f"{fmt}:{file.name}"] = file
     files["report_html"] = write_report_html(out_dir)  # after the programs: it lists them
-    wait_for_preview()
-    return files, summary
+    return summary
 
 
-def in_parallel(function) -> Callable[[], None]:
-    """Start ``function()`` in a forked child process and return ``wait()``, which
-    blocks until it is done and raises the child's error here (as it was, so an
-    OSError still names its path; RuntimeError if it cannot travel).
+class InParallel:
+    """``function()`` running in a forked child process (the plan is shared
+    copy-on-write: nothing is pickled); where fork is not available it runs at once.
 
-    Forking shares the plan copy-on-write: nothing is pickled. Where fork is not
-    available, ``function`` runs here and now.
+    ``wait()`` blocks until it is done and raises the child's error here, as it was (an
+    OSError keeps its path; RuntimeError if it cannot travel). ``cancel()`` stops it:
+    a folder is never removed while the child still writes into it.
     """
-    import multiprocessing
 
-    if "fork" not in multiprocessing.get_all_start_methods():
-        function()
-        return lambda: None
-    context = multiprocessing.get_context("fork")
-    receive, send = context.Pipe(duplex=False)
+    def __init__(self, function):
+        import multiprocessing
 
-    def child() -> None:
-        try:
+        self.process = None
+        if "fork" not in multiprocessing.get_all_start_methods():
             function()
-            send.send("")
-        except BaseException as error:  # raised by wait(), in the parent
+            return
+        context = multiprocessing.get_context("fork")
+        self.receive, send = context.Pipe(duplex=False)
+
+        def child() -> None:
             try:
-                send.send(error)
-            except Exception:  # not picklable: its text
-                send.send(f"{type(error).__name__}: {error}")
+                function()
+                send.send("")
+            except BaseException as error:  # raised by wait(), in the parent
+                try:
+                    send.send(error)
+                except Exception:  # not picklable: its text
+                    send.send(f"{type(error).__name__}: {error}")
 
-    process = context.Process(target=child, daemon=True)
-    process.start()
-    send.close()
+        self.process = context.Process(target=child, daemon=True)
+        self.process.start()
+        send.close()
 
-    def wait() -> None:
+    def wait(self) -> None:
+        if self.process is None:
+            return
         try:
-            message = receive.recv()
+            message = self.receive.recv()
         except EOFError:
             message = "the writer process ended without a word"
-        process.join()
+        self.process.join()
+        self.process = None
         if isinstance(message, BaseException):
             raise message
-        if message or process.exitcode != 0:
-            raise RuntimeError(message or f"writer process exit code {process.exitcode}")
+        if message:
+            raise RuntimeError(message)
 
-    return wait
+    def cancel(self) -> None:
+        if self.process is not None:
+            self.process.terminate()
+            self.process.join()
+            self.process = None

@@ -21,6 +21,7 @@ from pydrake.geometry import Box, Capsule, Convex, Cylinder, Mesh, Shape, Sphere
 from pydrake.math import RigidTransform
 
 from offline_prog.config.cell import Cell, transform
+from offline_prog.config.safe_yaml import short_repr
 from offline_prog.constants import MAX_MESH_EXTENT_M
 from offline_prog.scene.mesh_cache import as_obj, convex_pieces
 
@@ -83,7 +84,7 @@ def _positive(key: str, name: str, value, count: int) -> tuple[float, ...]:
     if value is None:
         raise ShapeError(key, f"missing for the {name!r} shape")
     if not (len(values) == count and all(np.isfinite(v) and v > 0 for v in values)):
-        raise ShapeError(key, f"expected {count} positive number(s) for {name!r}, got {value!r}")
+        raise ShapeError(key, f"expected {count} positive number(s) for {name!r}, got {short_repr(value)}")
     return tuple(float(v) * 1e-3 for v in values)
 
 
