@@ -84,7 +84,8 @@ def _positive(key: str, name: str, value, count: int) -> tuple[float, ...]:
     if value is None:
         raise ShapeError(key, f"missing for the {name!r} shape")
     if not (len(values) == count and all(np.isfinite(v) and v > 0 for v in values)):
-        raise ShapeError(key, f"expected {count} positive number(s) for {name!r}, got {short_repr(value)}")
+        got = short_repr(value)
+        raise ShapeError(key, f"expected {count} positive number(s) for {name!r}, got {got}")
     return tuple(float(v) * 1e-3 for v in values)
 
 
