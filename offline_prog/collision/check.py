@@ -38,6 +38,7 @@ from offline_prog.collision.result import (  # noqa: F401  (re-exported)
 )
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.scene.exact_distance import exact_distance, exact_shape, exact_shape_of_drake
+from offline_prog.scene.filters import allow_fixed_layout
 
 # A pair certified above clearance + this is not evaluated (its minimum is then over
 # the evaluated points only).
@@ -55,12 +56,16 @@ class _Pairs:
     """The unfiltered geometry pairs g of a cell, grouped into shape pairs s, and their
     signed distances at a joint vector (Drake) or on the original shapes (FCL)."""
 
-    def __init__(self, cell: DrakeCell):
+    def __init__(self, cell: DrakeCell, *, fixed_layout: bool = False):
         self.cell, plant = cell, cell.plant
         self.context = cell.diagram.CreateDefaultContext()
         self.plant_context = plant.GetMyMutableContextFromRoot(self.context)
         scene_graph = cell.diagram.scene_graph()
-        self.sg_context = scene_graph.GetMyContextFromRoot(self.context)
+        self.sg_context = scene_graph.GetMyMutableContextFromRoot(self.context)
+        if fixed_layout:  # in this context only: IK and plots keep Drake's filters
+            allow_fixed_layout(
+                scene_graph, plant, cell.robot, cell.labels, self.sg_context, cell.allowed_contact
+            )
         self.port = scene_graph.get_query_output_port()
         self.set(plant.GetPositions(self.plant_context, cell.robot))
         fixed = {b.name() for b in plant.GetBodiesWeldedTo(plant.world_body())}
@@ -167,7 +172,7 @@ def check_trajectory(
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"{name}: expected a distance >= 0 m, got {value!r}")
     start = time.perf_counter()
-    pairs, rho = _Pairs(cell), cell.motion_radii()
+    pairs, rho = _Pairs(cell, fixed_layout=True), cell.motion_radii()
     clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
     clear_s = np.where(pairs.is_fixed, 0.0, clear_s)  # a base on its floor touches it
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]

@@ -30,7 +30,7 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.scene.exact_distance import bounding_radius
-from offline_prog.scene.filters import allow_fixed_layout, filter_contacts, filter_self_pairs
+from offline_prog.scene.filters import filter_contacts, filter_self_pairs
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
 PART_COLOR = Rgba(0.85, 0.55, 0.15, 1.0)
@@ -204,7 +204,6 @@ def build_drake_cell(
     for body in (plant.get_body(b) for b in plant.GetBodyIndices(model)):
         for geometry_id in plant.GetCollisionGeometriesForBody(body):
             labels[geometry_id] = GeometryLabel("robot", body.name(), body.name())
-    allow_fixed_layout(builder.scene_graph(), plant, model, labels)
     filter_contacts(builder.scene_graph(), plant, labels, part, allowed_contact)
     skipped = filter_self_pairs(builder.scene_graph(), plant, model, robot)
     visualizer = None

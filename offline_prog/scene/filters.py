@@ -3,8 +3,9 @@
 MultibodyPlant filters every pair of geometries on bodies welded together, which in a
 cell means the robot base, the fixed tool and the obstacles (all welded to the world):
 a cable duct through the robot's base would never be seen. ``allow_fixed_layout`` puts
-those pairs back (robot base vs obstacles and tool, tool vs obstacles; obstacles among
-themselves stay filtered: they stand on each other by design). Then the intended
+those pairs back in the collision check's context (robot base vs obstacles and tool,
+tool vs obstacles; obstacles among themselves stay filtered: they stand on each other
+by design). Then the intended
 contacts (the part in its gripper, ``allowed_contact``) and the robot's own link pairs
 that its self-collision matrix does not mark ``check`` are filtered out.
 """
@@ -18,10 +19,14 @@ from offline_prog.scene.self_collision import read_matrix
 from offline_prog.scene.shapes import ShapeError
 
 
-def allow_fixed_layout(scene_graph, plant, model, labels) -> None:
+def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_contact=()) -> None:
     """Check the robot base vs obstacles and tool, and the tool vs obstacles, although
-    they never move: their overlap is a layout error (checked once, held to contact)."""
-    manager = scene_graph.collision_filter_manager()
+    they never move: their overlap is a layout error (checked once, held to contact).
+
+    Applied to one SceneGraph ``context`` (the collision check's), so Drake IK with a
+    minimum-distance constraint and the distance plots keep Drake's own filters: a
+    base resting on its floor must not count there."""
+    manager = scene_graph.collision_filter_manager(context)
     base = plant.GetBodyByName("base_link", model)
     fixed = {b.index() for b in plant.GetBodiesWeldedTo(plant.world_body())}
     owners = {"robot": [], "tool": [], "obstacle": []}
@@ -33,6 +38,13 @@ def allow_fixed_layout(scene_graph, plant, model, labels) -> None:
                  (owners["tool"], owners["obstacle"])):  # fmt: skip
         if a and b:
             manager.Apply(CollisionFilterDeclaration().AllowBetween(GeometrySet(a), GeometrySet(b)))
+    by_name: dict[str, list[GeometryId]] = {}
+    for geometry_id, label in labels.items():
+        by_name.setdefault(label.name, []).append(geometry_id)
+    for pair in allowed_contact:  # intended contacts stay unchecked
+        if all(name in by_name for name in pair):
+            a, b = (GeometrySet(by_name[name]) for name in pair)
+            manager.Apply(CollisionFilterDeclaration().ExcludeBetween(a, b))
 
 
 def filter_contacts(scene_graph, plant, labels, part, allowed_contact) -> None:
