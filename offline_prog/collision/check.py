@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
+from offline_prog.arrays import at_index, true_runs
 from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     CollisionResult,
     CollisionStretch,
@@ -129,12 +129,6 @@ class _Pairs:
         return min(exact_distance(sa, pose(ga), sb, pose(gb)) for sa, ga in a for sb, gb in b)
 
 
-def _at(values: np.ndarray, x: float) -> float:
-    """values (N, ...) linearly interpolated at the fractional sample index x."""
-    i = min(int(x), len(values) - 2) if len(values) > 1 else 0
-    return values[i] + (x - i) * (values[i + 1] - values[i]) if x != i else values[i]
-
-
 def check_trajectory(
     cell: DrakeCell,
     q: np.ndarray,
@@ -187,7 +181,7 @@ def check_trajectory(
         if motion <= max(clear_g[g], MIN_SUBSTEP_M):
             return
         xm = (xa + xb) / 2
-        pairs.set(_at(q, xm))
+        pairs.set(at_index(q, xm))
         dm = pairs.distance(g)
         found.append(([g], [xm], [dm]))
         bisect(g, xa, da, xm, dm, motion / 2)
@@ -232,15 +226,15 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
     if len(refine) > MAX_EXACT_CHECKS:
         notes.append(f"{len(refine) - MAX_EXACT_CHECKS} mesh-pair points kept Drake's distance")
     for k in refine[:MAX_EXACT_CHECKS]:
-        exact[k] = pairs.exact(_at(q, x[k]), s[k])
+        exact[k] = pairs.exact(at_index(q, x[k]), s[k])
         dist[k] = exact[k] if exact[k] > 0 else min(drake[k], 0.0)
 
     def entry(k: int) -> PairMinimum:
         a, b = pairs.names[s[k]]
         e = None if np.isnan(exact[k]) else float(exact[k])
         return PairMinimum(
-            a, b, pairs.groups[s[k]], float(dist[k]), float(_at(sigma, x[k])),
-            float(_at(t, x[k])), float(x[k]), float(drake[k]), max(0.0, -float(dist[k])), e,
+            a, b, pairs.groups[s[k]], float(dist[k]), float(at_index(sigma, x[k])),
+            float(at_index(t, x[k])), float(x[k]), float(drake[k]), max(0.0, -float(dist[k])), e,
         )  # fmt: skip
 
     bounds = np.flatnonzero(np.r_[True, s[1:] != s[:-1], True]) if len(s) else [0]
@@ -264,7 +258,7 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
     for pair in minima[:n_worst]:
         if pair.exact_distance_m is None:
             index = pairs.names.index((pair.a, pair.b))
-            pair.exact_distance_m = pairs.exact(_at(q, pair.sample), index)
+            pair.exact_distance_m = pairs.exact(at_index(q, pair.sample), index)
         e, d = pair.exact_distance_m, pair.drake_distance_m
         if not (e == 0.0 and d <= 0.0) and abs(e - d) > EXACT_MISMATCH_TOL_M:
             pair.note = f"Drake {d * 1e3:.2f} mm, exact {e * 1e3:.2f} mm"
