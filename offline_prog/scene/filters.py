@@ -19,6 +19,14 @@ from offline_prog.scene.self_collision import read_matrix
 from offline_prog.scene.shapes import ShapeError
 
 
+def ids_by_name(labels) -> dict[str, list[GeometryId]]:
+    """The collision GeometryIds of each shape name (a mesh has several pieces)."""
+    by_name: dict[str, list[GeometryId]] = {}
+    for geometry_id, label in labels.items():
+        by_name.setdefault(label.name, []).append(geometry_id)
+    return by_name
+
+
 def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_contact=()) -> None:
     """Check the robot base vs obstacles and tool, and the tool vs obstacles, although
     they never move: their overlap is a layout error (checked once, held to contact).
@@ -38,9 +46,7 @@ def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_conta
                  (owners["tool"], owners["obstacle"])):  # fmt: skip
         if a and b:
             manager.Apply(CollisionFilterDeclaration().AllowBetween(GeometrySet(a), GeometrySet(b)))
-    by_name: dict[str, list[GeometryId]] = {}
-    for geometry_id, label in labels.items():
-        by_name.setdefault(label.name, []).append(geometry_id)
+    by_name = ids_by_name(labels)
     for pair in allowed_contact:  # intended contacts stay unchecked
         if all(name in by_name for name in pair):
             a, b = (GeometrySet(by_name[name]) for name in pair)
@@ -49,9 +55,7 @@ def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_conta
 
 def filter_contacts(scene_graph, plant, labels, part, allowed_contact) -> None:
     """Part vs the bodies it is welded to (the gripper), and each allowed pair."""
-    by_name: dict[str, list[GeometryId]] = {}
-    for geometry_id, label in labels.items():
-        by_name.setdefault(label.name, []).append(geometry_id)
+    by_name = ids_by_name(labels)
     manager = scene_graph.collision_filter_manager()
     holders = [b for b in plant.GetBodiesWeldedTo(part) if b.index() != part.index()]
     part_ids = [g for g, label in labels.items() if label.owner == "part"]
