@@ -198,9 +198,3 @@ def write_matrix(robot: RobotModel, *, samples: int, seed: int, robots_dir: Path
     file = Path(robots_dir) / robot.name / MATRIX_FILE
     write_atomic(file, matrix_yaml(robot, pairs, samples=samples, seed=seed))
     return file, pairs
-
-
-def skipped_pairs(robot_folder: Path) -> dict[frozenset, LinkPair]:
-    """The link pairs the planner does not check (every class but ``check``), by pair."""
-    pairs = read_matrix(robot_folder) or []
-    return {frozenset((p.a, p.b)): p for p in pairs if p.kind != "check"}
