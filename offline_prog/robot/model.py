@@ -85,6 +85,14 @@ class RobotModel:
         out[..., 2] = q[..., 1] + q[..., 2]
         return out
 
+    def urdf_joints(self, q_c: np.ndarray) -> np.ndarray:
+        """(..., 6) URDF q from the controller's axes: the inverse of controller_joints."""
+        if not self.j23_coupled:
+            return q_c
+        out = np.array(q_c, dtype=float, copy=True)
+        out[..., 2] = q_c[..., 2] - q_c[..., 1]
+        return out
+
     def forward(self, q: np.ndarray) -> np.ndarray:
         """Flange poses X_BE (N, 4, 4) [m] for joint vectors q (N, 6) [rad]."""
         module = kinematics_opw if self.family == "opw" else kinematics_ur

@@ -49,14 +49,6 @@ class LinkPair:
     reason: str
 
 
-def _controller_to_urdf(robot: RobotModel, q_c: np.ndarray) -> np.ndarray:
-    """(N, 6) URDF joints from the controller's axes (inverse of controller_joints)."""
-    q = np.array(q_c, dtype=float, copy=True)
-    if robot.j23_coupled:
-        q[:, 2] = q_c[:, 2] - q_c[:, 1]
-    return q
-
-
 def compute_matrix(robot: RobotModel, *, samples: int = DEFAULT_SAMPLES, seed: int = 0):
     """Classify every link pair of ``robot`` by sampling ``samples`` configurations.
 
@@ -88,7 +80,7 @@ def compute_matrix(robot: RobotModel, *, samples: int = DEFAULT_SAMPLES, seed: i
     measured = [p for p in pairs if frozenset(p) not in adjacent]
     rng = np.random.default_rng(seed)
     q_c = rng.uniform(robot.q_lower, robot.q_upper, size=(samples, len(robot.q_lower)))
-    q = _controller_to_urdf(robot, q_c)
+    q = robot.urdf_joints(q_c)
     distances = np.empty((samples, len(measured)))
     for i, q_i in enumerate(q):
         plant.SetPositions(plant_context, model, q_i)

@@ -204,3 +204,13 @@ def test_invalid_yaml(robots_copy):
 def test_bad_record_names_file_and_key(robots_copy, name, edit, fragments):
     path = edit_record(robots_copy, name, edit)
     assert_one_line_error(lambda: load_robot(name, robots_copy), str(path), *fragments)
+
+
+def test_urdf_joints_inverts_controller_joints(rng):
+    """The ABB J2/J3 coupling both ways: controller axis 3 = q2 + q3, and back."""
+    for name in ("abb_irb2400", "kuka_kr16_2"):
+        robot = load_robot(name)
+        q = rng.uniform(-3.0, 3.0, size=(100, 6))
+        np.testing.assert_allclose(robot.urdf_joints(robot.controller_joints(q)), q, atol=1e-12)
+    abb = load_robot("abb_irb2400")
+    assert abb.urdf_joints(np.array([0.0, 0.3, 0.5, 0, 0, 0]))[2] == pytest.approx(0.2)
