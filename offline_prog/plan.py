@@ -26,10 +26,22 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell
-from offline_prog.errors import Failure, PlanFailedError
+from offline_prog.errors import Failure, InputError, PlanFailedError
+from offline_prog.job.assemble import JobSamples, lay_out
+from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
+from offline_prog.job.stages import (
+    check_job,
+    choose_order,
+    home_pose,
+    job_pieces,
+    seam_options,
+    tool_speed,
+)
 from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
@@ -38,7 +50,9 @@ from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit
 from offline_prog.path.sources import PathPoints
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
+from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import (
+    Inputs,
     attempt_motion,
     avoid,
     build_scene,
@@ -110,19 +124,33 @@ def plan_cell(
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
     file = Path(cell_file)
-    timings: dict[str, float] = {}
+    stage = StageTimer(progress)
+    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
+    scene = stage("scene", "building the Drake cell", build_scene, inputs)
+    return plan_seam(inputs, scene, stage)
 
-    def stage(name: str, description: str, function, *args):
-        progress(description)
+
+class StageTimer:
+    """Runs named stages, tells ``progress`` and keeps each stage's wall time [s]."""
+
+    def __init__(self, progress: Callable[[str], None], prefix: str = ""):
+        self.progress, self.prefix, self.timings_s = progress, prefix, {}
+
+    def __call__(self, name: str, description: str, function, *args):
+        self.progress(description)
         start = time.perf_counter()
         result = function(*args)
-        timings[name] = time.perf_counter() - start
+        key = self.prefix + name
+        self.timings_s[key] = self.timings_s.get(key, 0.0) + time.perf_counter() - start
         return result
 
-    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
+
+def plan_seam(inputs: Inputs, scene: DrakeCell, stage: StageTimer) -> Plan:
+    """The single-seam pipeline on loaded inputs and a built scene: fit, frames, joints,
+    collision avoidance, clearance profile (paper §§2–4)."""
+    file = inputs.file
     fit = stage("fit", "fitting the B-spline", fit_path, inputs)
     flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
-    scene = stage("scene", "building the Drake cell", build_scene, inputs)
     rotation, flange = flanges.rotations[0]
     try:
         first = stage(
@@ -132,12 +160,14 @@ def plan_cell(
     except PlanFailedError as error:
         raise with_normal_hint(error, inputs, fit, scene) from None
     chosen, avoidance = stage(
-        "collision", "collision avoidance", avoid, inputs, fit, flanges, scene, first, progress
-    )
+        "collision", "collision avoidance", avoid, inputs, fit, flanges, scene, first,
+        stage.progress,
+    )  # fmt: skip
     traj = chosen.joints.trajectory
     profile = stage(
         "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
     )
+    timings = stage.timings_s
     return Plan(
         file,
         inputs.cell,
@@ -157,3 +187,88 @@ def plan_cell(
         profile,
         fit.normal_fit,
     )
+
+
+@dataclasses.dataclass
+class JobPlan:
+    """A whole job: the seams as run (each a :class:`Plan`), the links, and the job's
+    samples with named segments, process I/O and the whole job's collision check."""
+
+    cell_file: Path
+    cell: Cell
+    robot: RobotModel
+    q_home: np.ndarray  # (6,) [rad]
+    options: list  # every seam option planned (job.stages.SeamOption), by seam
+    chosen: list  # the options run, in order
+    order: object  # job.order.JobOrder
+    links: list  # job.links.LinkMotion, in order (home → first, …, last → home)
+    samples: JobSamples
+    tcp_speed: np.ndarray  # (N,) speed of the tool along the part [m/s]
+    io: IoColumns
+    collisions: CollisionResult
+    timings_s: dict[str, float]
+
+    @property
+    def seams(self) -> list[Plan]:
+        return [option.plan for option in self.chosen]
+
+    @property
+    def feasible(self) -> bool:
+        return self.collisions.collision_free and all(p.feasible for p in self.seams)
+
+    @property
+    def failure(self) -> str:
+        if self.collisions.collision_free:
+            return next((p.failure for p in self.seams if not p.feasible), "")
+        at = self.collisions.first_contact or self.collisions.closest
+        where = "" if at is None else f"{self.samples.segment_at(at.t_s).label}: "
+        return where + self.collisions.message
+
+    @property
+    def failure_kind(self) -> Failure | None:
+        return None if self.feasible else Failure.COLLISION
+
+
+def plan_job(
+    cell_file: str | Path,
+    *,
+    robots_dir: Path = ROBOTS_DIR,
+    progress: Callable[[str], None] = lambda stage: None,
+) -> JobPlan:
+    """A whole job (issue 13): every seam by the one-seam pipeline, approach and
+    retract, seam order, collision-free links from home and back, process I/O, and the
+    collision check of the whole job.
+
+    Raises:
+        InputError: bad input (one line; exit 2).
+        PlanFailedError: a seam the robot cannot do, or a link not found (exit 1).
+    """
+    file = Path(cell_file)
+    stage = StageTimer(progress)
+    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
+    scene = stage("scene", "building the Drake cell", build_scene, inputs)
+    q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
+
+    def one_seam(seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
+        return plan_seam(seam_inputs, seam_scene, StageTimer(progress))
+
+    options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
+    order = stage("order", "choosing the seam order", choose_order, inputs, options, q_home)
+    flat = [option for seam in options for option in seam]
+    chosen = [flat[i] for i in order.sequence]
+    pieces, links = stage(
+        "links", "linking moves", job_pieces, inputs, scene, chosen, q_home, progress
+    )
+    samples = lay_out(pieces)
+    tcp_speed = tool_speed(inputs, samples, chosen)
+    lengths = {option.name: option.plan.path.length for option in chosen}
+    try:
+        io = io_columns(samples, inputs.cell.tool.process_io, lengths, tcp_speed)
+    except IoPlacementError as error:
+        raise InputError(file, error.key, error.reason) from None
+    collisions = stage("check", "collision check of the whole job", check_job, inputs, scene,
+                       samples)  # fmt: skip
+    return JobPlan(
+        file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
+        tcp_speed, io, collisions, stage.timings_s,
+    )  # fmt: skip

@@ -49,7 +49,7 @@ class Inputs:
 
     file: Path
     cell: Cell
-    points: PathPoints
+    points: PathPoints | None  # None for a job (seams:); see job.seams.seam_inputs
     robot: RobotModel
     X_IB: RigidTransform  # robot base B in I
     X_IT: RigidTransform  # fixed tool T in I
@@ -78,7 +78,7 @@ def load_inputs(file: Path, robots_dir: Path) -> Inputs:
     """Read and check the cell file; load the path points and the robot."""
     cell = load_cell(file)
     check_cell(file, cell, robots_dir)
-    points = load_points(file, cell)
+    points = load_points(file, cell) if cell.path is not None else None
     try:
         robot = load_robot(cell.robot.model, robots_dir)
     except ValueError as error:

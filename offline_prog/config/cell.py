@@ -7,10 +7,7 @@ names the file, the dotted key and the reason in one line.
 """
 
 import dataclasses
-import math
 import os
-import types
-import typing
 from pathlib import Path
 
 from pydrake.common.schema import Transform
@@ -18,7 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform
 
 from offline_prog.config import safe_yaml
-from offline_prog.config.safe_yaml import short_repr
+from offline_prog.config.typed_check import check_mapping
 from offline_prog.errors import InputError
 
 REQUIRED = {"required": True}
@@ -51,6 +48,34 @@ class RobotConfig:
 
 
 @dataclasses.dataclass
+class DigitalSwitch:
+    """Switch a digital output at a distance along the path: ``lead_mm`` before the
+    seam's start (on) or before its end (off); negative: after."""
+
+    digital_output: int = required()
+    lead_mm: float = 0.0
+
+
+@dataclasses.dataclass
+class AnalogFlow:
+    """An analog output following the TCP speed: value = offset + per_mps · v_TCP,
+    clipped to [min, max] (the controller's unit, e.g. volts)."""
+
+    analog_output: int = required()
+    per_mps: float = required()
+    offset: float = 0.0
+    min: float = 0.0
+    max: float = 10.0
+
+
+@dataclasses.dataclass
+class ProcessIoConfig:
+    on: DigitalSwitch | None = None
+    off: DigitalSwitch | None = None
+    flow: AnalogFlow | None = None
+
+
+@dataclasses.dataclass
 class ToolConfig:
     X_IT: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
     name: str = "tool"
@@ -59,6 +84,7 @@ class ToolConfig:
     free_rotation_deg: float = 0.0
     symmetry_axis: str = "y"
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in T
+    process_io: ProcessIoConfig | None = None  # the process output (glue gun, torch)
 
 
 @dataclasses.dataclass
@@ -113,6 +139,41 @@ class PathConfig:
 
 
 @dataclasses.dataclass
+class ApproachConfig:
+    """How the tool meets (approach) or leaves (retract) a seam: a straight line in P
+    along −n (``normal``: off the surface) or −t (``tangent``: along the path, before
+    its start / after its end) of the process frame F at the seam's end, or ``none``."""
+
+    kind: str = "normal"  # normal | tangent | none
+    distance_mm: float = 50.0
+
+
+@dataclasses.dataclass
+class SeamConfig(PathConfig):
+    """One seam of a job: a processing path (every key of ``path:``) plus its name,
+    direction, an optional own speed and how the tool meets and leaves it."""
+
+    name: str = required()  # unique; in reports, programs and trajectory.csv
+    direction: str = "forward"  # forward | reverse | auto (the planner picks)
+    speed: float | None = None  # m/s, overrides motion.speed for this seam
+    approach: ApproachConfig = dataclasses.field(default_factory=ApproachConfig)
+    retract: ApproachConfig = dataclasses.field(default_factory=ApproachConfig)
+
+
+@dataclasses.dataclass
+class HomeConfig:
+    joints_deg: list[float] = required()  # the controller's axes [deg]
+
+
+@dataclasses.dataclass
+class JobConfig:
+    """The job around the seams: where the robot starts and ends, and the seam order."""
+
+    home: HomeConfig | None = None  # default: the robot's home_deg (robot.yaml)
+    order: str = "given"  # given | auto (order, direction, branch for the least air time)
+
+
+@dataclasses.dataclass
 class MotionConfig:
     speed: float = required()  # m/s of the time-law parameter (at the TCP by default)
     max_acceleration: float = required()  # m/s²
@@ -129,7 +190,10 @@ class Cell:
     robot: RobotConfig = dataclasses.field(default_factory=RobotConfig, metadata=REQUIRED)
     tool: ToolConfig = dataclasses.field(default_factory=ToolConfig, metadata=REQUIRED)
     part: PartConfig = dataclasses.field(default_factory=PartConfig, metadata=REQUIRED)
-    path: PathConfig = dataclasses.field(default_factory=PathConfig, metadata=REQUIRED)
+    # One of: path (one seam, the shorthand) or seams (a job of several).
+    path: PathConfig | None = None
+    seams: list[SeamConfig] = dataclasses.field(default_factory=list)
+    job: JobConfig = dataclasses.field(default_factory=JobConfig)
     motion: MotionConfig = dataclasses.field(default_factory=MotionConfig, metadata=REQUIRED)
     name: str = ""
     description: str = ""
@@ -137,112 +201,6 @@ class Cell:
     obstacles: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in I
     # Pairs of shape names whose contact is intended (the tool tip on the part).
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
-
-
-def _is_number(value) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
-def _is_float_text(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _check_vector(file, key, value, size):
-    if not (isinstance(value, list) and len(value) == size and all(map(_is_number, value))):
-        raise InputError(file, key, f"expected a list of {size} numbers, got {short_repr(value)}")
-    if not all(math.isfinite(v) for v in value):
-        raise InputError(file, key, f"NaN or infinity in {short_repr(value)}")
-
-
-def _check_transform(file, key, raw):
-    if not isinstance(raw, dict):
-        raise InputError(
-            file, key, "expected {translation: [x, y, z], rotation: !Rpy {deg: [...]}}"
-        )
-    unknown = set(raw) - {"translation", "rotation", "base_frame"}
-    if unknown:
-        raise InputError(
-            file, f"{key}.{sorted(unknown)[0]}", "unknown key (allowed: translation, rotation)"
-        )
-    if "translation" in raw:
-        _check_vector(file, f"{key}.translation", raw["translation"], 3)
-    rotation = raw.get("rotation")
-    if rotation is not None:
-        if not (
-            isinstance(rotation, dict)
-            and rotation.get("__tag__") == "!Rpy"
-            and set(rotation) == {"__tag__", "deg"}
-        ):
-            raise InputError(file, f"{key}.rotation", "expected !Rpy {deg: [roll, pitch, yaw]}")
-        _check_vector(file, f"{key}.rotation.deg", rotation["deg"], 3)
-
-
-def _check_value(file, key, raw, schema):
-    """Check raw YAML against a field type; raises InputError naming ``key``."""
-    origin, args = typing.get_origin(schema), typing.get_args(schema)
-    if origin in (typing.Union, types.UnionType):
-        if raw is None:
-            return
-        return _check_value(file, key, raw, next(a for a in args if a is not type(None)))
-    if schema is Transform:
-        return _check_transform(file, key, raw)
-    if dataclasses.is_dataclass(schema):
-        return _check_mapping(file, key, raw, schema)
-    if (
-        origin is list
-        and args
-        and (
-            dataclasses.is_dataclass(args[0])
-            or typing.get_origin(args[0]) is list
-            or args[0] is str
-        )
-    ):
-        if not isinstance(raw, list):
-            raise InputError(file, key, f"expected a list, got {short_repr(raw)}")
-        for i, item in enumerate(raw):
-            _check_value(file, f"{key}[{i}]", item, args[0])
-        return
-    if origin is list:
-        if not (isinstance(raw, list) and all(map(_is_number, raw))):
-            raise InputError(file, key, f"expected a list of numbers, got {short_repr(raw)}")
-        if not all(math.isfinite(v) for v in raw):
-            raise InputError(file, key, f"NaN or infinity in {short_repr(raw)}")
-        return
-    expected = {
-        float: _is_number,
-        int: lambda v: isinstance(v, int) and not isinstance(v, bool),
-        bool: lambda v: isinstance(v, bool),
-        str: lambda v: isinstance(v, str),
-    }[schema]
-    if not expected(raw):
-        hint = ""
-        if schema is float and isinstance(raw, str) and _is_float_text(raw):
-            hint = f" (YAML reads {raw} as text: write {float(raw):.1e})"
-        raise InputError(file, key, f"expected {schema.__name__}, got {short_repr(raw)}{hint}")
-    if schema is float and not math.isfinite(raw):
-        raise InputError(file, key, f"{raw} is not a finite number")
-
-
-def _check_mapping(file, prefix, raw, schema):
-    if not isinstance(raw, dict) or "__tag__" in raw:
-        raise InputError(file, prefix or "(top level)", "expected a mapping of keys")
-    hints = typing.get_type_hints(schema)
-    fields = {f.name: f for f in dataclasses.fields(schema)}
-    for name in raw:
-        if name not in fields:
-            where = f"{prefix}.{name}" if prefix else str(name)
-            raise InputError(file, where, f"unknown key (allowed: {', '.join(fields)})")
-    for name, field in fields.items():
-        where = f"{prefix}.{name}" if prefix else name
-        if name not in raw or raw[name] is None:
-            if field.metadata.get("required"):
-                raise InputError(file, where, "missing (required)")
-            continue
-        _check_value(file, where, raw[name], hints[name])
 
 
 def load_cell(file: str | os.PathLike) -> Cell:
@@ -254,9 +212,9 @@ def load_cell(file: str | os.PathLike) -> Cell:
     file = Path(file)
     text = safe_yaml.read_text(file)  # size, encoding
     raw = safe_yaml.load(file, text)  # aliases, depth, duplicate keys
-    _check_mapping(file, "", raw, Cell)
+    check_mapping(file, "", raw, Cell)
     try:
-        return yaml_load_typed(schema=Cell, data=text)
+        return yaml_load_typed(schema=Cell, data=safe_yaml.quote_bool_keys(text))
     except Exception as error:  # Drake's message is multi-line; keep its first line.
         first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
         raise InputError(file, "", first_line) from None

@@ -5,11 +5,12 @@ Every failure is a InputError naming the file and key (one line).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
-from offline_prog.config.cell import Cell
+from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -19,6 +20,12 @@ from offline_prog.constants import (
     UNIT_SCALE,
 )
 from offline_prog.errors import InputError
+
+DIRECTIONS = ("forward", "reverse", "auto")
+APPROACH_KINDS = ("normal", "tangent", "none")
+MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
+MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
+SEAM_NAME = re.compile(rf"[A-Za-z][A-Za-z0-9_]{{0,{MAX_SEAM_NAME_CHARS - 1}}}")
 
 
 def _error(file, key, reason) -> InputError:
@@ -37,33 +44,19 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             f"{cell.robot.model!r} is not a robot folder in "
             f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})",
         )
-    path, motion = cell.path, cell.motion
-    for key, value in (("path.units", path.units), ("part.mesh_units", cell.part.mesh_units)):
-        if value not in UNIT_SCALE:
-            raise _error(file, key, f"{value!r} is not a unit (use m or mm)")
-    sources = [k for k in ("points", "dxf", "analytic") if getattr(path, k) is not None]
-    if len(sources) != 1:
+    motion = cell.motion
+    if cell.part.mesh_units not in UNIT_SCALE:
         raise _error(
-            file,
-            "path",
-            f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
+            file, "part.mesh_units", f"{cell.part.mesh_units!r} is not a unit (use m or mm)"
         )
+    if cell.part.mesh is not None:
+        _check_data_file(file, "part.mesh", file.parent / cell.part.mesh)
+    if (cell.path is None) == (not cell.seams):
+        raise _error(file, "seams", "give exactly one of path (one seam) or seams (a job)")
+    for key, path in seam_keys(cell):
+        _check_path(file, key, path, cell)
+    _check_job(file, cell)
     for key, value in (
-        ("path.points", path.points),
-        ("path.dxf", path.dxf),
-        ("part.mesh", cell.part.mesh),
-    ):
-        if value is not None:
-            _check_data_file(file, key, file.parent / value)
-    if path.normal_from_mesh and cell.part.mesh is None:
-        raise _error(file, "path.normal_from_mesh", "needs part.mesh")
-    if path.normal is not None and np.linalg.norm(path.normal) < 1e-9:
-        raise _error(file, "path.normal", "is the zero vector")
-    if path.degree < 5:
-        raise _error(file, "path.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
-    for key, value in (
-        ("path.fit_tolerance_mm", path.fit_tolerance_mm),
-        ("path.normal_tolerance_deg", path.normal_tolerance_deg),
         ("motion.speed", motion.speed),
         ("motion.max_acceleration", motion.max_acceleration),
         ("motion.max_jerk", motion.max_jerk),
@@ -99,6 +92,96 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
     _check_payload(file, cell)
     _check_shapes(file, cell)
+
+
+def seam_keys(cell: Cell) -> list[tuple[str, PathConfig]]:
+    """(key, path) of each seam: ``[("path", cell.path)]`` for the one-seam shorthand,
+    else ``("seams[k]", seam)``: the key that errors about it name."""
+    if cell.path is not None:
+        return [("path", cell.path)]
+    return [(f"seams[{k}]", seam) for k, seam in enumerate(cell.seams)]
+
+
+def _check_path(file: Path, key: str, path: PathConfig, cell: Cell) -> None:
+    """One processing path (``path:`` or a seam): one source, units, normals, fit."""
+    if path.units not in UNIT_SCALE:
+        raise _error(file, f"{key}.units", f"{path.units!r} is not a unit (use m or mm)")
+    sources = [k for k in ("points", "dxf", "analytic") if getattr(path, k) is not None]
+    if len(sources) != 1:
+        raise _error(
+            file,
+            key,
+            f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
+        )
+    for name in ("points", "dxf"):
+        if getattr(path, name) is not None:
+            _check_data_file(file, f"{key}.{name}", file.parent / getattr(path, name))
+    if path.normal_from_mesh and cell.part.mesh is None:
+        raise _error(file, f"{key}.normal_from_mesh", "needs part.mesh")
+    if path.normal is not None and np.linalg.norm(path.normal) < 1e-9:
+        raise _error(file, f"{key}.normal", "is the zero vector")
+    if path.degree < 5:
+        raise _error(file, f"{key}.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
+    for name in ("fit_tolerance_mm", "normal_tolerance_deg"):
+        if not getattr(path, name) > 0:
+            raise _error(file, f"{key}.{name}", f"must be > 0, got {getattr(path, name)}")
+
+
+def _check_job(file: Path, cell: Cell) -> None:
+    """Seam names unique and safe in a controller program; directions, speeds,
+    approach and retract; job order; process I/O numbers and ranges."""
+    names: set[str] = set()
+    for k, seam in enumerate(cell.seams):
+        key = f"seams[{k}]"
+        if not SEAM_NAME.fullmatch(seam.name):
+            raise _error(
+                file,
+                f"{key}.name",
+                f"{seam.name!r} is not a seam name (letters, digits and _, starting "
+                f"with a letter, at most {MAX_SEAM_NAME_CHARS} characters: it names "
+                "labels in controller programs)",
+            )
+        if seam.name.lower() in names:
+            raise _error(file, f"{key}.name", f"{seam.name!r} is used twice")
+        names.add(seam.name.lower())
+        if seam.direction not in DIRECTIONS:
+            raise _error(
+                file, f"{key}.direction", f"{seam.direction!r} (use {', '.join(DIRECTIONS)})"
+            )
+        if seam.speed is not None and not 0 < seam.speed <= MAX_SPEED_M_S:
+            raise _error(file, f"{key}.speed", f"must be within (0, {MAX_SPEED_M_S:g}] m/s")
+        for end in ("approach", "retract"):
+            move = getattr(seam, end)
+            if move.kind not in APPROACH_KINDS:
+                raise _error(
+                    file, f"{key}.{end}.kind", f"{move.kind!r} (use {', '.join(APPROACH_KINDS)})"
+                )
+            if not 0 <= move.distance_mm <= MAX_APPROACH_MM:
+                raise _error(
+                    file,
+                    f"{key}.{end}.distance_mm",
+                    f"must be within [0, {MAX_APPROACH_MM:g}] mm, got {move.distance_mm:g}",
+                )
+    if cell.job.order not in ("given", "auto"):
+        raise _error(file, "job.order", f"{cell.job.order!r} (use given or auto)")
+    if cell.job.home is not None and len(cell.job.home.joints_deg) != 6:
+        raise _error(file, "job.home.joints_deg", "expected 6 joint values [deg]")
+    io = cell.tool.process_io
+    if io is not None:
+        for name in ("on", "off"):
+            switch = getattr(io, name)
+            if switch is not None and abs(switch.lead_mm) > MAX_APPROACH_MM:
+                raise _error(
+                    file,
+                    f"tool.process_io.{name}.lead_mm",
+                    f"must be within ±{MAX_APPROACH_MM:g} mm",
+                )
+        if (io.on is None) != (io.off is None):
+            raise _error(file, "tool.process_io", "give both on and off (or neither)")
+        if io.on is not None and io.on.digital_output != io.off.digital_output:
+            raise _error(file, "tool.process_io.off.digital_output", "must equal on's")
+        if io.flow is not None and not io.flow.min < io.flow.max:
+            raise _error(file, "tool.process_io.flow", "needs min < max")
 
 
 def _check_payload(file: Path, cell: Cell) -> None:

@@ -12,6 +12,7 @@ object is built from it; libyaml's C loader is used where it is installed.
 from __future__ import annotations
 
 import codecs
+import re
 import reprlib
 from pathlib import Path
 
@@ -39,6 +40,27 @@ def _construct_tagged(loader, tag_suffix, node):
 
 
 TagTolerantLoader.add_multi_constructor("!", _construct_tagged)
+# YAML 1.2 booleans: only true / false. YAML 1.1 (PyYAML's default) also reads on, off,
+# yes, no as booleans, which would turn the contract's ``process_io: {on: ..., off: ...}``
+# keys into True / False.
+TagTolerantLoader.yaml_implicit_resolvers = {
+    first: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:bool"]
+    for first, resolvers in _BaseLoader.yaml_implicit_resolvers.items()
+}
+TagTolerantLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
+)
+# Keys that YAML 1.1 loaders (Drake's typed loader is one) would read as booleans.
+_YAML11_BOOL_KEY = re.compile(
+    r"(?m)(^[ \t]*(?:-[ \t]+)?|[{,][ \t]*)(on|off|On|Off|ON|OFF|yes|no|Yes|No|YES|NO|y|n|Y|N)"
+    r"([ \t]*:(?:[ \t]|$))"
+)
+
+
+def quote_bool_keys(text: str) -> str:
+    """The YAML text with keys like ``on:`` quoted (``"on":``), so that a YAML 1.1
+    loader reads them as the strings a YAML 1.2 reader (and the schema) sees."""
+    return _YAML11_BOOL_KEY.sub(r'\1"\2"\3', text)
 
 _short = reprlib.Repr()
 _short.maxstring = _short.maxother = MAX_VALUE_CHARS

@@ -57,6 +57,8 @@ class RobotModel:
         vendor: the maker, e.g. ``"kuka"`` (robot.yaml ``vendor``).
         language: the controller's program format (``krl``, ``rapid``, ``urscript``) or
             None (robot.yaml ``controller.language``).
+        home_c: (6,) a safe home pose in the controller's axes [rad] (robot.yaml
+            ``controller.home_deg``), where a job starts and ends unless the cell says.
     """
 
     name: str
@@ -71,6 +73,7 @@ class RobotModel:
     j23_coupled: bool = False
     vendor: str = ""
     language: str | None = None
+    home_c: np.ndarray | None = None  # (6,) the controller's home axes [rad], or None
 
     def controller_joints(self, q: np.ndarray) -> np.ndarray:
         """(..., 6) the joint values the controller counts (and limits) from URDF q.
@@ -183,6 +186,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         j23_coupled=_j23_coupled(check, record.get("controller")),
         vendor=str(record.get("vendor", "")),
         language=_language(check, record.get("controller")),
+        home_c=_home(check, record.get("controller"), position),
     )
 
 
@@ -190,11 +194,24 @@ def _j23_coupled(check: _Checker, controller: Any) -> bool:
     """The ``controller: {j23_coupled: bool}`` record (default False)."""
     if controller is None:
         return False
-    check.keys(controller, "controller", required=set(), allowed={"j23_coupled", "language"})
+    check.keys(
+        controller, "controller", required=set(), allowed={"j23_coupled", "language", "home_deg"}
+    )
     value = controller.get("j23_coupled", False)
     if not isinstance(value, bool):
         check.fail("controller.j23_coupled", value, "true or false")
     return value
+
+
+def _home(check: _Checker, controller: Any, position: np.ndarray) -> np.ndarray | None:
+    """``controller: {home_deg: [6 numbers]}``: the controller's home axes [deg],
+    inside the position limits (in the controller's axes), as radians; or None."""
+    if controller is None or controller.get("home_deg") is None:
+        return None
+    home = check.numbers(controller["home_deg"], "controller.home_deg")
+    if home.shape != (6,) or not np.all((position[:, 0] <= home) & (home <= position[:, 1])):
+        check.fail("controller.home_deg", controller["home_deg"], "6 axes inside the limits")
+    return _frozen(np.radians(home))
 
 
 def _language(check: _Checker, controller: Any) -> str | None:

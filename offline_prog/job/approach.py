@@ -1,0 +1,145 @@
+"""Approach and retract: the straight moves that bring the tool onto a seam and off it.
+
+The part moves past the fixed tool, so "the tool approaches along −n" means the tool
+frame T slides in the part frame P along a straight line that ends (approach) or starts
+(retract) at the seam's end frame F = X_PF(σ_end):
+
+    p_PT(δ) = p_PF − δ·u,   R_PT = R_PF (constant),   δ ∈ [0, d],
+
+with u = n (y of F, into the surface) for ``normal`` and u = ±t (x of F; − before the
+start, + after the end) for ``tangent``. The flange follows from the paper's chain
+X_IE = X_IT · X_PT⁻¹ · X_PE: with R_IE constant, p_IE(δ) = p_IE(0) + δ·R_IP·u, R_IP =
+R_IE·R_PE⁻¹ (the part moves by δu in I while the tool stays put). The move is timed by
+the same sin² law as the seam (speed = the seam's speed) and solved by analytic IK on the
+seam's branch, continuous with the seam's end configuration.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.config.cell import ApproachConfig
+from offline_prog.errors import Failure, PlanFailedError, PlanFailure
+from offline_prog.joints.path_ik import base_poses, branch_results
+from offline_prog.robot.model import RobotModel
+from offline_prog.timing.time_law import sin2_time_law
+from offline_prog.timing.trajectory import sample_times
+
+TWO_PI = 2.0 * np.pi
+# A move whose joints would exceed their speed limits is re-timed slower by the excess
+# times this margin, at most this many times.
+SLOWDOWN_MARGIN, MAX_SLOWDOWNS = 1.05, 4
+
+
+@dataclasses.dataclass(frozen=True)
+class CartesianMove:
+    """An approach or a retract, sampled.
+
+    Attributes:
+        kind: "approach" | "retract"; seam: the seam's name; distance_m: d [m].
+        t: (N,) time from the move's start [s].
+        q: (N, 6) joint positions [rad] (URDF order), continuous with the seam.
+        delta: (N,) δ(t): the tool's distance from the seam's end frame [m].
+        p_IE: (N, 3) flange positions in I [m]; R_IE: (3, 3) the constant flange rotation.
+        p_PT: (N, 3) the tool point in P [m]; R_PT: (3, 3) its constant rotation.
+    """
+
+    kind: str
+    seam: str
+    distance_m: float
+    t: np.ndarray
+    q: np.ndarray
+    delta: np.ndarray
+    p_IE: np.ndarray
+    R_IE: np.ndarray
+    p_PT: np.ndarray
+    R_PT: np.ndarray
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+
+def offset_direction(spec: ApproachConfig, kind: str, R_PF: np.ndarray) -> np.ndarray:
+    """(3,) u in P: the tool at p_PF − δ·u is off the seam's end by δ."""
+    if spec.kind == "normal":
+        return R_PF[:, 1]  # n: the tool backs off against the pressing direction
+    sign = 1.0 if kind == "approach" else -1.0  # before the start / after the end
+    return sign * R_PF[:, 0]
+
+
+def cartesian_move(
+    robot: RobotModel,
+    *,
+    X_IB,
+    kind: str,
+    seam: str,
+    spec: ApproachConfig,
+    p_PF: np.ndarray,
+    R_PF: np.ndarray,
+    p_IE: np.ndarray,
+    R_IE: np.ndarray,
+    R_PE: np.ndarray,
+    q_seam: np.ndarray,
+    branch: int,
+    speed: float,
+    a_max: float,
+    j_max: float,
+    rate_hz: float,
+) -> CartesianMove | None:
+    """The approach to (``kind="approach"``) or retract from a seam end, or None for
+    ``kind: none`` or a zero distance.
+
+    Args:
+        p_PF, R_PF: (3,), (3, 3) the process frame F at the seam's end, in P [m].
+        p_IE, R_IE: (3,), (3, 3) the flange at that end, in I [m].
+        R_PE: (3, 3) the flange's rotation in P.
+        q_seam: (6,) the seam's joints at that end [rad]; branch: its IK branch.
+        speed, a_max, j_max: the sin² law's limits [m/s, m/s², m/s³].
+
+    Raises:
+        PlanFailedError: the move leaves the reach or the joint limits on the branch.
+    """
+    d = spec.distance_mm * 1e-3
+    if spec.kind == "none" or d <= 0.0:
+        return None
+    u_P = offset_direction(spec, kind, R_PF)
+    for _ in range(MAX_SLOWDOWNS):
+        law = sin2_time_law(d, v_max=speed, a_max=a_max, j_max=j_max)
+        t = sample_times(law.duration, rate_hz)
+        travelled = law(t)[0]
+        delta = d - travelled if kind == "approach" else travelled
+        R_IP = R_IE @ R_PE.T
+        p_IE_t = p_IE + delta[:, None] * (R_IP @ u_P)
+        X_BE = base_poses(X_IB, p_IE_t, np.broadcast_to(R_IE, (len(t), 3, 3)))
+        result = branch_results(robot, X_BE)[branch]
+        if len(t) < 3 or not np.isfinite(result.q).all():
+            break
+        qd = robot.controller_joints(np.gradient(result.q, t, axis=0))
+        ratio = float((np.abs(qd) / robot.qd_max).max())
+        if ratio <= 1.0:
+            break
+        speed, a_max = speed / (ratio * SLOWDOWN_MARGIN), a_max / (ratio * SLOWDOWN_MARGIN) ** 2
+    end = -1 if kind == "approach" else 0  # the sample at the seam
+    if not np.isfinite(result.q).all():
+        reason = result.reason or "out of reach"
+        _fail(kind, seam, t, result.sample, f"{reason} on the seam's branch")
+    # The same 2π turns as the seam's joints at the shared end.
+    q = result.q + TWO_PI * np.round((q_seam - result.q[end]) / TWO_PI)
+    if np.abs(q[end] - q_seam).max() > 1e-6:
+        _fail(kind, seam, t, len(t) - 1 if end else 0, "singularity (the configuration flips)")
+    q_c = robot.controller_joints(q)
+    outside = (q_c < robot.q_lower) | (q_c > robot.q_upper)
+    if outside.any():
+        i, joint = np.argwhere(outside)[0]
+        _fail(kind, seam, t, int(i), f"joint limit on axis {joint + 1}")
+    return CartesianMove(
+        kind, seam, d, t, q, delta, p_IE_t, R_IE, p_PF - delta[:, None] * u_P, R_PF
+    )
+
+
+def _fail(kind: str, seam: str, t: np.ndarray, i: int, reason: str) -> None:
+    message = f"{reason} ({kind} of seam {seam}, t = {t[i]:.3f} s into it)"
+    raise PlanFailedError(PlanFailure(Failure.of(reason), 0.0, float(t[i]), message))

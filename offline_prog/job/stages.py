@@ -1,0 +1,234 @@
+"""The stages of :func:`offline_prog.plan.plan_job` beyond the one-seam pipeline.
+
+``home_pose`` → ``seam_options`` (each seam planned in each direction it may run,
+with its approach and retract) → ``choose_order`` → ``job_pieces`` (links between the
+chosen seams, from home and back) → ``job.assemble.lay_out`` → ``check_job``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.collision.check import CollisionResult, check_trajectory
+from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.job.approach import CartesianMove, cartesian_move
+from offline_prog.job.assemble import JobSamples, Piece
+from offline_prog.job.links import LinkMotion, plan_link
+from offline_prog.job.order import JobOrder, order_job
+from offline_prog.job.seams import errors_named_for, job_seams, seam_inputs, seam_key
+from offline_prog.scene.drake_cell import DrakeCell
+from offline_prog.stages import Inputs
+
+LINK_TIME_BUDGET_S = 10.0  # OMPL's time to find one link before the plan fails
+LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
+
+
+@dataclasses.dataclass
+class SeamOption:
+    """One way to run a seam: its plan (a :class:`~offline_prog.plan.Plan`) in one
+    direction, the approach and retract, and the link ends q_in / q_out (6,) [rad]."""
+
+    seam: int
+    name: str
+    reverse: bool
+    plan: object
+    approach: CartesianMove | None
+    retract: CartesianMove | None
+
+    @property
+    def q_in(self) -> np.ndarray:
+        return self.approach.q[0] if self.approach else self.plan.joints.q[0]
+
+    @property
+    def q_out(self) -> np.ndarray:
+        return self.retract.q[-1] if self.retract else self.plan.joints.q[-1]
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} {'reverse' if self.reverse else 'forward'}"
+
+
+def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
+    """(6,) the job's home in URDF joints [rad]: ``job.home`` or the robot's own,
+    inside the joint limits and collision-free at the cell's clearances.
+
+    Raises:
+        InputError: naming ``job.home.joints_deg``.
+    """
+    robot, home = inputs.robot, inputs.cell.job.home
+    key = "job.home.joints_deg"
+    if home is None:
+        if robot.home_c is None:
+            raise InputError(
+                inputs.file, "job.home", f"robot {robot.name} has no home_deg: give one"
+            )
+        q_c = np.asarray(robot.home_c)
+    else:
+        q_c = np.deg2rad(home.joints_deg)
+        outside = (q_c < robot.q_lower - 1e-12) | (q_c > robot.q_upper + 1e-12)
+        if outside.any():
+            j = int(np.argmax(outside))
+            raise InputError(
+                inputs.file, key, f"axis {j + 1} = {home.joints_deg[j]:g}° is outside its limits "
+                f"[{np.rad2deg(robot.q_lower[j]):g}, {np.rad2deg(robot.q_upper[j]):g}]°",
+            )  # fmt: skip
+    q = robot.urdf_joints(q_c)
+    motion = inputs.cell.motion
+    check = check_trajectory(
+        scene, q[None, :], np.zeros(1), np.zeros(1),
+        clearance=motion.clearance, self_clearance=motion.self_clearance,
+    )  # fmt: skip
+    if not check.collision_free:
+        where = "job.home" if home is None else key
+        raise InputError(inputs.file, where, f"the home pose collides: {check.message}")
+    return q
+
+
+def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[list[SeamOption]]:
+    """Each seam planned in each direction it may run (``direction``), with approach and
+    retract. A direction the robot cannot do is dropped when the other one works.
+
+    Raises:
+        InputError: naming ``seams[k].<key>``.
+        PlanFailedError: a seam cannot be done in any direction (its reason, named).
+    """
+    options = []
+    for k, seam in enumerate(job_seams(inputs.cell)):
+        directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]
+        found, errors = [], []
+        for reverse in directions:
+            progress(f"seam {seam.name} ({'reverse' if reverse else 'forward'})")
+            try:
+                with errors_named_for(seam_key(inputs.cell, k)):
+                    seam_in = seam_inputs(inputs, k, reverse=reverse)
+                    plan = plan_seam(seam_in, scene)
+                    approach, retract = _ends(seam_in, plan, seam)
+                found.append(SeamOption(k, seam.name, reverse, plan, approach, retract))
+            except PlanFailedError as error:
+                errors.append(error)
+        if not found:
+            failure = errors[0].failure
+            raise PlanFailedError(
+                dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
+            )
+        options.append(found)
+    return options
+
+
+def _ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
+    """The approach to the plan's first sample and the retract from its last."""
+    motion, joints = inputs.cell.motion, plan.joints
+    R_PE = inputs.X_PE.rotation().matrix()
+    ends = plan.flange(np.array([0.0, plan.path.length]))
+    moves = []
+    for kind, i, spec in (("approach", 0, seam.approach), ("retract", -1, seam.retract)):
+        moves.append(
+            cartesian_move(
+                inputs.robot,
+                X_IB=inputs.X_IB,
+                kind=kind,
+                seam=seam.name,
+                spec=spec,
+                p_PF=ends.p_PF[i],
+                R_PF=ends.R_PF[i],
+                p_IE=ends.p_IE[i],
+                R_IE=ends.R_IE[i],
+                R_PE=R_PE,
+                q_seam=joints.q[i],
+                branch=joints.branch,
+                speed=motion.speed,
+                a_max=motion.max_acceleration,
+                j_max=motion.max_jerk,
+                rate_hz=motion.sample_rate_hz,
+            )  # fmt: skip
+        )
+    return moves[0], moves[1]
+
+
+def choose_order(inputs: Inputs, options: list[list[SeamOption]], q_home) -> JobOrder:
+    """Seam order and direction (``job.order``) for the least estimated air time."""
+    flat = [option for seam in options for option in seam]
+    robot = inputs.robot
+    return order_job(
+        [(o.seam, o.label, o.q_in, o.q_out) for o in flat], q_home,
+        qd_max=robot.qd_max, qdd_max=robot.qdd_max, n_seams=len(options),
+        mode=inputs.cell.job.order, controller_joints=robot.controller_joints,
+    )  # fmt: skip
+
+
+def job_pieces(
+    inputs: Inputs, scene: DrakeCell, chosen: list[SeamOption], q_home, progress
+) -> tuple[list[Piece], list[LinkMotion]]:
+    """home → link → approach → process → retract → link → … → home, as pieces.
+
+    Raises:
+        PlanFailedError: a link not found within its time budget (naming it).
+    """
+    motion = inputs.cell.motion
+    pieces, links, q_now, previous = [], [], q_home, "home"
+    for option in [*chosen, None]:
+        target = option.q_in if option else q_home
+        name = f"{previous} -> {option.name if option else 'home'}"
+        progress(f"link {name}")
+        link = plan_link(
+            scene, inputs.robot, q_now, target, clearance=motion.clearance,
+            self_clearance=motion.self_clearance, seed=LINK_SEED + len(links),
+            time_budget_s=LINK_TIME_BUDGET_S, rate_hz=motion.sample_rate_hz, name=name,
+        )  # fmt: skip
+        if not link.ok:
+            raise PlanFailedError(link.failure)
+        links.append(link)
+        nan = np.full(len(link.t), np.nan)
+        pieces.append(Piece("link", "", link.t, link.q, link.qd, nan))
+        if option is None:
+            break
+        pieces += _seam_pieces(option)
+        q_now, previous = option.q_out, option.name
+    return pieces, links
+
+
+def _seam_pieces(option: SeamOption) -> list[Piece]:
+    joints, traj, name = option.plan.joints, option.plan.joints.trajectory, option.name
+    out = []
+    if option.approach:
+        a = option.approach
+        out.append(Piece("approach", name, a.t, a.q, np.gradient(a.q, a.t, axis=0), -a.delta))
+    out.append(Piece("process", name, traj.t, joints.q, joints.qd, traj.s))
+    if option.retract:
+        r = option.retract
+        length = option.plan.path.length
+        out.append(
+            Piece("retract", name, r.t, r.q, np.gradient(r.q, r.t, axis=0), length + r.delta)
+        )
+    return out
+
+
+def check_job(inputs: Inputs, scene: DrakeCell, samples: JobSamples) -> CollisionResult:
+    """The whole job's collision check: every sample and between samples, the same
+    geometry, clearances and rules as a seam (collision.check)."""
+    motion = inputs.cell.motion
+    return check_trajectory(
+        scene, samples.q, samples.t, np.nan_to_num(samples.path_m),
+        clearance=motion.clearance, self_clearance=motion.self_clearance,
+    )  # fmt: skip
+
+
+def tool_speed(inputs: Inputs, samples: JobSamples, chosen: list[SeamOption]) -> np.ndarray:
+    """(N,) speed of the tool point along the part [m/s] on every row: |d p_PT / dt|
+    with X_PT = X_PE · X_EB(q) · X_BI · X_IT (forward kinematics); the seams' own exact
+    TCP speed on their process rows."""
+    robot = inputs.robot
+    X_BE = robot.forward(samples.q)
+    X_BT = (inputs.X_IB.inverse() @ inputs.X_IT).GetAsMatrix4()
+    X_PE = inputs.X_PE.GetAsMatrix4()
+    p_PT = (X_PE @ np.linalg.inv(X_BE) @ X_BT)[:, :3, 3]
+    speed = np.linalg.norm(np.gradient(p_PT, samples.t, axis=0), axis=1)
+    by_seam = {option.name: option.plan.trajectory.tcp_speed for option in chosen}
+    for segment in samples.segments:
+        if segment.kind == "process":
+            speed[segment.start : segment.stop] = by_seam[segment.seam][
+                : segment.stop - segment.start
+            ]
+    return speed
