@@ -136,9 +136,12 @@ def main(argv: list[str] | None = None) -> int:
         return code
 
     try:
-        from offline_prog.plan import plan_cell
+        from offline_prog.config.cell import load_cell
+        from offline_prog.errors import InputError
+        from offline_prog.plan import plan_cell, plan_job
+        from offline_prog.results.job_folder import write_job_outputs
         from offline_prog.results.plan_folder import check_out_dir, write_outputs
-        from offline_prog.results.summary import print_summary
+        from offline_prog.results.summary import print_job_summary, print_summary
 
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
@@ -155,13 +158,19 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
+        is_job = bool(load_cell(args.cell).seams)  # seams: a whole job
+        if is_job and args.command == "preview":
+            raise InputError(args.cell, "seams", "the preview of a whole job is not written yet")
         with errors.status("planning") as status:
-            plan = plan_cell(args.cell, progress=lambda stage: status.update(stage))
+            plan = (plan_job if is_job else plan_cell)(
+                args.cell, progress=lambda stage: status.update(stage)
+            )
             status.update("writing outputs")
             if args.command == "plan":
-                files, report = write_outputs(plan, out)
+                files, report = (write_job_outputs if is_job else write_outputs)(plan, out)
         if args.command == "plan":
-            print_summary(console, report, files, time.perf_counter() - started)
+            summary = print_job_summary if is_job else print_summary
+            summary(console, report, files, time.perf_counter() - started)
         if args.preview:
             _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs

@@ -208,6 +208,8 @@ class JobPlan:
     collisions: CollisionResult
     timings_s: dict[str, float]
 
+    avoidance = None  # per seam, in each seam's report
+
     @property
     def seams(self) -> list[Plan]:
         return [option.plan for option in self.chosen]

@@ -64,3 +64,39 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
     for name, path in files.items():
         console.print(f"  {name:<9} {path}")
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
+
+
+def print_job_summary(console: Console, report: dict, files: dict, seconds: float) -> None:
+    """A few lines for a job: order, cycle time split, each seam, links, clearance."""
+    job = report["job"]
+    console.print(
+        f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
+        f"tool {report['tool']}, part {report['part']}: {len(report['seams'])} seams"
+    )
+    order = ", ".join(f"{o['seam']} ({o['direction']})" for o in job["order"])
+    console.print(
+        f"  order     {order} ({job['order_mode']}, {job['order_method']}; estimated "
+        f"saving {job['estimated_saving_s']:.2f} s against the given order)"
+    )
+    console.print(
+        f"  cycle     {job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
+        f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, approach and "
+        f"retract {job['approach_retract_time_s']:.2f} s)"
+    )
+    for seam in report["seams"]:
+        console.print(
+            f"  seam      {seam['seam']}: {seam['path']['length_m'] * 1e3:.1f} mm, "
+            f"{seam['trajectory']['duration_s']:.2f} s, fit max error "
+            f"{seam['fit']['max_error_mm']:.4f} mm"
+        )
+    for link in report["links"]:
+        console.print(f"  link      {link['name']}: {link['method']}, {link['duration_s']:.2f} s")
+    distance = report["min_distance_m"]
+    console.print(
+        "  clearance "
+        + ("no checked pairs" if distance is None else f"min distance {distance * 1e3:.1f} mm, ")
+        + ("collision-free" if report["collision_free"] else "FAILS")
+    )
+    for name, path in files.items():
+        console.print(f"  {name:<9} {path}")
+    console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
