@@ -70,9 +70,10 @@ def _run_robots(args, console: Console) -> None:
 
 def _run_export(args, console: Console) -> None:
     from offline_prog.export.formats import export
+    from offline_prog.export.job_program import JobProgramData
     from offline_prog.export.program import ProgramData
 
-    data = ProgramData.load(args.plan_dir)
+    data = JobProgramData.load(args.plan_dir) or ProgramData.load(args.plan_dir)
     out = args.out or args.plan_dir / "programs"
     files = export(data, args.format, out, force=args.force, **_export_options(args))
     for file in files:

@@ -16,6 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_manifest
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
 FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
@@ -31,8 +32,19 @@ def default_formats(language: str | None) -> list[str]:
     return ([language] if language else []) + ["csv", "ros-json"]
 
 
+def job_formats(language: str | None) -> list[str]:
+    """The formats a whole job is exported in today: the joint-trajectory files (the
+    controller programs of a job follow, issue 13)."""
+    return ["csv", "ros-json"]
+
+
 def export(
-    data: ProgramData, fmt: str, out_dir: Path, *, force: bool = False, **options
+    data: ProgramData | JobProgramData,
+    fmt: str,
+    out_dir: Path,
+    *,
+    force: bool = False,
+    **options,
 ) -> list[Path]:
     """Write ``fmt`` for the plan into ``out_dir``; returns the files written.
 
@@ -47,10 +59,14 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    if fmt in ("krl", "rapid") and fmt != data.language:
+    if fmt in ("krl", "rapid") and fmt != data.language:  # (a job's language is its robot's)
         raise ValueError(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"
+        )
+    if isinstance(data, JobProgramData):
+        return replace_owned(
+            Path(out_dir), fmt, lambda folder: _write_job(data, fmt, folder, **options)
         )
     return replace_owned(Path(out_dir), fmt, lambda folder: _write(data, fmt, folder, **options))
 
@@ -106,3 +122,16 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
     from offline_prog.export.rapid import write_rapid
 
     return list(write_rapid(data, out_dir, forced=forced, **options).files)
+
+
+def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
+    """Write one format's files of a whole job into out_dir (a fresh folder)."""
+    if fmt == "csv":
+        from offline_prog.export.joint_files import write_job_joint_csv
+
+        return [write_job_joint_csv(data, out_dir)]
+    if fmt == "ros-json":
+        from offline_prog.export.joint_files import write_job_ros_json
+
+        return [write_job_ros_json(data, out_dir)]
+    raise ValueError(f"{fmt}: the {fmt} program of a whole job is not written yet")

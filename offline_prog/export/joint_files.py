@@ -11,6 +11,7 @@ import numpy as np
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.header import header_lines
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
 
@@ -61,4 +62,56 @@ def write_joint_csv(data: ProgramData, out_dir: Path, name: str = "joint_traject
 def write_ros_json(data: ProgramData, out_dir: Path, name: str = "joint_trajectory") -> Path:
     file = Path(out_dir) / f"{name}.json"
     write_atomic(file, json.dumps(ros_json(data), separators=(",", ":")) + "\n")
+    return file
+
+
+def job_joint_csv_text(data: JobProgramData) -> str:
+    """``t_s,segment,<joint>_rad,...[,do<n>][,ao<n>]``: one row per planned sample of a
+    job, the segment label (link, approach:<seam>, process:<seam>, retract:<seam>) and
+    the process outputs (0/1 and the flow value) on each row."""
+    job, io = data.job, data.process_io
+    labels = np.empty(len(job.t), dtype=object)
+    for segment in data.segments:
+        labels[segment.start : segment.stop] = segment.label
+    header = ["t_s", "segment", *(f"{name}_rad" for name in job.joint_names)]
+    columns = [np.char.mod("%.10g", job.t), labels.astype(str)]
+    columns += [np.char.mod("%.10g", q) for q in job.q.T]
+    if data.digital is not None:
+        header.append(f"do{io.digital_output}")
+        columns.append(np.char.mod("%d", data.digital))
+    if data.analog is not None:
+        header.append(f"ao{io.analog_output}")
+        columns.append(np.char.mod("%.6g", data.analog))
+    rows = np.column_stack(columns)
+    return ",".join(header) + "\n" + "".join(",".join(row) + "\n" for row in rows)
+
+
+def job_ros_json(data: JobProgramData) -> dict:
+    """The job's JointTrajectory (as :func:`ros_json`) plus ``segments`` (label and the
+    index range [start, stop) of its points) and, with process I/O, ``process_io`` (the
+    output numbers and each point's values)."""
+    message = ros_json(data.job)
+    message["segments"] = [
+        {"segment": s.label, "start": s.start, "stop": s.stop} for s in data.segments
+    ]
+    io = data.process_io
+    if io is not None:
+        message["process_io"] = {
+            "digital_output": io.digital_output,
+            "digital": None if data.digital is None else data.digital.astype(int).tolist(),
+            "analog_output": io.analog_output,
+            "analog": None if data.analog is None else [float(v) for v in data.analog],
+        }
+    return message
+
+
+def write_job_joint_csv(data: JobProgramData, out_dir: Path, name: str = "joint_trajectory"):
+    file = Path(out_dir) / f"{name}.csv"
+    write_atomic(file, job_joint_csv_text(data))
+    return file
+
+
+def write_job_ros_json(data: JobProgramData, out_dir: Path, name: str = "joint_trajectory"):
+    file = Path(out_dir) / f"{name}.json"
+    write_atomic(file, json.dumps(job_ros_json(data), separators=(",", ":")) + "\n")
     return file

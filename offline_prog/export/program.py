@@ -97,21 +97,28 @@ class ProgramData:
         values = col[f"{prefix}{j + 1}"]
         return values + col[f"{prefix}2"] if self.j23_coupled and j == 2 else values
 
-    def save(self, folder: Path) -> Path:
-        """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
+    def packed(self) -> tuple[dict, dict[str, np.ndarray]]:
+        """(meta, arrays): the JSON-able header fields and the arrays by name."""
         meta = {
             f.name: getattr(self, f.name)
             for f in dataclasses.fields(self)
             if f.name not in _ARRAYS + _DENSE_ARRAYS
         }
         meta["joint_names"] = list(self.joint_names)
+        return meta, {name: getattr(self, name) for name in _ARRAYS + _DENSE_ARRAYS}
+
+    @classmethod
+    def unpacked(cls, meta: dict, arrays: dict[str, np.ndarray]) -> ProgramData:
+        """The inverse of :meth:`packed` (KeyError / TypeError when incomplete)."""
+        meta = {**meta, "joint_names": tuple(meta["joint_names"])}
+        return cls(**meta, **{k: v for k, v in arrays.items() if k in _ARRAYS + _DENSE_ARRAYS})
+
+    def save(self, folder: Path) -> Path:
+        """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically."""
+        meta, arrays = self.packed()
         target = Path(folder) / PLAN_FILE
         with atomic_stream(target) as stream:
-            np.savez_compressed(
-                stream,
-                meta=json.dumps(meta),
-                **{name: getattr(self, name) for name in _ARRAYS + _DENSE_ARRAYS},
-            )
+            np.savez_compressed(stream, meta=json.dumps(meta), **arrays)
         return target
 
     @classmethod
@@ -132,7 +139,6 @@ class ProgramData:
         except Exception as error:  # truncated or foreign: zipfile, zlib, pickle, json ...
             raise ValueError(f"{file}: unreadable, not a complete plan ({error})") from None
         try:
-            meta["joint_names"] = tuple(meta["joint_names"])
-            return cls(**meta, **arrays)
+            return cls.unpacked(meta, arrays)
         except (KeyError, TypeError) as error:
             raise ValueError(f"{file}: not a plan of this version ({error})") from None

@@ -19,9 +19,13 @@ import numpy as np
 from offline_prog import __version__
 from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
-from offline_prog.export.formats import PROGRAMS_DIR
+from offline_prog.config.cell import transform
+from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
+from offline_prog.export.job_program import JOB_FILE, JobProgramData, JobSegment, ProcessIo
+from offline_prog.export.payload import payload_record
+from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.plan import JobPlan
-from offline_prog.results.plan_folder import check_out_dir
+from offline_prog.results.plan_folder import check_out_dir, program_data
 from offline_prog.results.report import collision_summary, report
 
 
@@ -145,11 +149,82 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
         write_atomic(files["trajectory"], trajectory_csv(job))
         write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
         write_collisions_json(job.collisions, files["collisions"])
-        if job.feasible:
-            programs = folder / PROGRAMS_DIR
-            programs.mkdir()
-            files["csv:joint_trajectory.csv"] = programs / "joint_trajectory.csv"
-            write_atomic(files["csv:joint_trajectory.csv"], trajectory_csv(job))
+        data = job_program_data(job, summary)
+        files["job"] = data.save(folder)
+        files["plan"] = folder / PLAN_FILE
+        if data.feasible:  # no program from a failed plan (offline-prog export --force can)
+            for fmt in job_formats(data.language):
+                for file in export(data, fmt, folder / PROGRAMS_DIR):
+                    files[f"{fmt}:{file.name}"] = file
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
     return {key: out_dir / path.relative_to(folder) for key, path in files.items()}, summary
+
+
+def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
+    """The job as the program writers need it (poses in the robot base B)."""
+    cell, robot, s = job.cell, job.robot, job.samples
+    X_BI = transform(cell.robot.X_IB).inverse().GetAsMatrix4()
+    X_BT = X_BI @ transform(cell.tool.X_IT).GetAsMatrix4()
+    X_EP = transform(cell.part.X_PE).inverse().GetAsMatrix4()
+    X_BE = robot.forward(s.q)
+    X_PT = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)  # the tool T in P, every row
+    rows = ProgramData(
+        cell_name=cell.name or job.cell_file.stem,
+        cell_file=str(job.cell_file),
+        robot=robot.name,
+        tool=cell.tool.name,
+        part=cell.part.name,
+        process_speed_m_s=cell.motion.speed,
+        speed_reference=cell.motion.speed_reference,
+        cycle_time_s=float(s.t[-1]),
+        feasible=job.feasible,
+        failure=job.failure,
+        joint_names=tuple(robot.joint_names),
+        generated=summary["generated"],
+        t=s.t,
+        sigma=s.path_m,
+        q=s.q,
+        qd=s.qd,
+        X_BE=X_BE,
+        X_PF=X_PT,
+        X_BT=X_BT,
+        X_EP=X_EP,
+        tcp_speed=job.tcp_speed,
+        q_lower=robot.q_lower,
+        q_upper=robot.q_upper,
+        qd_max=robot.qd_max,
+        j23_coupled=robot.j23_coupled,
+        language=robot.language,
+        payload=payload_record(cell),
+    )
+    io = cell.tool.process_io
+    process_io = None
+    if io is not None:
+        process_io = ProcessIo(
+            digital_output=None if io.on is None else io.on.digital_output,
+            on_lead_m=0.0 if io.on is None else io.on.lead_mm * 1e-3,
+            off_lead_m=0.0 if io.off is None else io.off.lead_mm * 1e-3,
+            **(
+                {}
+                if io.flow is None
+                else {
+                    "analog_output": io.flow.analog_output,
+                    "per_mps": io.flow.per_mps,
+                    "offset": io.flow.offset,
+                    "min": io.flow.min,
+                    "max": io.flow.max,
+                }
+            ),
+        )
+    return JobProgramData(
+        job=rows,
+        segments=tuple(JobSegment(g.kind, g.seam, g.start, g.stop) for g in s.segments),
+        seams=tuple(program_data(o.plan, summary) for o in job.chosen),
+        seam_names=tuple(o.name for o in job.chosen),
+        seam_lengths_m=tuple(o.plan.path.length for o in job.chosen),
+        link_waypoints=tuple(np.asarray(link.waypoints, dtype=float) for link in job.links),
+        process_io=process_io,
+        digital=job.io.digital,
+        analog=job.io.analog,
+    )
