@@ -21,7 +21,7 @@ from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
 from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
-from offline_prog.export.job_program import JOB_FILE, JobProgramData, JobSegment, ProcessIo
+from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessIo
 from offline_prog.export.payload import payload_record
 from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.plan import JobPlan
