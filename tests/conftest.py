@@ -85,3 +85,22 @@ def planned_folder(tmp_path_factory):
 @pytest.fixture
 def rng():
     return np.random.default_rng(0)
+
+
+@pytest.fixture(scope="session")
+def planned_job(tmp_path_factory):
+    """name ↦ (job plan, folder): a demo job planned once per session with its outputs."""
+    from offline_prog.plan import plan_job
+    from offline_prog.results.job_folder import write_job_outputs
+
+    cache = {}
+
+    def get(name: str):
+        if name not in cache:
+            out = tmp_path_factory.mktemp(name)
+            job = plan_job(CELLS / f"{name}.yaml")
+            write_job_outputs(job, out)
+            cache[name] = (job, out)
+        return cache[name]
+
+    return get

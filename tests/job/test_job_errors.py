@@ -1,0 +1,79 @@
+"""Bad job input ends with one line naming the file, key and reason, exit 2, and
+nothing written (the issue's list: duplicate seam names, home outside the limits or in
+collision, a negative approach distance, I/O that cannot be placed)."""
+
+import subprocess
+import sys
+
+import pytest
+
+from conftest import CELLS
+
+JOB = (CELLS / "seal_job_kr16.yaml").read_text()
+
+
+def run(tmp_path, text):
+    cell = tmp_path / "job.yaml"
+    cell.write_text(text)
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    return result, out
+
+
+@pytest.mark.parametrize(
+    "change, key, reason",
+    [
+        (("name: hole_right", "name: hole_left"), "seams[2].name", "used twice"),
+        (("name: stripe", "name: Hole_Left"), "seams[3].name", "used twice"),
+        (("name: stripe", "name: 'stripe; $OUT[2]=TRUE'"), "seams[3].name", "not a seam name"),
+        (
+            (
+                "approach: {kind: normal, distance_mm: 50}",
+                "approach: {kind: normal, distance_mm: -5}",
+            ),
+            "seams[0].approach.distance_mm",
+            "must be within",
+        ),
+        (
+            ("direction: auto\n    speed", "direction: sideways\n    speed"),
+            "seams[3].direction",
+            "sideways",
+        ),
+        (("order: auto", "order: fastest"), "job.order", "fastest"),
+        (
+            ("order: auto", "order: auto\n  home: {joints_deg: [0, -90, 90, 0, 30, 400]}"),
+            "job.home.joints_deg",
+            "outside its limits",
+        ),
+        (
+            ("order: auto", "order: auto\n  home: {joints_deg: [0, 20, 130, 0, 30, 0]}"),
+            "job.home.joints_deg",
+            "collides",
+        ),
+        (
+            ("on:  {digital_output: 1, lead_mm: 5}", "on:  {digital_output: 1, lead_mm: 80}"),
+            "tool.process_io.on.lead_mm",
+            "outside its",
+        ),
+        (
+            ("off: {digital_output: 1, lead_mm: 2}", "off: {digital_output: 2, lead_mm: 2}"),
+            "tool.process_io.off.digital_output",
+            "must equal",
+        ),
+        (("seams:", "path: {units: mm, points: a.csv}\nseams:"), "seams", "exactly one of"),
+    ],
+)
+def test_bad_job_input_is_one_line_exit_2_nothing_written(tmp_path, change, key, reason):
+    old, new = change
+    assert old in JOB
+    result, out = run(tmp_path, JOB.replace(old, new, 1))
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2, result.stderr
+    assert len(lines) == 1 and "Traceback" not in result.stderr
+    assert f": {key}: " in lines[0] and reason in lines[0], lines[0]
+    assert not out.exists()
