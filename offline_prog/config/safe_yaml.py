@@ -62,6 +62,7 @@ def quote_bool_keys(text: str) -> str:
     loader reads them as the strings a YAML 1.2 reader (and the schema) sees."""
     return _YAML11_BOOL_KEY.sub(r'\1"\2"\3', text)
 
+
 _short = reprlib.Repr()
 _short.maxstring = _short.maxother = MAX_VALUE_CHARS
 _short.maxlist = _short.maxdict = 6

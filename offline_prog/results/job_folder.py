@@ -25,8 +25,10 @@ from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessI
 from offline_prog.export.payload import payload_record
 from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.plan import JobPlan
-from offline_prog.results.plan_folder import check_out_dir, program_data
+from offline_prog.results.plan_folder import InParallel, check_out_dir, program_data
 from offline_prog.results.report import collision_summary, report
+from offline_prog.viz.job_preview import write_job_preview_html
+from offline_prog.viz.job_report_html import write_job_report_html
 
 
 def job_table(job: JobPlan) -> tuple[list[str], list[list[str]]]:
@@ -51,9 +53,7 @@ def trajectory_csv(job: JobPlan) -> str:
     header, columns = job_table(job)
     out = io.StringIO()
     out.write(",".join(header) + "\n")
-    text = [
-        c if c.dtype == object else np.char.mod("%.10g", c.astype(float)) for c in columns
-    ]
+    text = [c if c.dtype == object else np.char.mod("%.10g", c.astype(float)) for c in columns]
     table = np.column_stack(text)
     table[table == "nan"] = ""
     out.writelines(",".join(row) + "\n" for row in table)
@@ -140,8 +140,11 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     with staged_folder(out_dir) as folder:
+        files = {"preview": folder / "preview.html"}
+        # preview.html needs nothing else written here: the second core draws it.
+        preview = InParallel(lambda: write_job_preview_html(job, files["preview"]))
         summary = job_report(job)
-        files = {
+        files |= {
             "trajectory": folder / "trajectory.csv",
             "report": folder / "report.json",
             "collisions": folder / "collisions.json",
@@ -156,6 +159,8 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
             for fmt in job_formats(data.language):
                 for file in export(data, fmt, folder / PROGRAMS_DIR):
                     files[f"{fmt}:{file.name}"] = file
+        files["report_html"] = write_job_report_html(folder)  # after the programs
+        preview.wait()
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
     return {key: out_dir / path.relative_to(folder) for key, path in files.items()}, summary

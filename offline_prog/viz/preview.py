@@ -163,7 +163,7 @@ def _draw_shape(scene: StaticScene, path: str, shape, rgba) -> None:
         raise ValueError(f"preview: no drawing for Drake {type(shape).__name__}")
 
 
-def _draw_cell(scene: StaticScene, drake) -> dict[str, object]:
+def draw_cell(scene: StaticScene, drake) -> dict[str, object]:
     """Every illustration geometry under ``/drake/<model>/<body>``; returns the bodies
     by node path."""
     plant, inspector = drake.plant, drake.diagram.scene_graph().model_inspector()
@@ -191,7 +191,7 @@ def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[St
     plant = drake.plant
     context = plant.CreateDefaultContext()
     scene = StaticScene()
-    bodies = _draw_cell(scene, drake)
+    bodies = draw_cell(scene, drake)
     extra = overlays(plan, near_collision)
     part = next((p for p, b in bodies.items() if b.name() == "part"), None)
     if part is None:  # a part without geometry: its frame still carries the path

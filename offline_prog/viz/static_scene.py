@@ -164,13 +164,26 @@ class StaticScene:
         tx, ty, tz = (float(v) for v in p_I_target)
         self._add({"type": "set_target", "value": [tx, tz, -ty]})
 
-    def set_animation(self, paths: list[str], times: np.ndarray, poses: np.ndarray, fps: float):
+    def set_animation(
+        self,
+        paths: list[str],
+        times: np.ndarray,
+        poses: np.ndarray,
+        fps: float,
+        scales: dict[str, np.ndarray] | None = None,
+    ):
         """Animate each node: poses (n_nodes, n_times, 4, 4) in its parent, at frame
-        ⌊t · fps⌋ for each of ``times`` [s] (one pose per frame: the later one)."""
+        ⌊t · fps⌋ for each of ``times`` [s] (one pose per frame: the later one).
+        ``scales``: node path ↦ (n_times,) uniform scale (0 hides the node)."""
         frames = np.floor(np.asarray(times) * fps + 1e-9).astype(int)
         keep = np.r_[frames[1:] != frames[:-1], True]
         frames, poses = frames[keep].tolist(), np.asarray(poses)[:, keep]
         animations = []
+        for path, scale in (scales or {}).items():
+            values = [[float(v)] * 3 for v in np.asarray(scale)[keep]]
+            track = {"name": ".scale", "type": "vector3", "keys": _keys(frames, values)}
+            animations.append({"path": path, "clip": {"fps": fps, "name": "default",
+                                                      "tracks": [track]}})  # fmt: skip
         for path, X in zip(paths, poses, strict=True):
             positions = X[:, :3, 3].tolist()
             quaternions = Rotation.from_matrix(X[:, :3, :3]).as_quat().tolist()  # x, y, z, w

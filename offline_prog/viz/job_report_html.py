@@ -1,0 +1,181 @@
+"""report.html of a whole job: a self-contained page read from the plan folder alone
+(report.json, trajectory.csv, the names in programs/).
+
+Summary: the verdict, the seam order (and the estimated saving against the given
+order), the cycle time split into process and air time, one row per seam and per link,
+and the process I/O switches. Plots (uPlot, inlined, as in the one-seam report): the
+TCP speed over the whole job with the process output and the flow value on the same
+time axis (the I/O timeline), and the joints against their limits.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.atomic import MANIFEST, write_atomic
+from offline_prog.viz.report_html import _CSS, PROGRAMS_DIR, REPORT_FILE
+from offline_prog.viz.report_plots import PLOT_SCRIPT, plot_assets
+from offline_prog.viz.report_summary import escape as _e
+
+JOINT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
+MAX_PLOT_POINTS = 6000  # rows kept for the page's plots (every k-th row beyond)
+
+
+def _columns(plan_dir: Path) -> dict[str, np.ndarray]:
+    with open(plan_dir / "trajectory.csv", newline="") as stream:
+        rows = list(csv.reader(stream))
+    header, body = rows[0], rows[1:]
+    step = max(1, len(body) // MAX_PLOT_POINTS)
+    body = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
+    out = {}
+    for j, name in enumerate(header):
+        values = [r[j] for r in body]
+        out[name] = (
+            np.array(values, dtype=object)
+            if name == "segment"
+            else np.array([float(v) if v else np.nan for v in values])
+        )
+    return out
+
+
+def _series(values: np.ndarray, scale: float = 1.0) -> list:
+    return [None if not np.isfinite(v) else round(float(v) * scale, 6) for v in values]
+
+
+def _plots(report: dict, col: dict) -> dict:
+    t = col["t_s"]
+    columns = {"t": _series(t), "v": _series(col["tcp_speed_m_s"], 1e3)}
+    io = [name for name in col if name[:2] in ("do", "ao") and name[2:].isdigit()]
+    for name in io:
+        columns[name] = _series(col[name])
+    for j in range(6):
+        columns[f"q{j + 1}"] = _series(col[f"q{j + 1}"], 180.0 / np.pi)
+    speed = {
+        "title": "TCP speed along the part",
+        "ylabel": "speed [mm/s]",
+        "series": [{"col": "v", "label": "v_TCP [mm/s]", "color": "#1f77b4"}],
+    }
+    io_panel = {
+        "title": "process I/O (on the same time axis)",
+        "ylabel": "output",
+        "series": [
+            {
+                "col": name,
+                "label": f"{name} {'[0/1]' if name[0] == 'd' else '[V]'}",
+                "color": "#2e7d32" if name[0] == "d" else "#c62828",
+            }
+            for name in io
+        ],  # fmt: skip
+    }
+    joints = {
+        "title": "joint positions",
+        "ylabel": "q [deg]",
+        "series": [
+            {"col": f"q{j + 1}", "label": f"q{j + 1} [deg]", "color": JOINT_COLORS[j]}
+            for j in range(6)
+        ],
+    }
+    panels = [speed, io_panel] if io else [speed]
+    return {
+        "columns": columns,
+        "plots": [
+            {
+                "id": "plot-speed",
+                "columns": 1,
+                "panels": panels,
+                "caption": "TCP speed over the whole job (gaps: links, where the tool is off "
+                "the part's path) and the process output and flow value.",
+            },
+            {
+                "id": "plot-joints",
+                "columns": 1,
+                "panels": [joints],
+                "caption": "Joint positions over the whole job, home to home.",
+            },
+        ],  # fmt: skip
+    }
+
+
+def _table(header: list[str], rows: list[list]) -> str:
+    head = "".join(f"<th>{_e(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{_e(v)}</td>" for v in row) + "</tr>" for row in rows)
+    return f'<table class="list"><tr>{head}</tr>{body}</table>'
+
+
+def render_job_report_html(plan_dir: Path) -> str:
+    """The report page of a job's plan folder, as one HTML string."""
+    plan_dir = Path(plan_dir)
+    report = json.loads((plan_dir / "report.json").read_text())
+    col = _columns(plan_dir)
+    job = report["job"]
+    ok = report["collision_free"]
+    word = '<span class="pass">PASS</span>' if ok else '<span class="fail">FAIL</span>'
+    programs = sorted(
+        p.relative_to(plan_dir).as_posix()
+        for p in (plan_dir / PROGRAMS_DIR).glob("**/*")
+        if p.is_file() and p.name != MANIFEST
+    )
+    order = ", ".join(f"{o['seam']} ({o['direction']})" for o in job["order"])
+    summary = [
+        ("Result", word),
+        ("Order", f"{order}: {job['order_mode']} ({job['order_method']}), estimated "
+                  f"saving {job['estimated_saving_s']:.2f} s against the given order"),
+        ("Cycle time", f"{job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
+                       f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, "
+                       f"approach and retract {job['approach_retract_time_s']:.2f} s)"),
+        ("Clearance", "none checked" if report["min_distance_m"] is None
+         else f"min distance {report['min_distance_m'] * 1e3:.1f} mm"),
+        ("Programs", ", ".join(programs) or "none (the plan failed)"),
+    ]  # fmt: skip
+    table = "".join(f"<tr><th>{_e(k)}</th><td>{v if k == 'Result' else _e(v)}</td></tr>"
+                    for k, v in summary)  # fmt: skip
+    seams = _table(
+        ["seam", "length [mm]", "time [s]", "fit max error [mm]", "min clearance [mm]"],
+        [
+            [s["seam"], f"{s['path']['length_m'] * 1e3:.1f}",
+             f"{s['trajectory']['duration_s']:.2f}", f"{s['fit']['max_error_mm']:.4f}",
+             "" if s["min_distance_m"] is None else f"{s['min_distance_m'] * 1e3:.1f}"]
+            for s in report["seams"]
+        ],
+    )  # fmt: skip
+    links = _table(
+        ["link", "method", "time [s]", "joint path [deg]", "waypoints"],
+        [[k["name"], k["method"], f"{k['duration_s']:.2f}",
+          f"{np.rad2deg(k['length_rad']):.1f}", k["waypoints"]] for k in report["links"]],
+    )  # fmt: skip
+    events = _table(
+        ["seam", "output", "state", "position along the path [mm]", "t [s]"],
+        [[e["seam"], e["digital_output"], e["state"], f"{e['path_m'] * 1e3:.2f}",
+          f"{e['t_s']:.3f}"] for e in report["process_io"]],
+    )  # fmt: skip
+    data = _plots(report, col)
+    text = json.dumps(data, separators=(",", ":"), allow_nan=False)
+    text = text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+    figures = "".join(
+        f'<figure><div class="plot" id="{p["id"]}"></div><figcaption>{_e(p["caption"])}'
+        "</figcaption></figure>"
+        for p in data["plots"]
+    )
+    css, script = plot_assets()
+    title = f"Job report: {report.get('name') or plan_dir.name}"
+    return (
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{_e(title)}'
+        f"</title><style>{_CSS}{css}</style></head><body><h1>{_e(title)}</h1>"
+        f'<p class="sub">{_e(report.get("generator", ""))}, planned '
+        f'{_e(report.get("generated", ""))}</p><h2>Summary</h2><table id="summary">{table}'
+        f"</table><h2>Seams</h2>{seams}<h2>Links</h2>{links}<h2>Process I/O</h2>{events}"
+        f'<h2>Plots</h2><p class="hint">Drag to zoom into a time range, double-click to '
+        f"reset.</p>{figures}"
+        f'<script type="application/json" id="plot-data">{text}</script>'
+        f"<script>{script}</script><script>{PLOT_SCRIPT}</script></body></html>\n"
+    )
+
+
+def write_job_report_html(plan_dir: Path) -> Path:
+    target = Path(plan_dir) / REPORT_FILE
+    write_atomic(target, render_job_report_html(plan_dir))
+    return target
