@@ -129,6 +129,8 @@ class PathConfig:
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
+    dxf_entity: int | None = None  # which path entity (0-based) when the DXF has several
+    csv_seam: str | None = None  # rows of this seam (CSV seam column); seams: its name
     analytic: AnalyticPath | None = None
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh

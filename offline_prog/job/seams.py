@@ -70,6 +70,8 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
     cell = job.cell
     seam = job_seams(cell)[k]
     fields = {f.name: getattr(seam, f.name) for f in dataclasses.fields(PathConfig)}
+    if cell.seams and seam.points and seam.csv_seam is None and _has_seam_column(job.file, seam):
+        fields["csv_seam"] = seam.name  # a CSV of several seams: this seam's rows
     speed = seam.speed if seam.speed is not None else cell.motion.speed
     seam_cell = dataclasses.replace(
         cell,
@@ -82,3 +84,15 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
     if reverse:
         points = reversed_points(points)
     return dataclasses.replace(job, cell=seam_cell, points=points)
+
+
+def _has_seam_column(file, seam: SeamConfig) -> bool:
+    """The seam's CSV has a ``seam`` column (its header's last name)."""
+    try:
+        with open(file.parent / seam.points) as stream:
+            for line in stream:
+                if line.strip() and not line.startswith("#"):
+                    return line.strip().lower().split(",")[-1].strip() == "seam"
+    except OSError:
+        return False
+    return False

@@ -92,9 +92,14 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
                 units=path.units,
                 closed=path.closed,
                 close_tolerance_m=path.fit_tolerance_mm * 1e-3,
+                seam=path.csv_seam,
             )
         return path_sources.read_dxf_points(
-            file.parent / source, layer=path.dxf_layer, closed=path.closed, units=path.units
+            file.parent / source,
+            layer=path.dxf_layer,
+            closed=path.closed,
+            units=path.units,
+            entity=path.dxf_entity,
         )
     except path_sources.OpenEndsError as error:
         raise _error(

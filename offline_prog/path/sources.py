@@ -52,10 +52,17 @@ def clean_points(p, normals, *, closed: bool) -> PathPoints:
 
 
 def read_csv_points(
-    file: Path, *, units: str, closed: bool, close_tolerance_m: float = DUPLICATE_POINT_M
+    file: Path,
+    *,
+    units: str,
+    closed: bool,
+    close_tolerance_m: float = DUPLICATE_POINT_M,
+    seam: str | None = None,
 ) -> PathPoints:
-    """Read ``x,y,z[,nx,ny,nz]`` rows (header required) in P, scaled to metres.
+    """Read ``x,y,z[,nx,ny,nz][,seam]`` rows (header required) in P, scaled to metres.
 
+    With a ``seam`` column the file holds several seams: ``seam`` picks the rows of one
+    (in file order); without ``seam`` all rows must name the same one.
     A closed path's last row repeats its first (within close_tolerance_m [m]); that
     row is dropped. Otherwise OpenEndsError: closing it would add a stroke no one drew.
     """
@@ -67,32 +74,47 @@ def read_csv_points(
         raise ValueError(f"header must start with x,y,z (got {','.join(header) or 'nothing'})")
     has_normals = header[3:6] == ["nx", "ny", "nz"]
     extra = header[6:] if has_normals else header[3:]
-    if extra:
-        raise ValueError(f"unknown columns {extra}; allowed: x,y,z[,nx,ny,nz]")
-    width = 6 if has_normals else 3
+    has_seams = extra == ["seam"]
+    if extra and not has_seams:
+        raise ValueError(f"unknown columns {extra}; allowed: x,y,z[,nx,ny,nz][,seam]")
+    width = (6 if has_normals else 3) + has_seams
     for number, row in enumerate(rows, start=2):
         if len(row) != width:
             raise ValueError(f"line {number} has {len(row)} values, expected {width}")
+    numbers = list(range(len(rows)))
+    if has_seams:
+        labels = [row[-1].strip() for row in rows]
+        names = list(dict.fromkeys(labels))
+        if seam is None and len(names) > 1:
+            raise ValueError(f"holds seams {', '.join(names)}: choose one (a seam's name)")
+        if seam is not None and seam not in names:
+            raise ValueError(f"has no seam {seam!r} (seam column: {', '.join(names)})")
+        numbers = [i for i, label in enumerate(labels) if seam is None or label == seam]
+        rows = [rows[i][:-1] for i in numbers]
+        width -= 1
     try:
         data = np.array([[float(v) for v in row] for row in rows], dtype=float).reshape(-1, width)
     except ValueError as error:
         raise ValueError(f"a value is not a number ({error})") from None
     bad_rows = np.flatnonzero(~np.isfinite(data).all(axis=1))
     if bad_rows.size:
-        raise ValueError(f"line {bad_rows[0] + 2} holds NaN or infinity")
+        raise ValueError(f"line {numbers[bad_rows[0]] + 2} holds NaN or infinity")
     p = data[:, :3] * UNIT_SCALE[units]
     normals = None
     if has_normals:
         lengths = np.linalg.norm(data[:, 3:], axis=1)
         if lengths.min() < 1e-9:
-            raise ValueError(f"line {int(np.argmin(lengths)) + 2}: normal (nx,ny,nz) is zero")
+            line = numbers[int(np.argmin(lengths))] + 2
+            raise ValueError(f"line {line}: normal (nx,ny,nz) is zero")
         normals = data[:, 3:] / lengths[:, None]
     if closed and len(p) > 1:
         gap = float(np.linalg.norm(p[-1] - p[0]))
         if gap > close_tolerance_m:
             raise OpenEndsError(gap, close_tolerance_m)
         p, normals = p[:-1], None if normals is None else normals[:-1]
-    return clean_points(p, normals, closed=closed)
+        numbers = numbers[:-1]
+    points = clean_points(p, normals, closed=closed)
+    return dataclasses.replace(points, rows=np.asarray(numbers)[points.rows])
 
 
 def _count(length: float) -> int:
@@ -135,9 +157,12 @@ def rounded_rectangle_points(center, size, corner_radius) -> np.ndarray:
     return points[:-1] + center
 
 
-def read_dxf_points(file: Path, *, layer: str | None, closed: bool, units: str) -> PathPoints:
-    """Sample the one path entity (LINE, ARC, CIRCLE, (LW)POLYLINE, SPLINE, ELLIPSE)
-    of a DXF file's modelspace (optionally on one layer), scaled to metres."""
+def read_dxf_points(
+    file: Path, *, layer: str | None, closed: bool, units: str, entity: int | None = None
+) -> PathPoints:
+    """Sample one path entity (LINE, ARC, CIRCLE, (LW)POLYLINE, SPLINE, ELLIPSE) of a
+    DXF file's modelspace, scaled to metres: the only one (optionally on one layer), or
+    the ``entity``-th (0-based, in drawing order) of several."""
     import ezdxf
 
     try:
@@ -149,10 +174,14 @@ def read_dxf_points(file: Path, *, layer: str | None, closed: bool, units: str) 
     if layer is not None:
         entities = [e for e in entities if e.dxf.layer == layer]
     where = f" on layer {layer!r}" if layer is not None else ""
+    if entity is not None:
+        if not 0 <= entity < len(entities):
+            raise ValueError(f"has {len(entities)} path entities{where}, no entity {entity}")
+        entities = [entities[entity]]
     if len(entities) != 1:
         raise ValueError(
             f"expected exactly one path entity{where}, found {len(entities)} "
-            f"({', '.join(e.dxftype() for e in entities) or 'none'}); set path.dxf_layer"
+            f"({', '.join(e.dxftype() for e in entities) or 'none'}); set dxf_layer or dxf_entity"
         )
     entity = entities[0]
     scale = UNIT_SCALE[units]
