@@ -85,12 +85,17 @@ def _serve_preview(plan, args, console: Console) -> None:
     """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
     from pydrake.geometry import Meshcat, MeshcatParams
 
+    from offline_prog.plan import JobPlan
+    from offline_prog.viz.job_preview import show_job
     from offline_prog.viz.preview import near_collision_mask, show_plan
 
     params = MeshcatParams()
     params.port = args.port
     meshcat = Meshcat(params)
-    info = show_plan(plan, meshcat, near_collision=near_collision_mask(plan))
+    if isinstance(plan, JobPlan):
+        info = show_job(plan, meshcat)
+    else:
+        info = show_plan(plan, meshcat, near_collision=near_collision_mask(plan))
     console.print(
         f"MeshCat preview at [bold]{meshcat.web_url()}[/bold] "
         f"({info['frames']} animation frames; Ctrl-C to stop)"
@@ -138,7 +143,6 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         from offline_prog.config.cell import load_cell
-        from offline_prog.errors import InputError
         from offline_prog.plan import plan_cell, plan_job
         from offline_prog.results.job_folder import write_job_outputs
         from offline_prog.results.plan_folder import check_out_dir, write_outputs
@@ -160,8 +164,6 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
         is_job = bool(load_cell(args.cell).seams)  # seams: a whole job
-        if is_job and args.command == "preview":
-            raise InputError(args.cell, "seams", "the preview of a whole job is not written yet")
         with errors.status("planning") as status:
             plan = (plan_job if is_job else plan_cell)(
                 args.cell, progress=lambda stage: status.update(stage)

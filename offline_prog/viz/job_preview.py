@@ -78,3 +78,57 @@ def write_job_preview_html(job, file) -> dict:
     title = f"Preview: {job.cell.name or Path(job.cell_file).stem}"
     write_atomic(Path(file), scene.html(title))
     return info
+
+
+def show_job(job, meshcat) -> dict:
+    """Draw the job in a live Drake ``meshcat`` and record its motion as an animation,
+    each seam's highlight visible only while it runs.
+
+    Returns:
+        {"frames": recorded animation frames, "frames_per_second", "seams": their number}.
+    """
+    from pydrake.geometry import Rgba
+
+    drake = build_cell_model(job.cell, job.cell_file, job.robot, meshcat=meshcat)
+    part = f"/drake/visualizer/part/{drake.plant.GetBodyByName('part').name()}"
+    highlights = {}
+    for option in job.chosen:
+        plan = option.plan
+        s = np.linspace(0.0, plan.path.length, 600)
+        p_PF = plan.path(s, order=0)[0]
+        meshcat.SetLine(f"{part}/seams/{option.name}", p_PF.T, 3.0, Rgba(*PATH_COLOR))
+        n_P = plan.flange(s[:1]).R_PF[0][:, 1]
+        path = f"{part}/active/{option.name}"
+        meshcat.SetLine(path, (p_PF - ACTIVE_LIFT_M * n_P).T, 6.0, Rgba(*ACTIVE_COLOR))
+        highlights[option.name] = path
+    X_IE = transform(job.cell.robot.X_IB).GetAsMatrix4() @ job.robot.forward(job.samples.q)
+    for k, segment in enumerate(job.samples.segments):
+        rows = slice(segment.start, min(segment.stop + 1, len(X_IE)))
+        color = LINK_COLOR if segment.kind == "link" else FLANGE_COLOR
+        meshcat.SetLine(f"/offline_prog/flange_path/{k}_{segment.kind}",
+                        X_IE[rows, :3, 3].T, 2.0, Rgba(*color))  # fmt: skip
+    diagram, plant = drake.diagram, drake.plant
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyContextFromRoot(context)
+    times = np.append(np.arange(0.0, job.samples.t[-1], 1.0 / PREVIEW_FPS), job.samples.t[-1])
+    drake.visualizer.StartRecording(set_transforms_while_recording=False)
+    for time in times:
+        context.SetTime(time)
+        q = [np.interp(time, job.samples.t, job.samples.q[:, j]) for j in range(6)]
+        plant.SetPositions(plant_context, drake.robot, q)
+        diagram.ForcedPublish(context)
+    drake.visualizer.StopRecording()
+    animation = drake.visualizer.get_mutable_recording()
+    for segment in job.samples.segments:
+        if segment.kind != "process":
+            continue
+        path = highlights[segment.seam]
+        for time in times:
+            active = segment.t_start <= time < segment.t_stop
+            animation.SetProperty(animation.frame(time), path, "visible", active)
+    drake.visualizer.PublishRecording()
+    return {
+        "frames": int(animation.frame(times[-1])) + 1,
+        "frames_per_second": animation.frames_per_second(),
+        "seams": len(job.chosen),
+    }

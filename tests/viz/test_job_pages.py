@@ -58,3 +58,21 @@ def test_preview_highlights_each_seam_only_while_it_runs(folder, planned_job):
         assert min(shown) == pytest.approx(segment.t_start, abs=1.0 / fps)
         assert max(shown) == pytest.approx(segment.t_stop, abs=2.0 / fps)
         assert np.all(np.diff([k["time"] for k in keys]) > 0)
+
+
+def test_live_preview_draws_every_seam_and_records_the_whole_job(planned_job):
+    from pydrake.geometry import Meshcat, MeshcatParams
+
+    from offline_prog.viz.job_preview import show_job
+
+    job = planned_job(JOB)[0]
+    params = MeshcatParams()
+    params.port = 0  # any free port
+    meshcat = Meshcat(params)
+    info = show_job(job, meshcat)
+    fps = info["frames_per_second"]
+    assert info["frames"] == int(np.floor(job.samples.t[-1] * fps + 1e-9)) + 1
+    part = "/drake/visualizer/part/part"
+    for option in job.chosen:
+        assert meshcat.HasPath(f"{part}/seams/{option.name}")
+        assert meshcat.HasPath(f"{part}/active/{option.name}")
