@@ -27,17 +27,45 @@ from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.plan import JobPlan
 from offline_prog.results.plan_folder import InParallel, check_out_dir, program_data
 from offline_prog.results.report import collision_summary, report
+from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
 from offline_prog.viz.job_report_html import write_job_report_html
 
 
-def job_table(job: JobPlan) -> tuple[list[str], list[list[str]]]:
-    """trajectory.csv's header and rows: t_s, segment, path_m, tcp_speed_m_s, q1..q6
-    [rad], qd1..qd6 [rad/s], then do<n> (0/1) and ao<n> when the tool has process I/O."""
+def flange_table(job: JobPlan) -> np.ndarray:
+    """(N, len(CSV_COLUMNS)) the one-seam trajectory.csv columns on every row of the job:
+    on the seams the seams' own exact values (σ the arc length); elsewhere the flange
+    pose X_IE from forward kinematics and its rates by central differences in t, with
+    ``sigma`` the signed path position (NaN on links)."""
+    s = job.samples
+    X_IE = transform(job.cell.robot.X_IB).GetAsMatrix4() @ job.robot.forward(s.q)
+    p, R = X_IE[:, :3, 3], X_IE[:, :3, :3]
+    v = np.gradient(p, s.t, axis=0)
+    W = np.gradient(R, s.t, axis=0) @ np.swapaxes(R, 1, 2)  # skew(w) = Ṙ Rᵀ
+    w = 0.5 * np.stack([W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0],
+                        W[:, 1, 0] - W[:, 0, 1]], axis=1)  # fmt: skip
+    table = np.column_stack(
+        [s.t, s.path_m, p, tait_bryan_xyz(R), v, w, np.gradient(v, s.t, axis=0),
+         job.tcp_speed, np.gradient(w, s.t, axis=0)]
+    )  # fmt: skip
+    by_seam = {option.name: option.plan.trajectory for option in job.chosen}
+    for segment in s.segments:
+        if segment.kind == "process":
+            rows = slice(segment.start, segment.stop)
+            exact = by_seam[segment.seam].table()[: segment.stop - segment.start]
+            table[rows, 1:] = exact[:, 1:]  # the job's own clock in column t
+    return table
+
+
+def job_table(job: JobPlan) -> tuple[list[str], list[np.ndarray]]:
+    """trajectory.csv's header and columns: the one-seam columns (``CSV_COLUMNS``),
+    then ``segment`` (link, approach:<seam>, process:<seam>, retract:<seam>: the
+    contract), q1..q6 [rad], qd1..qd6 [rad/s], and do<n> (0/1) and ao<n> (the flow
+    value) when the tool has process I/O."""
     s, io_ = job.samples, job.io
-    header = ["t_s", "segment", "path_m", "tcp_speed_m_s"]
+    header = [*CSV_COLUMNS, "segment"]
     header += [f"q{i + 1}" for i in range(6)] + [f"qd{i + 1}" for i in range(6)]
-    columns = [s.t, s.labels(), s.path_m, job.tcp_speed, *s.q.T, *s.qd.T]
+    columns = [*flange_table(job).T, s.labels(), *s.q.T, *s.qd.T]
     process_io = job.cell.tool.process_io
     if io_.digital is not None:
         header.append(f"do{process_io.on.digital_output}")
@@ -49,7 +77,7 @@ def job_table(job: JobPlan) -> tuple[list[str], list[list[str]]]:
 
 
 def trajectory_csv(job: JobPlan) -> str:
-    """CSV text of :func:`job_table` (SI units; path_m empty on links)."""
+    """CSV text of :func:`job_table` (SI units; sigma empty on links)."""
     header, columns = job_table(job)
     out = io.StringIO()
     out.write(",".join(header) + "\n")

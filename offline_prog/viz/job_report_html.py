@@ -47,9 +47,9 @@ def _series(values: np.ndarray, scale: float = 1.0) -> list:
 
 
 def _plots(report: dict, col: dict) -> dict:
-    t = col["t_s"]
+    t = col["t"]
     on_link = col["segment"] == "link"  # the tool is off the part's path: a gap
-    columns = {"t": _series(t), "v": _series(np.where(on_link, np.nan, col["tcp_speed_m_s"]), 1e3)}
+    columns = {"t": _series(t), "v": _series(np.where(on_link, np.nan, col["tcp_speed"]), 1e3)}
     io = [name for name in col if name[:2] in ("do", "ao") and name[2:].isdigit()]
     for name in io:
         columns[name] = _series(col[name])

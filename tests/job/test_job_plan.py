@@ -92,7 +92,7 @@ def test_process_io_switches_at_the_requested_positions(job):
     with open(folder / "trajectory.csv") as f:
         rows = list(csv.DictReader(f))
     do = np.array([int(r["do1"]) for r in rows])
-    path = np.array([float(r["path_m"]) if r["path_m"] else np.nan for r in rows])
+    path = np.array([float(r["sigma"]) if r["sigma"] else np.nan for r in rows])
     segment = np.array([r["segment"] for r in rows])
     step = np.nanmax(np.abs(np.diff(path)))  # path travelled between two samples
     assert step < IO_TOL_M
@@ -143,3 +143,23 @@ def test_home_pose_is_collision_free_in_the_cell():
     q = robot.urdf_joints(robot.home_c)
     result = check_trajectory(scene, q[None], np.zeros(1), np.zeros(1), clearance=0.005)
     assert result.collision_free
+
+
+def test_trajectory_csv_has_the_one_seam_columns_then_segment(job):
+    """The one-seam columns on every row (the seams' exact values on their rows, forward
+    kinematics elsewhere), then the segment label: the contract."""
+    from offline_prog.timing.trajectory import CSV_COLUMNS
+
+    plan, folder = job
+    with open(folder / "trajectory.csv") as f:
+        header = f.readline().strip().split(",")
+    assert header[: len(CSV_COLUMNS) + 1] == [*CSV_COLUMNS, "segment"]
+    table = np.genfromtxt(folder / "trajectory.csv", delimiter=",", skip_header=1)
+    X_IE = plan.robot.forward(plan.samples.q)  # the demo's base is at I
+    np.testing.assert_allclose(table[:, 2:5], X_IE[:, :3, 3], atol=1e-6)
+    for segment, option in zip(
+        [g for g in plan.samples.segments if g.kind == "process"], plan.chosen, strict=True
+    ):
+        rows = slice(segment.start, segment.stop)
+        exact = option.plan.trajectory.table()[: segment.stop - segment.start]
+        np.testing.assert_allclose(table[rows, 1:18], exact[:, 1:18], rtol=1e-8, atol=1e-9)
