@@ -143,6 +143,7 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         from offline_prog.config.cell import load_cell
+        from offline_prog.job.seams import is_job as job_cell
         from offline_prog.plan import plan_cell, plan_job
         from offline_prog.results.job_folder import write_job_outputs
         from offline_prog.results.plan_folder import check_out_dir, write_outputs
@@ -163,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
-        is_job = bool(load_cell(args.cell).seams)  # seams: a whole job
+        is_job = job_cell(load_cell(args.cell))  # seams:, or path: with job:
         with errors.status("planning") as status:
             plan = (plan_job if is_job else plan_cell)(
                 args.cell, progress=lambda stage: status.update(stage)

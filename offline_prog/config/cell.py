@@ -195,7 +195,8 @@ class Cell:
     # One of: path (one seam, the shorthand) or seams (a job of several).
     path: PathConfig | None = None
     seams: list[SeamConfig] = dataclasses.field(default_factory=list)
-    job: JobConfig = dataclasses.field(default_factory=JobConfig)
+    # The job around the seams (home, order). A path: cell with job: is a one-seam job.
+    job: JobConfig | None = None
     motion: MotionConfig = dataclasses.field(default_factory=MotionConfig, metadata=REQUIRED)
     name: str = ""
     description: str = ""

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from offline_prog.config.cell import Cell, PathConfig
+from offline_prog.config.cell import Cell, JobConfig, PathConfig
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -162,9 +162,10 @@ def _check_job(file: Path, cell: Cell) -> None:
                     f"{key}.{end}.distance_mm",
                     f"must be within [0, {MAX_APPROACH_MM:g}] mm, got {move.distance_mm:g}",
                 )
-    if cell.job.order not in ("given", "auto"):
-        raise _error(file, "job.order", f"{cell.job.order!r} (use given or auto)")
-    if cell.job.home is not None and len(cell.job.home.joints_deg) != 6:
+    job = cell.job or JobConfig()
+    if job.order not in ("given", "auto"):
+        raise _error(file, "job.order", f"{job.order!r} (use given or auto)")
+    if job.home is not None and len(job.home.joints_deg) != 6:
         raise _error(file, "job.home.joints_deg", "expected 6 joint values [deg]")
     io = cell.tool.process_io
     if io is not None:

@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.config.cell import Cell, PathConfig, SeamConfig
+from offline_prog.config.cell import Cell, JobConfig, PathConfig, SeamConfig
 from offline_prog.errors import InputError
 from offline_prog.path.inputs import load_points
 from offline_prog.path.sources import PathPoints
@@ -30,6 +30,16 @@ def job_seams(cell: Cell) -> list[SeamConfig]:
         return list(cell.seams)
     fields = {f.name: getattr(cell.path, f.name) for f in dataclasses.fields(PathConfig)}
     return [SeamConfig(**fields, name=SHORTHAND_NAME)]
+
+
+def is_job(cell: Cell) -> bool:
+    """``seams:``, or ``path:`` with ``job:`` (a one-seam job), plans as a whole job."""
+    return bool(cell.seams) or cell.job is not None
+
+
+def job_config(cell: Cell) -> JobConfig:
+    """The cell's ``job:``, or its defaults (home from the robot, the given order)."""
+    return cell.job or JobConfig()
 
 
 def seam_key(cell: Cell, k: int) -> str:

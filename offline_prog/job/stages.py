@@ -17,7 +17,13 @@ from offline_prog.job.approach import CartesianMove, cartesian_move
 from offline_prog.job.assemble import JobSamples, Piece
 from offline_prog.job.links import LinkMotion, plan_link
 from offline_prog.job.order import JobOrder, order_job
-from offline_prog.job.seams import errors_named_for, job_seams, seam_inputs, seam_key
+from offline_prog.job.seams import (
+    errors_named_for,
+    job_config,
+    job_seams,
+    seam_inputs,
+    seam_key,
+)
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs
 
@@ -57,7 +63,7 @@ def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
     Raises:
         InputError: naming ``job.home.joints_deg``.
     """
-    robot, home = inputs.robot, inputs.cell.job.home
+    robot, home = inputs.robot, job_config(inputs.cell).home
     key = "job.home.joints_deg"
     if home is None:
         if robot.home_c is None:
@@ -154,7 +160,7 @@ def choose_order(inputs: Inputs, options: list[list[SeamOption]], q_home) -> Job
     return order_job(
         [(o.seam, o.label, o.q_in, o.q_out) for o in flat], q_home,
         qd_max=robot.qd_max, qdd_max=robot.qdd_max, n_seams=len(options),
-        mode=inputs.cell.job.order, controller_joints=robot.controller_joints,
+        mode=job_config(inputs.cell).order, controller_joints=robot.controller_joints,
     )  # fmt: skip
 
 

@@ -24,6 +24,7 @@ from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
 from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessIo
 from offline_prog.export.payload import payload_record
 from offline_prog.export.program import PLAN_FILE, ProgramData
+from offline_prog.job.seams import job_config
 from offline_prog.plan import JobPlan
 from offline_prog.results.plan_folder import InParallel, check_out_dir, program_data
 from offline_prog.results.report import collision_summary, report
@@ -126,7 +127,7 @@ def job_report(job: JobPlan) -> dict:
         "part": job.cell.part.name,
         "job": {
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
-            "order_mode": job.cell.job.order,
+            "order_mode": job_config(job.cell).order,
             "order": [
                 {"seam": o.name, "direction": "reverse" if o.reverse else "forward"}
                 for o in job.chosen
