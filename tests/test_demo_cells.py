@@ -18,9 +18,9 @@ from offline_prog.robot.model import load_robot
 from offline_prog.scene.drake_cell import build_drake_cell
 from offline_prog.timing.trajectory import CSV_COLUMNS
 
-from conftest import CELLS, REPO
+from conftest import ONE_SEAM_CELLS, REPO
 
-DEMO_CELLS = sorted(CELLS.glob("*.yaml"))
+DEMO_CELLS = ONE_SEAM_CELLS  # whole jobs (seams:) have their own tests in tests/job
 
 
 @pytest.fixture(scope="module", params=DEMO_CELLS, ids=lambda p: p.stem)
