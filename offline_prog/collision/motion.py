@@ -36,26 +36,26 @@ class MotionChecker:
         self.pairs = pairs = _Pairs(cell, fixed_layout=True)
         clear_s = np.where(pairs.is_self, self_clearance, clearance)
         moving = pairs.c > 0  # the fixed layout does not move: checked with the seams
-        self.index = {
-            frozenset((a.get_value(), b.get_value())): g
-            for g, (a, b) in enumerate(pairs.ids)
-            if moving[g]
-        }
-        self.clear_g = clear_s[pairs.shape_of]
+        clear_g = clear_s[pairs.shape_of]
+        # (id_A, id_B) in either order ↦ (clearance [m], c) of each moving pair.
+        self.pair = {}
+        for g, (a, b) in enumerate(pairs.ids):
+            if moving[g]:
+                entry = (float(clear_g[g]), float(pairs.c[g]))
+                self.pair[a, b] = self.pair[b, a] = entry
+        self.far = (REACH_M - float(clear_g.max())) / 2.0  # the budget of unmeasured pairs
         self.rho = cell.motion_radii()
-        self.c = pairs.c
         self.states, self.motions = 0, 0
 
     def budget(self, q: np.ndarray) -> float:
         """min_g b_g [m of motion bound] at q: negative when a pair is below its clearance."""
         self.states += 1
-        pairs = self.pairs
-        pairs.set(q)
-        budget = (REACH_M - self.clear_g.max()) / 2.0
-        for r in pairs.query.ComputeSignedDistancePairwiseClosestPoints(max_distance=REACH_M):
-            g = self.index.get(frozenset((r.id_A.get_value(), r.id_B.get_value())))
-            if g is not None:
-                budget = min(budget, (r.distance - self.clear_g[g]) / self.c[g])
+        self.pairs.set(q)
+        budget, pair = self.far, self.pair
+        for r in self.pairs.query.ComputeSignedDistancePairwiseClosestPoints(REACH_M):
+            entry = pair.get((r.id_A, r.id_B))
+            if entry is not None:
+                budget = min(budget, (r.distance - entry[0]) / entry[1])
         return budget
 
     def clear(self, q: np.ndarray) -> bool:

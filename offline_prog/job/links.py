@@ -5,13 +5,15 @@ controller's PTP / MoveAbsJ / movej to a fine point does). If the collision chec
 (:class:`~offline_prog.collision.motion.MotionChecker`: certified between configurations,
 same pairs and clearances as the seams) rejects it, OMPL's RRTConnect plans in joint
 space with that checker as its state and motion validity, and OMPL's PathSimplifier
-shortens the path (``simplifyMax``: shortcuts and vertex reduction, every new segment
-certified). Each segment between waypoints is then timed rest to rest by ruckig on one
-path parameter s ∈ [0, 1], q = q_a + s (q_b − q_a), with the tightest joint's limits
-(v_s = min_k v_k / |Δq_k|, likewise for acceleration and jerk): the motion stays on the
-certified straight segment and within every joint's speed, acceleration and jerk limit
-(in the controller's axes; the IRB 2400's axis 3 = q2 + q3 is linear in q, so straight
-stays straight).
+shortens the path (``reduceVertices``: shortcuts between vertices; ``collapseCloseVertices``;
+every new segment certified; ``simplifyMax`` found paths a few percent shorter at five to
+ten times the cost, ``scripts/bench_links.py``). Each segment between waypoints is then
+timed rest to rest by ruckig on one path parameter s ∈ [0, 1], q = q_a + s (q_b − q_a),
+with the tightest joint's limits (v_s = min_k v_k / |Δq_k|, likewise for acceleration
+and jerk): the motion stays on the certified straight segment and within every joint's
+speed, acceleration and jerk limit (in the controller's axes; the IRB 2400's axis 3 =
+q2 + q3 is linear in q, so straight stays straight). Waypoints are fine points (rest):
+what the controller programs command, so the checked motion is the one the robot runs.
 
 Determinism: OMPL's random numbers are seeded (``seed``) before each planning, so the
 same link with the same seed gives the same path. A link not found within
@@ -30,7 +32,9 @@ from offline_prog.errors import Failure, PlanFailure
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.trajectory import sample_times
 
-PLANNER_RANGE_RAD = 0.5  # RRTConnect's longest edge in joint space [rad, Euclidean]
+# RRTConnect's longest edge in joint space [rad, Euclidean]: long edges, few vertices
+# (each edge is certified by conservative advancement, which steps as far as it may).
+PLANNER_RANGE_RAD = 1.5
 # Not published by the vendors: the time in which a joint may build up its full
 # acceleration, hence jerk limits j_k = a_k / JERK_RAMP_S.
 JERK_RAMP_S = 0.1
@@ -160,7 +164,9 @@ def _ompl_path(robot, checker, q_start, q_goal, seed, time_budget_s) -> np.ndarr
             del status
             return None
         path = setup.getSolutionPath()
-        og.PathSimplifier(info).simplifyMax(path)
+        simplifier = og.PathSimplifier(info)  # its random numbers: seeded above
+        simplifier.reduceVertices(path)  # shortcuts between vertices, each certified
+        simplifier.collapseCloseVertices(path)
         return np.array([vector(path.getState(i)) for i in range(path.getStateCount())])
     finally:
         ou.setLogLevel(level)
