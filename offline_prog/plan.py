@@ -216,10 +216,17 @@ class JobPlan:
 
     @property
     def feasible(self) -> bool:
-        return self.collisions.collision_free and all(p.feasible for p in self.seams)
+        return (
+            self.collisions.collision_free
+            and all(p.feasible for p in self.seams)
+            and all(link.ok for link in self.links)
+        )
 
     @property
     def failure(self) -> str:
+        failed = next((link for link in self.links if not link.ok), None)
+        if failed is not None:
+            return failed.failure.reason
         if self.collisions.collision_free:
             return next((p.failure for p in self.seams if not p.feasible), "")
         at = self.collisions.first_contact or self.collisions.closest

@@ -58,6 +58,13 @@ class MotionChecker:
                 budget = min(budget, (r.distance - entry[0]) / entry[1])
         return budget
 
+    def min_distance(self, q: np.ndarray) -> float:
+        """The smallest distance of any moving pair at q [m] (REACH_M if none nearer)."""
+        self.pairs.set(q)
+        results = self.pairs.query.ComputeSignedDistancePairwiseClosestPoints(REACH_M)
+        moving = [r.distance for r in results if (r.id_A, r.id_B) in self.pair]
+        return min(moving, default=REACH_M)
+
     def clear(self, q: np.ndarray) -> bool:
         """Every moving pair at least its clearance apart at q."""
         return bool(self.budget(q) >= 0.0)

@@ -38,6 +38,7 @@ PLANNER_RANGE_RAD = 1.5
 # Not published by the vendors: the time in which a joint may build up its full
 # acceleration, hence jerk limits j_k = a_k / JERK_RAMP_S.
 JERK_RAMP_S = 0.1
+MIN_CLEARANCE_SAMPLES = 200  # samples of a link measured for its reported clearance
 
 
 @dataclasses.dataclass(frozen=True)
@@ -61,6 +62,7 @@ class LinkMotion:
     waypoints: np.ndarray
     planning_time_s: float
     failure: PlanFailure | None = None
+    min_clearance_m: float | None = None  # over its samples (Drake's distances) [m]
 
     @property
     def ok(self) -> bool:
@@ -112,7 +114,11 @@ def plan_link(
             return failed(f"no collision-free path found within {time_budget_s:g} s (OMPL)")
         method = "planned"
     t, q, qd = timed_polyline(robot, waypoints, rate_hz)
-    return LinkMotion(name, method, t, q, qd, waypoints, time.perf_counter() - started)
+    nearest = min(
+        checker.min_distance(q_k) for q_k in q[:: max(1, len(q) // MIN_CLEARANCE_SAMPLES)]
+    )
+    return LinkMotion(name, method, t, q, qd, waypoints, time.perf_counter() - started,
+                      min_clearance_m=float(nearest))  # fmt: skip
 
 
 def _ompl_path(robot, checker, q_start, q_goal, seed, time_budget_s) -> np.ndarray | None:

@@ -15,7 +15,7 @@ from offline_prog.collision.check import CollisionResult, check_trajectory
 from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.job.approach import CartesianMove, cartesian_move
 from offline_prog.job.assemble import JobSamples, Piece
-from offline_prog.job.links import LinkMotion, plan_link
+from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.order import JobOrder, order_job
 from offline_prog.job.seams import (
     errors_named_for,
@@ -169,9 +169,8 @@ def job_pieces(
 ) -> tuple[list[Piece], list[LinkMotion]]:
     """home → link → approach → process → retract → link → … → home, as pieces.
 
-    Raises:
-        PlanFailedError: a link not found within its time budget (naming it).
-    """
+    A link not found within its time budget keeps its failure (naming it) and the direct
+    move in its place, so that the job's reports show where it collides."""
     motion = inputs.cell.motion
     pieces, links, q_now, previous = [], [], q_home, "home"
     for option in [*chosen, None]:
@@ -183,8 +182,10 @@ def job_pieces(
             self_clearance=motion.self_clearance, seed=LINK_SEED + len(links),
             time_budget_s=LINK_TIME_BUDGET_S, rate_hz=motion.sample_rate_hz, name=name,
         )  # fmt: skip
-        if not link.ok:
-            raise PlanFailedError(link.failure)
+        if not link.ok:  # the direct move stands in: the check shows where it collides
+            t, q, qd = timed_polyline(inputs.robot, np.array([q_now, target]),
+                                      motion.sample_rate_hz)  # fmt: skip
+            link = dataclasses.replace(link, t=t, q=q, qd=qd, waypoints=np.array([q_now, target]))
         links.append(link)
         nan = np.full(len(link.t), np.nan)
         pieces.append(Piece("link", "", link.t, link.q, link.qd, nan))

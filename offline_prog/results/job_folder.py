@@ -111,8 +111,9 @@ def job_report(job: JobPlan) -> dict:
                 "duration_s": float(link.t[-1]),
                 "length_rad": float(np.linalg.norm(np.diff(link.q, axis=0), axis=1).sum()),
                 "waypoints": int(len(link.waypoints)),
-                "min_clearance_m": getattr(link, "min_clearance_m", None),
-                "planning_time_s": getattr(link, "planning_time_s", None),
+                "min_clearance_m": link.min_clearance_m,
+                "planning_time_s": link.planning_time_s,
+                "failure": None if link.ok else link.failure.reason,
                 "t_start_s": segment.t_start,
             }
         )

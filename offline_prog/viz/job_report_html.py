@@ -144,9 +144,11 @@ def render_job_report_html(plan_dir: Path) -> str:
         ],
     )  # fmt: skip
     links = _table(
-        ["link", "method", "time [s]", "joint path [deg]", "waypoints"],
-        [[k["name"], k["method"], f"{k['duration_s']:.2f}",
-          f"{np.rad2deg(k['length_rad']):.1f}", k["waypoints"]] for k in report["links"]],
+        ["link", "method", "time [s]", "joint path [deg]", "waypoints", "min clearance [mm]"],
+        [[k["name"], k["method"] or f"FAILED: {k['failure']}", f"{k['duration_s']:.2f}",
+          f"{np.rad2deg(k['length_rad']):.1f}", k["waypoints"],
+          "" if k["min_clearance_m"] is None else f"{k['min_clearance_m'] * 1e3:.1f}"]
+         for k in report["links"]],
     )  # fmt: skip
     events = _table(
         ["seam", "output", "state", "position along the path [mm]", "t [s]"],
