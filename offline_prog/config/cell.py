@@ -173,6 +173,7 @@ class JobConfig:
 
     home: HomeConfig | None = None  # default: the robot's home_deg (robot.yaml)
     order: str = "given"  # given | auto (order, direction, branch for the least air time)
+    link_time_s: float = 10.0  # planning time per link before the plan fails [s]
 
 
 @dataclasses.dataclass

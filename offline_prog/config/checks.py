@@ -24,6 +24,7 @@ from offline_prog.errors import InputError
 DIRECTIONS = ("forward", "reverse", "auto")
 APPROACH_KINDS = ("normal", "tangent", "none")
 MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
+MAX_LINK_TIME_S = 600.0  # planning time per link
 MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
 SEAM_NAME = re.compile(rf"[A-Za-z][A-Za-z0-9_]{{0,{MAX_SEAM_NAME_CHARS - 1}}}")
 
@@ -165,6 +166,8 @@ def _check_job(file: Path, cell: Cell) -> None:
     job = cell.job or JobConfig()
     if job.order not in ("given", "auto"):
         raise _error(file, "job.order", f"{job.order!r} (use given or auto)")
+    if not 0 < job.link_time_s <= MAX_LINK_TIME_S:
+        raise _error(file, "job.link_time_s", f"must be within (0, {MAX_LINK_TIME_S:g}] s")
     if job.home is not None and len(job.home.joints_deg) != 6:
         raise _error(file, "job.home.joints_deg", "expected 6 joint values [deg]")
     io = cell.tool.process_io

@@ -12,6 +12,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.collision.check import CollisionResult, check_trajectory
+from offline_prog.collision.motion import MotionChecker
 from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.job.approach import CartesianMove, cartesian_move
 from offline_prog.job.assemble import JobSamples, Piece
@@ -27,7 +28,6 @@ from offline_prog.job.seams import (
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs
 
-LINK_TIME_BUDGET_S = 10.0  # OMPL's time to find one link before the plan fails
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
 
 
@@ -172,6 +172,7 @@ def job_pieces(
     A link not found within its time budget keeps its failure (naming it) and the direct
     move in its place, so that the job's reports show where it collides."""
     motion = inputs.cell.motion
+    checker = MotionChecker(scene, clearance=motion.clearance, self_clearance=motion.self_clearance)
     pieces, links, q_now, previous = [], [], q_home, "home"
     for option in [*chosen, None]:
         target = option.q_in if option else q_home
@@ -180,7 +181,8 @@ def job_pieces(
         link = plan_link(
             scene, inputs.robot, q_now, target, clearance=motion.clearance,
             self_clearance=motion.self_clearance, seed=LINK_SEED + len(links),
-            time_budget_s=LINK_TIME_BUDGET_S, rate_hz=motion.sample_rate_hz, name=name,
+            time_budget_s=job_config(inputs.cell).link_time_s, rate_hz=motion.sample_rate_hz,
+            name=name, checker=checker,
         )  # fmt: skip
         if not link.ok:  # the direct move stands in: the check shows where it collides
             t, q, qd = timed_polyline(inputs.robot, np.array([q_now, target]),

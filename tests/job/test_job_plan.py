@@ -166,3 +166,52 @@ def test_trajectory_csv_has_the_one_seam_columns_then_segment(job):
         rows = slice(segment.start, segment.stop)
         exact = option.plan.trajectory.table()[: segment.stop - segment.start]
         np.testing.assert_allclose(table[rows, 1:18], exact[:, 1:18], rtol=1e-8, atol=1e-9)
+
+
+def test_the_demo_needs_the_sampling_planner_and_its_links_are_clear(job):
+    """The nozzle and its stand block the direct joint move of at least one link: OMPL
+    plans it; every link is certified clear at the cell's clearance."""
+    plan, _ = job
+    from offline_prog.collision.motion import MotionChecker
+    from offline_prog.robot.model import ROBOTS_DIR
+    from offline_prog.stages import build_scene, load_inputs
+
+    scene = build_scene(load_inputs(CELLS / f"{JOB}.yaml", ROBOTS_DIR))
+    checker = MotionChecker(scene, clearance=0.005, self_clearance=0.005)
+    planned = [link for link in plan.links if link.method == "planned"]
+    assert planned
+    for link in planned:
+        assert not checker.move_clear(link.waypoints[0], link.waypoints[-1])
+    for link in plan.links:
+        assert all(
+            checker.move_clear(a, b)
+            for a, b in zip(link.waypoints[:-1], link.waypoints[1:], strict=True)
+        )
+    assert plan.collisions.collision_free and plan.feasible
+
+
+def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    text = (
+        (CELLS / f"{JOB}.yaml")
+        .read_text()
+        .replace("job:\n  order: auto\n", "job:\n  order: auto\n  link_time_s: 0.0001\n")
+    )
+    cell = tmp_path / "job.yaml"
+    cell.write_text(text)
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert result.returncode == 1, result.stderr
+    line = result.stderr.strip().splitlines()[-1]
+    assert "link" in line and "no collision-free path found within" in line
+    report = json.loads((out / "report.json").read_text())
+    failed = [k for k in report["links"] if k["failure"]]
+    assert failed and failed[0]["name"] in line
+    assert (out / "trajectory.csv").is_file() and (out / "collisions.json").is_file()
+    assert not (out / "programs").exists()
