@@ -33,9 +33,8 @@ def default_formats(language: str | None) -> list[str]:
 
 
 def job_formats(language: str | None) -> list[str]:
-    """The formats a whole job is exported in today: the joint-trajectory files (the
-    controller programs of a job follow, issue 13)."""
-    return ["csv", "ros-json"]
+    """The formats a whole job is exported in: as for one seam (default_formats)."""
+    return default_formats(language)
 
 
 def export(
@@ -134,4 +133,14 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
         from offline_prog.export.joint_files import write_job_ros_json
 
         return [write_job_ros_json(data, out_dir)]
-    raise ValueError(f"{fmt}: the {fmt} program of a whole job is not written yet")
+    if fmt == "krl":
+        from offline_prog.export.krl_job import write_krl_job
+
+        return write_krl_job(data, out_dir, forced=not data.feasible, **options)
+    if fmt == "rapid":
+        from offline_prog.export.rapid_job import write_rapid_job
+
+        return write_rapid_job(data, out_dir, forced=not data.feasible, **options)
+    from offline_prog.export.urscript_job import write_urscript_job
+
+    return [write_urscript_job(data, out_dir, forced=not data.feasible, **options)]

@@ -1,0 +1,197 @@
+"""KUKA KRL for KSS 8: a whole job as ``name.src`` / ``.dat`` plus one ``name_<k>``
+module per seam, in the external-TCP style of :mod:`offline_prog.export.krl` (``$BASE``
+= the fixed tool T, ``$TOOL`` = the part P, ``$IPO_MODE=#TCP``, LIN points X_TP).
+
+Main program: home (``PTP`` to an ``E6AXIS``), then per seam: the link (``PTP`` through
+its ``E6AXIS`` waypoints, fine points), the approach (``LIN`` to the seam's first
+point), the seam's module (its LIN points, ``C_DIS``, speeds and point choice exactly as
+a one-seam program), the retract (``LIN``), and the last link home.
+
+Process I/O on the path (KSS 8 System Software, "TRIGGER WHEN PATH"): ``TRIGGER WHEN
+PATH = −d DELAY = 0 DO $OUT[n] = TRUE`` before a LIN switches d mm before that motion's
+end point. The output goes on on the approach (``lead_mm`` before the seam's start) and
+off on the seam's LIN that holds ``L − lead_mm``. The flow follows the TCP speed with
+``ANOUT ON $ANOUT[n] = f * $VEL_ACT + o MINIMUM = lo MAXIMUM = hi`` from the approach
+to the retract (``ANOUT OFF`` after it): ``$VEL_ACT`` in m/s and ``$ANOUT`` normalised
+to ±1 = ±10 V, so f = per_mps / 10, o = offset / 10 (the cell's values in volts).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
+from offline_prog.export.header import header_lines
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.job_steps import JointMove, LinearMove, Process, job_steps
+from offline_prog.export.krl import _load, _process_lines, _write
+from offline_prog.export.krl_header import krl_comments
+from offline_prog.export.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
+from offline_prog.robot.model import load_robot
+
+ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
+PTP_VEL_PERCENT, PTP_ACC_PERCENT = 100, 100  # links: the planned joint moves at full rate
+_ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
+
+
+def _axes(q: np.ndarray) -> str:
+    return ",".join(f"A{i + 1} {krl_num(v, 5)}" for i, v in enumerate(np.rad2deg(q)))
+
+
+def write_krl_job(
+    data: JobProgramData,
+    out_dir: Path,
+    *,
+    name: str = "offline_prog",
+    chord_tol_m: float = DEFAULT_CHORD_TOL_M,
+    angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
+    blend_m: float = 0.001,
+    forced: bool = False,
+) -> list[Path]:
+    """Write the job's KRL modules into out_dir; returns the files (main first)."""
+    robot = load_robot(data.robot)
+    if robot.family != "opw":
+        raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
+    if len(name) > 20 or not name.replace("_", "a").isalnum() or not name[0].isalpha():
+        raise ValueError(f"write_krl: name {name!r} is not a KRL name of <= 20 characters")
+    job, io = data.job, data.process_io
+    steps = job_steps(data, chord_tol_m, angle_tol_rad)
+    src, modules = [], []
+    decl = []  # main .dat declarations
+    q_home = steps[0].targets[0]
+    decl.append(f"DECL E6AXIS XHOME={{{_axes(q_home)}{_ZEROS}}}")
+    src += ["; Home", "PTP XHOME"]
+    n_link, seam_no = 0, 0
+    flow = io is not None and io.analog_output is not None
+    for step in steps:
+        if isinstance(step, JointMove):
+            n_link += 1
+            src.append(f"; Link {n_link}: PTP through {len(step.targets) - 1} joint target(s)")
+            for w, q in enumerate(step.targets[1:], start=1):
+                decl.append(f"DECL E6AXIS XL{n_link}_{w}={{{_axes(q)}{_ZEROS}}}")
+                src.append(f"PTP XL{n_link}_{w}")
+        elif isinstance(step, LinearMove):
+            seam_no += step.kind == "approach"
+            label = f"X{step.kind[0].upper()}{seam_no}"  # XA<k> approach end, XR<k> retract end
+            if step.kind == "approach":
+                src.append(f"; Approach of seam {step.seam}: LIN {step.length_m * 1e3:.1f} mm")
+                if flow:
+                    f, o = io.per_mps / ANALOG_FULL_SCALE_V, io.offset / ANALOG_FULL_SCALE_V
+                    lo, hi = io.min / ANALOG_FULL_SCALE_V, io.max / ANALOG_FULL_SCALE_V
+                    src.append(
+                        f"ANOUT ON $ANOUT[{io.analog_output}]={krl_num(f, 6)}*$VEL_ACT+"
+                        f"{krl_num(o, 6)} MINIMUM={krl_num(lo, 4)} MAXIMUM={krl_num(hi, 4)}"
+                    )
+            else:
+                src.append(f"; Retract of seam {step.seam}: LIN {step.length_m * 1e3:.1f} mm")
+            src.append(f"$VEL.CP={vel_cp(step.speed_m_s):.4f}")
+            src += [_trigger(s) for s in step.switches]
+            status, turn = status_turn(robot.params, step.q[None])
+            pose = krl_frame(np.linalg.inv(step.X_PT))
+            decl.append(f"DECL E6POS {label}={{{pose},S {status[0]},T {turn[0]}{_ZEROS}}}")
+            src.append(f"LIN {label}")
+            if step.kind == "retract" and flow:
+                src.append(f"ANOUT OFF $ANOUT[{io.analog_output}]")
+        else:
+            module = f"{name}_{seam_no}"
+            src.append(f"; Seam {step.seam}: {len(step.indices) - 1} LIN points in {module}")
+            src.append(f"{module}( )")
+            modules.append((module, step))
+    # The approach ends at the seam's first point: its E6POS is the seam's XP1.
+    head = _header(data, steps, forced)
+    ori = _ori_speed(job)
+    main_src = [
+        f"DEF {name}( )",
+        *(f"EXT {m}( )" for m, _ in modules),
+        ";FOLD INI", "BAS(#INITMOV,0)", ";ENDFOLD (INI)",
+        *([line for line in _load(job).splitlines() if line]),
+        "$BASE=FIXED_TOOL", "$TOOL=PART_ON_FLANGE", "$IPO_MODE=#TCP", "$ORI_TYPE=#VAR",
+        "$ADVANCE=3", f"BAS(#VEL_PTP,{PTP_VEL_PERCENT})", f"BAS(#ACC_PTP,{PTP_ACC_PERCENT})",
+        f"$VEL.ORI1={ori:.0f}", f"$VEL.ORI2={ori:.0f}", f"$APO.CDIS={blend_m * 1e3:.3f}",
+        *src, "END",
+    ]  # fmt: skip
+    main_dat = [
+        f"DEFDAT {name}",
+        "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
+        f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ job.X_EP)}}}",
+        f"DECL FRAME FIXED_TOOL={{{krl_frame(job.X_BT)}}}",
+        *decl,
+        "ENDDAT",
+    ]
+    files = _write(Path(out_dir), name, head + main_src, head + main_dat)
+    for module, step in modules:
+        files += _seam_module(Path(out_dir), module, step, robot, head)
+    return files
+
+
+def _trigger(switch) -> str:
+    state = "TRUE" if switch.state else "FALSE"
+    return (
+        f"TRIGGER WHEN PATH={krl_num(-switch.before_end_m * 1e3, 3)} DELAY=0 "
+        f"DO $OUT[{switch.output}]={state} PRIO=-1"
+    )
+
+
+def _seam_module(folder: Path, module: str, step: Process, robot, head) -> list[Path]:
+    """``module.src`` / ``.dat``: the seam's LIN points (the first is where the approach
+    ended), with the switches before the LIN whose motion holds them."""
+    data, idx = step.data, step.indices
+    names = [f"XP{k + 1}" for k in range(len(idx))]
+    status, turn = status_turn(robot.params, data.q[idx])
+    poses = np.linalg.inv(data.X_PF[idx])
+    decls = [
+        f"DECL E6POS {n}={{{krl_frame(X)},S {s},T {t}{_ZEROS}}}"
+        for n, X, s, t in zip(names, poses, status, turn, strict=True)
+    ]
+    lines = _process_lines(names, idx, data.tcp_speed, line_limit=10**9)[0]
+    by_move = {s.move: s for s in step.switches}
+    body = []
+    for line in lines:
+        if line.startswith("LIN "):
+            m = names.index(line.split()[1])
+            if m in by_move:
+                body.append(_trigger(by_move[m]))
+        body.append(line)
+    src = [f"DEF {module}( )", *body, "END"]
+    note = [f"; Seam {step.seam}: deviation <= {step.max_chord_m * 1e3:.4f} mm, "
+            f"{np.rad2deg(step.max_angle_rad):.4f} deg from the plan"]  # fmt: skip
+    dat = [f"DEFDAT {module}", "EXT BAS (BAS_COMMAND :IN,REAL :IN )", *decls[1:], "ENDDAT"]
+    # XP1 is the approach's end (main .dat XA<k>): the first LIN here goes to XP2.
+    return _write(folder, module, head + note + src, head + note + dat)
+
+
+def _ori_speed(job) -> float:
+    from scipy.spatial.transform import Rotation
+
+    from offline_prog.export.krl import ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S
+
+    R = job.X_BE[:, :3, :3]
+    dt = np.diff(job.t)
+    omega = Rotation.from_matrix(np.swapaxes(R[:-1], 1, 2) @ R[1:]).magnitude() / dt
+    return max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S)
+
+
+def _header(data: JobProgramData, steps, forced: bool) -> list[str]:
+    io = data.process_io
+    order = ", ".join(data.seam_names)
+    lines = [
+        f"Job: {len(data.seam_names)} seams in this order: {order}.",
+        "Style external_tcp: $BASE = fixed tool T in $WORLD (= base_link), $TOOL = part P "
+        "in $FLANGE, $IPO_MODE = #TCP; E6POS = P in T (X_TP); E6AXIS = q [deg].",
+        "Links: PTP to E6AXIS fine points (the planned, collision-checked joint moves); "
+        "approach and retract: LIN; seams: LIN with C_DIS, $VEL.CP = planned speed.",
+    ]
+    if io is not None and io.digital_output is not None:
+        lines.append(
+            f"Process output $OUT[{io.digital_output}]: TRIGGER WHEN PATH, on "
+            f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
+            f"{io.off_lead_m * 1e3:g} mm before its end."
+        )
+    if io is not None and io.analog_output is not None:
+        lines.append(
+            f"Flow $ANOUT[{io.analog_output}] = ({io.per_mps:g} V per m/s * $VEL_ACT + "
+            f"{io.offset:g} V) / 10 V, within [{io.min:g}, {io.max:g}] V, approach to retract."
+        )
+    return krl_comments(header_lines(data.job, conventions=lines, forced=forced))

@@ -1,0 +1,134 @@
+"""Universal Robots URScript: a whole job as one ``.script``.
+
+Links: ``movej`` through the link's joint waypoints (the planned, collision-checked
+straight joint moves; the controller's own timing at the joints' common limits). Each
+seam with its approach and retract: the planned joint trajectory resampled to the
+controller period and streamed with ``servoj``, as the one-seam writer does
+(:mod:`offline_prog.export.urscript`).
+
+Process I/O on the path: the digital output is switched (``set_standard_digital_out``)
+just before the first ``servoj`` whose sample has reached the switching position along
+the seam's path (the stream advances by v_TCP · 2 ms, 0.2 mm at 100 mm/s, per command);
+the flow follows the planned TCP speed with ``set_standard_analog_out(n, value / 10 V)``
+(URScript takes the output as a fraction of its 0–10 V range) whenever the value has
+changed by ``ANALOG_STEP_V``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline
+
+from offline_prog.atomic import write_atomic
+from offline_prog.export.header import header_lines
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.payload import payload
+from offline_prog.export.text import identifier, urscript_comment
+from offline_prog.export.urscript import (
+    E_SERIES_PERIOD_S,
+    NAME_MAX,
+    SERVOJ_GAIN,
+    SERVOJ_LOOKAHEAD_S,
+    _list,
+)
+from offline_prog.robot.model import load_robot
+
+ANALOG_RANGE_V = 10.0  # standard analog outputs: 0..10 V as 0..1
+ANALOG_STEP_V = 0.02  # write the flow when it changed by this much
+
+
+def write_urscript_job(
+    data: JobProgramData,
+    out_dir: Path,
+    *,
+    name: str = "offline_prog",
+    period_s: float = E_SERIES_PERIOD_S,
+    forced: bool = False,
+) -> Path:
+    """Write ``out_dir/<name>.script``; returns the file."""
+    identifier(name, max_chars=NAME_MAX, what="name")
+    robot = load_robot(data.robot)
+    job, io = data.job, data.process_io
+    v_link, a_link = float(robot.qd_max.min()), float(robot.qdd_max.min())
+    conventions = [
+        "Units: m, rad, s. Joint order: " + ", ".join(job.joint_names) + ".",
+        f"Job: {len(data.seam_names)} seams in this order: {', '.join(data.seam_names)}.",
+        f"Links: movej through joint waypoints (a={a_link:.3f}, v={v_link:.3f}); seams with "
+        f"approach and retract: servoj every {period_s} s (resampled from the plan).",
+    ]
+    if io is not None and io.digital_output is not None:
+        conventions.append(
+            f"Process output: standard digital out {io.digital_output}, on "
+            f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
+            f"{io.off_lead_m * 1e3:g} mm before its end (at the servoj sample that reaches it)."
+        )
+    if io is not None and io.analog_output is not None:
+        conventions.append(
+            f"Flow: standard analog out {io.analog_output} = ({io.offset:g} V + "
+            f"{io.per_mps:g} V per m/s x v_TCP) / 10 V, within [{io.min:g}, {io.max:g}] V."
+        )
+    lines = [f"# {urscript_comment(line)}" for line in header_lines(job, conventions=conventions,
+                                                                     forced=forced)]  # fmt: skip
+    lines.append(f"def {name}():")
+    if (load := payload(job.payload)) is not None:
+        mass, p_EC = load.total(job.X_EP)
+        lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
+    lines.append(f"  movej({_list(data.link_waypoints[0][0])}, a={a_link:.3f}, v={v_link:.3f})")
+    links = iter(data.link_waypoints)
+    segments = list(data.segments)
+    k = 0
+    while k < len(segments):
+        segment = segments[k]
+        if segment.kind == "link":
+            for q in next(links)[1:]:
+                lines.append(f"  movej({_list(q)}, a={a_link:.3f}, v={v_link:.3f})")
+            k += 1
+            continue
+        stop = k
+        while stop + 1 < len(segments) and segments[stop + 1].kind != "link":
+            stop += 1
+        rows = slice(segment.start, min(segments[stop].stop + 1, len(job.t)))
+        seam = data.seam_names.index(segment.seam)
+        lines += _stream(data, rows, seam, period_s)
+        k = stop + 1
+    lines += ["  stopj(2.0)", "end", f"{name}()"]
+    file = Path(out_dir) / f"{name}.script"
+    write_atomic(file, "\n".join(lines) + "\n")
+    return file
+
+
+def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> list[str]:
+    """servoj lines over the job's rows of one seam (approach to retract), with I/O."""
+    job, io = data.job, data.process_io
+    t = job.t[rows] - job.t[rows][0]
+    spline = CubicHermiteSpline(t, job.q[rows], job.qd[rows], axis=0)
+    grid = np.arange(0.0, t[-1], period_s)
+    grid = np.append(grid, t[-1]) if t[-1] - grid[-1] > 1e-9 else grid
+    q = spline(grid)
+    position = np.interp(grid, t, job.sigma[rows])  # along the seam's path [m]
+    switches = {}
+    if (where := data.switch_positions(seam)) is not None:
+        for value, state in zip(where, (True, False), strict=True):
+            i = int(np.searchsorted(position, value - 1e-12))
+            switches[min(i, len(grid) - 1)] = state
+    flow = None
+    if io is not None and io.analog_output is not None and data.analog is not None:
+        flow = np.interp(grid, t, data.analog[rows])
+    lines, last_flow = [], None
+    for i in range(1, len(grid)):
+        if i in switches:
+            state = "True" if switches[i] else "False"
+            lines.append(f"  set_standard_digital_out({io.digital_output}, {state})")
+        if flow is not None and (last_flow is None or abs(flow[i] - last_flow) >= ANALOG_STEP_V):
+            last_flow = flow[i]
+            lines.append(
+                f"  set_standard_analog_out({io.analog_output}, "
+                f"{np.clip(flow[i] / ANALOG_RANGE_V, 0.0, 1.0):.4f})"
+            )
+        lines.append(
+            f"  servoj({_list(q[i])}, t={period_s}, lookahead_time={SERVOJ_LOOKAHEAD_S}, "
+            f"gain={SERVOJ_GAIN})"
+        )
+    return lines

@@ -1,0 +1,278 @@
+"""Whole-job programs read back with independent parsers: KRL (KR 16-2 demo job), RAPID
+(IRB 2400 weld seam as a one-seam job) and URScript (UR10e tape as a one-seam job).
+
+Each asserts what a cell engineer checks on the controller: the links go through the
+planned joint targets, approach and retract have the asked lengths, and the process
+output switches within ±1 mm of the asked positions along the path (on ``lead_mm``
+before each seam's start, off ``lead_mm`` before its end), reconstructed from the
+program's own statements and poses."""
+
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from krl_lint import assert_krllint_clean
+from scipy.spatial.transform import Rotation
+
+from offline_prog.config.cell import load_cell
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.plan import plan_job
+from offline_prog.results.job_folder import write_job_outputs
+
+from conftest import CELLS
+
+IO_TOL_M = 1e-3  # the issue: within ±1 mm
+LENGTH_TOL_M = 0.01e-3  # approach / retract lengths
+JOINT_TOL_DEG = 1e-3
+IO = (
+    "tool:\n  process_io:\n    on:  {digital_output: 2, lead_mm: 3}\n"
+    "    off: {digital_output: 2, lead_mm: 4}\n"
+    "    flow: {analog_output: 1, per_mps: 30.0, offset: 1.0, min: 0.0, max: 10.0}\n"
+)
+
+
+def one_seam_job(tmp_path, name: str, home: str) -> object:
+    text = (CELLS / f"{name}.yaml").read_text()
+    text = text.replace("motion:", f"job: {{order: given{home}}}\nmotion:", 1)
+    text = text.replace("tool:\n", IO, 1)
+    file = tmp_path / f"{name}_job.yaml"
+    file.write_text(text)
+    return file
+
+
+@pytest.fixture(scope="module")
+def folders(planned_job, tmp_path_factory):
+    """robot language ↦ (JobProgramData, programs folder, cell)."""
+    out = {"krl": planned_job("seal_job_kr16")[1]}
+    work = tmp_path_factory.mktemp("jobs")
+    shutil.copytree(CELLS / "data", work / "data")  # the cells' path and mesh files
+    for language, name, home in (
+        ("rapid", "weld_seam_irb2400", ", home: {joints_deg: [0, -20, 20, 0, 60, 0]}"),
+        ("urscript", "tape_cylinder_ur10e", ""),
+    ):
+        cell = one_seam_job(work, name, home)
+        job = plan_job(cell)
+        assert job.feasible, job.failure
+        out[language] = work / language
+        write_job_outputs(job, out[language])
+    return {k: (JobProgramData.load(f), f / "programs", f) for k, f in out.items()}
+
+
+def asked(data: JobProgramData, k: int) -> tuple[float, float]:
+    """(on, off) positions along seam k's path [m] the cell asks for."""
+    return data.switch_positions(k)
+
+
+# --- KRL --------------------------------------------------------------------------------
+
+KRL_DECL = re.compile(r"^DECL (E6POS|E6AXIS) (\w+)=\{(.*)\}$")
+
+
+def krl_fields(text: str) -> dict[str, float]:
+    return {k: float(v) for k, v in (item.split() for item in text.split(",")) if k != "S"
+            and k != "T"}  # fmt: skip
+
+
+def krl_tool_in_part(fields) -> np.ndarray:
+    """p_PT [m]: the E6POS is P in T (X_TP, KUKA Z-Y'-X'' angles); the tool in P is its
+    inverse's translation."""
+    X = np.eye(4)
+    X[:3, :3] = Rotation.from_euler("ZYX", [fields["A"], fields["B"], fields["C"]],
+                                    degrees=True).as_matrix()  # fmt: skip
+    X[:3, 3] = np.array([fields["X"], fields["Y"], fields["Z"]]) * 1e-3
+    return np.linalg.inv(X)[:3, 3]
+
+
+def krl_run(folder: Path, name: str = "offline_prog"):
+    """(statements in execution order (module, line), declarations by module)."""
+    decls, run = {}, []
+
+    def read(module):
+        decls[module] = {
+            m[2]: (m[1], m[3])
+            for line in (folder / f"{module}.dat").read_text().splitlines()
+            if (m := KRL_DECL.match(line))
+        }
+        for line in (folder / f"{module}.src").read_text().splitlines():
+            if line.startswith(";") or not line.strip():
+                continue
+            if re.fullmatch(rf"{name}_\d+\( \)", line):
+                read(line.split("(")[0])
+            else:
+                run.append((module, line))
+
+    read(name)
+    return run, decls
+
+
+def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
+    data, folder, _ = folders["krl"]
+    run, decls = krl_run(folder)
+    main = decls["offline_prog"]
+    specs = {s.name: s for s in load_cell(CELLS / "seal_job_kr16.yaml").seams}
+    # Links: every PTP target is the plan's waypoint, in order (home first).
+    ptp = [main[line.split()[1]][1] for _, line in run if line.startswith("PTP ")]
+    axes = np.array([[v for k, v in krl_fields(f).items() if k.startswith("A")] for f in ptp])
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(axes, np.rad2deg(planned), atol=JOINT_TOL_DEG)
+    # Walk the statements: the tool's point on the part, its path position per seam.
+    q_link, pending, here, position, k, switched = None, None, None, 0.0, -1, {}
+    for module, line in run:
+        if line.startswith("PTP "):
+            q_link = np.deg2rad(axes[[f for f in ptp].index(main[line.split()[1]][1])])
+        elif line.startswith("TRIGGER"):
+            pending = (float(re.search(r"PATH=(-?[\d.]+)", line)[1]) * 1e-3, "TRUE" in line)
+        elif line.startswith("LIN "):
+            name = line.split()[1]
+            p = krl_tool_in_part(krl_fields(decls[module][name][1]))
+            if name.startswith("XA"):  # the approach ends at the seam's start: position 0
+                k += 1
+                length = np.linalg.norm(p - tool_in_part_from_joints(data, q_link))
+                spec = specs[data.seam_names[k]].approach
+                assert length == pytest.approx(spec.distance_mm * 1e-3, abs=LENGTH_TOL_M)
+                position = 0.0
+            else:
+                step = np.linalg.norm(p - here)
+                if name.startswith("XR"):
+                    spec = specs[data.seam_names[k]].retract
+                    assert step == pytest.approx(spec.distance_mm * 1e-3, abs=LENGTH_TOL_M)
+                position += step
+            here = p
+            if pending is not None:  # PATH = -d: d before this motion's end point
+                switched.setdefault(k, {})[pending[1]] = position + pending[0]
+                pending = None
+    assert sorted(switched) == list(range(len(data.seam_names)))
+    for k in switched:
+        on, off = asked(data, k)
+        assert switched[k][True] == pytest.approx(on, abs=IO_TOL_M)
+        assert switched[k][False] == pytest.approx(off, abs=IO_TOL_M)
+    assert_krllint_clean(folder, tmp_path)
+
+
+def tool_in_part_from_joints(data: JobProgramData, q: np.ndarray) -> np.ndarray:
+    """p_PT [m] at joints q: X_PT = X_EP⁻¹ · X_BE(q)⁻¹ · X_BT (forward kinematics)."""
+    from offline_prog.robot.model import load_robot
+
+    X_BE = load_robot(data.robot).forward(q[None])[0]
+    return (np.linalg.inv(data.job.X_EP) @ np.linalg.inv(X_BE) @ data.job.X_BT)[:3, 3]
+
+
+# --- RAPID ------------------------------------------------------------------------------
+
+ROBTARGET = re.compile(r"robtarget (\w+) := \[\[([^\]]*)\],\[([^\]]*)\]")
+JOINTTARGET = re.compile(r"jointtarget (\w+) := \[\[([^\]]*)\]")
+MOVE = re.compile(r"^(MoveL|TriggL|MoveAbsJ) (\w+)")
+
+
+def rapid_run(module_text: str):
+    """(statements in execution order, robtarget positions [m], jointtargets [deg])."""
+    points = {
+        m[1]: np.array(m[2].split(","), float) * 1e-3 for m in ROBTARGET.finditer(module_text)
+    }
+    joints = {m[1]: np.array(m[2].split(","), float) for m in JOINTTARGET.finditer(module_text)}
+    procs, current = {}, None
+    for raw in module_text.splitlines():
+        line = raw.strip()
+        if line.startswith("PROC "):
+            current = procs.setdefault(line.split()[1].split("(")[0], [])
+        elif line.startswith("ENDPROC"):
+            current = None
+        elif current is not None:
+            current.append(line)
+    run = []
+    for line in procs["main"]:
+        call = line.split(";")[0]
+        run += procs.get(call, [line])
+    return run, points, joints
+
+
+def test_rapid_job_links_approach_retract_and_io(folders):
+    from offline_prog.export.abb import abb_axes_deg
+
+    data, folder, _ = folders["rapid"]
+    text = (folder / "OfflineProg.mod").read_text()
+    run, points, joints = rapid_run(text)
+    targets = [MOVE.match(line)[2] for line in run if line.startswith("MoveAbsJ")]
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(
+        [joints[t] for t in targets], abb_axes_deg(np.array(planned), j23_coupled=True),
+        atol=JOINT_TOL_DEG,
+    )  # fmt: skip
+    triggs, here, position, switched, q_link = {}, None, 0.0, {}, None
+    for line in run:
+        if line.startswith("TriggIO"):
+            name, rest = line.split()[1].rstrip(","), line.split(",", 1)[1]
+            triggs[name] = (float(rest.split("\\")[0]) * 1e-3, rest.strip().endswith(", 1;"))
+            continue
+        m = MOVE.match(line)
+        if m is None:
+            continue
+        if m[1] == "MoveAbsJ":
+            q_link = planned[targets.index(m[2])]
+            continue
+        p = points[m[2]]
+        if m[2] == "pA1":
+            start = tool_in_part_from_joints(data, q_link)
+            assert np.linalg.norm(p - start) == pytest.approx(0.05, abs=LENGTH_TOL_M)
+            position = 0.0
+        else:
+            step = np.linalg.norm(p - here)
+            if m[2] == "pR1":
+                assert step == pytest.approx(0.05, abs=LENGTH_TOL_M)
+            position += step
+        here = p
+        if m[1] == "TriggL":
+            for name in re.findall(r"\b(tOn|tOff)\b", line):
+                distance, state = triggs[name]
+                switched[state] = position - distance
+    on, off = asked(data, 0)
+    assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
+    assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
+    assert "TriggSpeed tFlow" in text and f"ao{data.process_io.analog_output}" in text
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
+def test_rapid_job_passes_rapidchecker(folders):
+    rapidchecker = pytest.importorskip("rapidchecker.cli", reason="rapidchecker not installed")
+    _, folder, _ = folders["rapid"]
+    assert [str(e) for e in rapidchecker.check_file((folder / "OfflineProg.mod").read_text())] == []
+
+
+# --- URScript ---------------------------------------------------------------------------
+
+
+def test_urscript_job_links_and_io(folders):
+    data, folder, _ = folders["urscript"]
+    lines = (folder / "offline_prog.script").read_text().splitlines()
+    q_of = lambda line: np.array(re.search(r"\(\[([^\]]*)\]", line)[1].split(","), float)  # noqa: E731
+    movej = [q_of(line) for line in lines if line.strip().startswith("movej(")]
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(movej, planned, atol=1e-7)
+    # The path position of the tool at each servoj: along the approach from its start,
+    # then along the seam's planned points (σ of the nearest dense sample).
+    seam = data.seams[0]
+    p_seam = seam.X_PF[:, :3, 3]
+    switched, last_q = {}, None
+    pending = None
+    for line in lines:
+        line = line.strip()
+        if line.startswith("set_standard_digital_out"):
+            pending = "True" in line
+        elif line.startswith("servoj("):
+            last_q = q_of(line)
+            if pending is not None:
+                p = tool_in_part_from_joints(data, last_q)
+                gap = np.linalg.norm(p_seam - p, axis=1)
+                i = int(np.argmin(gap))
+                if i == 0 and gap[0] > 1e-4:  # before the seam: on the approach line
+                    position = -gap[0]
+                else:
+                    position = seam.sigma[i] + (gap[i] if i == len(gap) - 1 else 0.0)
+                switched[pending] = position
+                pending = None
+    on, off = asked(data, 0)
+    assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
+    assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
+    assert any(line.strip().startswith("set_standard_analog_out") for line in lines)
