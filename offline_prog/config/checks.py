@@ -188,6 +188,38 @@ def _check_job(file: Path, cell: Cell) -> None:
             raise _error(file, "tool.process_io.flow", "needs min < max")
 
 
+# The process outputs each controller family can have (its own numbering):
+# KUKA KSS 8: $OUT[1..4096], $ANOUT[1..32]; UR e-Series: standard digital out 0..7,
+# standard analog out 0..1; ABB: signals named do<n> / ao<n> in the I/O configuration.
+OUTPUT_RANGES = {
+    "krl": {"digital_output": (1, 4096), "analog_output": (1, 32)},
+    "urscript": {"digital_output": (0, 7), "analog_output": (0, 1)},
+    "rapid": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
+}
+
+
+def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
+    """The process output numbers exist on the robot's controller (``OUTPUT_RANGES``)."""
+    io = cell.tool.process_io
+    if io is None:
+        return
+    ranges = OUTPUT_RANGES.get(language, {"digital_output": (0, 9999), "analog_output": (0, 9999)})
+    for name, kind in (("on", "digital_output"), ("off", "digital_output"),
+                       ("flow", "analog_output")):  # fmt: skip
+        part = getattr(io, name)
+        if part is None:
+            continue
+        low, high = ranges[kind]
+        number = getattr(part, kind)
+        if not low <= number <= high:
+            raise _error(
+                file,
+                f"tool.process_io.{name}.{kind}",
+                f"{number} is not an output of the robot's {language or 'controller'} "
+                f"controller (use {low}..{high})",
+            )
+
+
 def _check_payload(file: Path, cell: Cell) -> None:
     """Masses within [0, MAX_PAYLOAD_KG], centres of mass 3 numbers within reach."""
     loads = [("part", cell.part.mass_kg, cell.part.center_of_mass_mm)]

@@ -60,18 +60,29 @@ def run(tmp_path, text):
             "tool.process_io.on.lead_mm",
             "outside its",
         ),
-        (
-            ("off: {digital_output: 1, lead_mm: 2}", "off: {digital_output: 2, lead_mm: 2}"),
-            "tool.process_io.off.digital_output",
-            "must equal",
-        ),
         (("seams:", "path: {units: mm, points: a.csv}\nseams:"), "seams", "exactly one of"),
+        (
+            ("digital_output: 1,", "digital_output: 5000,"),  # on and off
+            "tool.process_io.on.digital_output",
+            "not an output of the robot's krl controller (use 1..4096)",
+        ),
+        (
+            ("digital_output: 1, lead_mm: 2}", "digital_output: 2, lead_mm: 2}"),
+            "tool.process_io.off.digital_output",
+            "must equal on's",
+        ),
+        (
+            ("flow: {analog_output: 1,", "flow: {analog_output: 40,"),
+            "tool.process_io.flow.analog_output",
+            "use 1..32",
+        ),
+        (("order: auto", "order: auto\n  link_time_s: 0"), "job.link_time_s", "must be within"),
     ],
 )
 def test_bad_job_input_is_one_line_exit_2_nothing_written(tmp_path, change, key, reason):
     old, new = change
     assert old in JOB
-    result, out = run(tmp_path, JOB.replace(old, new, 1))
+    result, out = run(tmp_path, JOB.replace(old, new))
     lines = result.stderr.strip().splitlines()
     assert result.returncode == 2, result.stderr
     assert len(lines) == 1 and "Traceback" not in result.stderr
