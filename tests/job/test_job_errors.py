@@ -2,27 +2,22 @@
 nothing written (the issue's list: duplicate seam names, home outside the limits or in
 collision, a negative approach distance, I/O that cannot be placed)."""
 
-import subprocess
-import sys
-
 import pytest
+
+from offline_prog.cli import main
 
 from conftest import CELLS
 
 JOB = (CELLS / "seal_job_kr16.yaml").read_text()
 
 
-def run(tmp_path, text):
+def run(tmp_path, text, capsys):
+    """The CLI in this process (test_cli.py runs it as a subprocess)."""
     cell = tmp_path / "job.yaml"
     cell.write_text(text)
     out = tmp_path / "out"
-    result = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    return result, out
+    code = main(["plan", str(cell), "--out", str(out)])
+    return code, capsys.readouterr().err, out
 
 
 @pytest.mark.parametrize(
@@ -79,12 +74,12 @@ def run(tmp_path, text):
         (("order: auto", "order: auto\n  link_time_s: 0"), "job.link_time_s", "must be within"),
     ],
 )
-def test_bad_job_input_is_one_line_exit_2_nothing_written(tmp_path, change, key, reason):
+def test_bad_job_input_is_one_line_exit_2_nothing_written(tmp_path, capsys, change, key, reason):
     old, new = change
     assert old in JOB
-    result, out = run(tmp_path, JOB.replace(old, new))
-    lines = result.stderr.strip().splitlines()
-    assert result.returncode == 2, result.stderr
-    assert len(lines) == 1 and "Traceback" not in result.stderr
+    code, stderr, out = run(tmp_path, JOB.replace(old, new), capsys)
+    lines = stderr.strip().splitlines()
+    assert code == 2, stderr
+    assert len(lines) == 1 and "Traceback" not in stderr
     assert f": {key}: " in lines[0] and reason in lines[0], lines[0]
     assert not out.exists()

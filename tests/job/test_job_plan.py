@@ -190,10 +190,10 @@ def test_the_demo_needs_the_sampling_planner_and_its_links_are_clear(job):
     assert plan.collisions.collision_free and plan.feasible
 
 
-def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp_path):
+def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp_path, capsys):
     import json
-    import subprocess
-    import sys
+
+    from offline_prog.cli import main
 
     text = (
         (CELLS / f"{JOB}.yaml")
@@ -203,12 +203,10 @@ def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp
     cell = tmp_path / "job.yaml"
     cell.write_text(text)
     out = tmp_path / "out"
-    result = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)],
-        capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert result.returncode == 1, result.stderr
-    line = result.stderr.strip().splitlines()[-1]
+    code = main(["plan", str(cell), "--out", str(out)])
+    stderr = capsys.readouterr().err
+    assert code == 1, stderr
+    line = stderr.strip().splitlines()[-1]
     assert "link" in line and "no collision-free path found within" in line
     report = json.loads((out / "report.json").read_text())
     failed = [k for k in report["links"] if k["failure"]]
