@@ -228,7 +228,8 @@ class JobPlan:
         if failed is not None:
             return failed.failure.reason
         if self.collisions.collision_free:
-            return next((p.failure for p in self.seams if not p.feasible), "")
+            failed = (o for o in self.chosen if not o.plan.feasible)
+            return next((f"seam {o.name}: {o.plan.failure}" for o in failed), "")
         at = self.collisions.first_contact or self.collisions.closest
         where = "" if at is None else f"{self.samples.segment_at(at.t_s).label}: "
         return where + self.collisions.message
