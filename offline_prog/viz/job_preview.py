@@ -15,7 +15,15 @@ import numpy as np
 from offline_prog.atomic import write_atomic
 from offline_prog.config.cell import transform
 from offline_prog.scene.drake_cell import build_cell_model
-from offline_prog.viz.preview import FLANGE_COLOR, PATH_COLOR, PREVIEW_FPS, draw_cell
+from offline_prog.viz.preview import (
+    FLANGE_COLOR,
+    PATH_COLOR,
+    PREVIEW_FPS,
+    body_poses,
+    camera,
+    draw_cell,
+    part_node,
+)
 from offline_prog.viz.static_scene import StaticScene
 
 ACTIVE_COLOR = (1.0, 0.45, 0.0, 1.0)  # the seam being processed
@@ -26,15 +34,9 @@ ACTIVE_LIFT_M = 5e-4  # the highlight sits just off the surface, in front of the
 def job_preview_scene(job) -> tuple[StaticScene, dict]:
     """The job as MeshCat commands; returns the scene and {"frames", "seams"}."""
     drake = build_cell_model(job.cell, job.cell_file, job.robot)
-    plant = drake.plant
-    context = plant.CreateDefaultContext()
     scene = StaticScene()
     bodies = draw_cell(scene, drake)
-    part = next((p for p, b in bodies.items() if b.name() == "part"), None)
-    if part is None:
-        body = plant.GetBodyByName("part")
-        part = f"/drake/{plant.GetModelInstanceName(body.model_instance())}/part"
-        bodies[part] = body
+    part = part_node(drake.plant, bodies)
     times = np.append(np.arange(0.0, job.samples.t[-1], 1.0 / PREVIEW_FPS), job.samples.t[-1])
     scales = {}
     for option in job.chosen:
@@ -55,18 +57,10 @@ def job_preview_scene(job) -> tuple[StaticScene, dict]:
         rows = slice(segment.start, min(segment.stop + 1, len(p_IE)))
         color = LINK_COLOR if segment.kind == "link" else FLANGE_COLOR
         scene.set_lines(f"/offline_prog/flange_path/{k}_{segment.kind}", p_IE[rows], color)
-    base = transform(job.cell.robot.X_IB).translation()
-    tool = transform(job.cell.tool.X_IT).translation()
-    target = 0.5 * (base + tool) + np.array([0.0, 0.0, 0.2])
-    reach = max(1.0, float(np.linalg.norm(tool - base)))
-    scene.set_camera(target + reach * np.array([1.2, 1.6, 0.9]), target)
+    scene.set_camera(*camera(transform(job.cell.robot.X_IB).translation(),
+                             transform(job.cell.tool.X_IT).translation()))  # fmt: skip
     q = np.column_stack([np.interp(times, job.samples.t, job.samples.q[:, j]) for j in range(6)])
-    paths = list(bodies)
-    poses = np.empty((len(paths), len(times), 4, 4))
-    for i, q_i in enumerate(q):
-        plant.SetPositions(context, drake.robot, q_i)
-        for k, path in enumerate(paths):
-            poses[k, i] = plant.EvalBodyPoseInWorld(context, bodies[path]).GetAsMatrix4()
+    paths, poses = body_poses(drake, bodies, q)
     scene.set_animation(paths, times, poses, PREVIEW_FPS, scales=scales)
     frames = int(np.floor(times[-1] * PREVIEW_FPS + 1e-9)) + 1
     return scene, {"frames": frames, "seams": len(job.chosen)}

@@ -80,12 +80,8 @@ def overlays(plan, near_collision: np.ndarray | None) -> Overlays:
         index = np.flatnonzero(mask)
         index = index[:: max(1, len(index) // MAX_MARKERS)]
         markers.append((name, color, p_IE[index]))
-    base = transform(plan.cell.robot.X_IB).translation()
-    tool = plan.flange.X_IT.translation()
-    target = 0.5 * (base + tool) + np.array([0.0, 0.0, 0.2])
-    reach = max(1.0, float(np.linalg.norm(tool - base)))
-    camera = (target + reach * np.array([1.2, 1.6, 0.9]), target)  # front-left, above
-    return Overlays(dense, triads, p_IE, markers, camera)
+    view = camera(transform(plan.cell.robot.X_IB).translation(), plan.flange.X_IT.translation())
+    return Overlays(dense, triads, p_IE, markers, view)
 
 
 def near_collision_mask(plan) -> np.ndarray:
@@ -181,6 +177,37 @@ def draw_cell(scene: StaticScene, drake) -> dict[str, object]:
     return bodies
 
 
+def part_node(plant, bodies: dict) -> str:
+    """The part's node path (added to ``bodies`` when the part has no geometry: its
+    frame still carries the paths drawn on it)."""
+    part = next((p for p, b in bodies.items() if b.name() == "part"), None)
+    if part is None:
+        body = plant.GetBodyByName("part")
+        part = f"/drake/{plant.GetModelInstanceName(body.model_instance())}/part"
+        bodies[part] = body
+    return part
+
+
+def body_poses(drake, bodies: dict, q: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """(node paths, (n_nodes, F, 4, 4) poses in I) of the drawn bodies at joints q (F, 6)."""
+    plant = drake.plant
+    context = plant.CreateDefaultContext()
+    paths = list(bodies)
+    poses = np.empty((len(paths), len(q), 4, 4))
+    for i, q_i in enumerate(q):
+        plant.SetPositions(context, drake.robot, q_i)
+        for k, path in enumerate(paths):
+            poses[k, i] = plant.EvalBodyPoseInWorld(context, bodies[path]).GetAsMatrix4()
+    return paths, poses
+
+
+def camera(p_IB: np.ndarray, p_IT: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(p_I_camera, p_I_target) [m]: front-left and above the robot base B and tool T."""
+    target = 0.5 * (p_IB + p_IT) + np.array([0.0, 0.0, 0.2])
+    reach = max(1.0, float(np.linalg.norm(p_IT - p_IB)))
+    return target + reach * np.array([1.2, 1.6, 0.9]), target
+
+
 def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[StaticScene, dict]:
     """The plan as MeshCat commands: cell, overlays, camera and the animation.
 
@@ -188,16 +215,10 @@ def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[St
         The scene and {"frames", "markers", "frames_per_second"}.
     """
     drake = build_cell_model(plan.cell, plan.cell_file, plan.robot)
-    plant = drake.plant
-    context = plant.CreateDefaultContext()
     scene = StaticScene()
     bodies = draw_cell(scene, drake)
     extra = overlays(plan, near_collision)
-    part = next((p for p, b in bodies.items() if b.name() == "part"), None)
-    if part is None:  # a part without geometry: its frame still carries the path
-        body = plant.GetBodyByName("part")
-        part = f"/drake/{plant.GetModelInstanceName(body.model_instance())}/part"
-        bodies[part] = body
+    part = part_node(drake.plant, bodies)
     scene.set_lines(f"{part}/processing_path", extra.p_P_path, PATH_COLOR)
     for axis, segments in enumerate(extra.triads):
         scene.set_lines(f"{part}/frames/{'xyz'[axis]}", segments.reshape(-1, 3), AXIS_COLORS[axis],
@@ -212,13 +233,7 @@ def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[St
             count += 1
     scene.set_camera(*extra.camera)
     times = _animation_times(plan)
-    q = _joints_at(plan, times)
-    paths = list(bodies)
-    poses = np.empty((len(paths), len(times), 4, 4))
-    for i, q_i in enumerate(q):
-        plant.SetPositions(context, drake.robot, q_i)
-        for k, path in enumerate(paths):
-            poses[k, i] = plant.EvalBodyPoseInWorld(context, bodies[path]).GetAsMatrix4()
+    paths, poses = body_poses(drake, bodies, _joints_at(plan, times))
     scene.set_animation(paths, times, poses, PREVIEW_FPS)
     frames = int(np.floor(times[-1] * PREVIEW_FPS + 1e-9)) + 1
     return scene, {"frames": frames, "markers": count, "frames_per_second": PREVIEW_FPS}
