@@ -22,11 +22,15 @@ from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
 from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
 from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessIo
-from offline_prog.export.payload import payload_record
 from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.job.seams import job_config
 from offline_prog.plan import JobPlan
-from offline_prog.results.plan_folder import InParallel, check_out_dir, program_data
+from offline_prog.results.plan_folder import (
+    InParallel,
+    check_out_dir,
+    program_data,
+    program_names,
+)
 from offline_prog.results.report import collision_summary, report
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
@@ -205,18 +209,11 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
     X_BE = robot.forward(s.q)
     X_PT = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE @ X_EP)  # the tool T in P, every row
     rows = ProgramData(
-        cell_name=cell.name or job.cell_file.stem,
-        cell_file=str(job.cell_file),
-        robot=robot.name,
-        tool=cell.tool.name,
-        part=cell.part.name,
-        process_speed_m_s=cell.motion.speed,
+        **program_names(cell, job.cell_file, robot, summary),
         speed_reference=cell.motion.speed_reference,
         cycle_time_s=float(s.t[-1]),
         feasible=job.feasible,
         failure=job.failure,
-        joint_names=tuple(robot.joint_names),
-        generated=summary["generated"],
         t=s.t,
         sigma=s.path_m,
         q=s.q,
@@ -226,12 +223,6 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         X_BT=X_BT,
         X_EP=X_EP,
         tcp_speed=job.tcp_speed,
-        q_lower=robot.q_lower,
-        q_upper=robot.q_upper,
-        qd_max=robot.qd_max,
-        j23_coupled=robot.j23_coupled,
-        language=robot.language,
-        payload=payload_record(cell),
     )
     io = cell.tool.process_io
     process_io = None

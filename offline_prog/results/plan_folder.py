@@ -85,6 +85,27 @@ def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
     return X
 
 
+def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
+    """The ProgramData fields that name the cell, robot, tool and part and carry the
+    robot's limits and the payload (the same for a seam and a job)."""
+    return {
+        "cell_name": cell.name or Path(cell_file).stem,
+        "cell_file": str(cell_file),
+        "robot": robot.name,
+        "tool": cell.tool.name,
+        "part": cell.part.name,
+        "process_speed_m_s": cell.motion.speed,
+        "joint_names": tuple(robot.joint_names),
+        "generated": summary["generated"],
+        "q_lower": robot.q_lower,
+        "q_upper": robot.q_upper,
+        "qd_max": robot.qd_max,
+        "j23_coupled": robot.j23_coupled,
+        "language": robot.language,
+        "payload": payload_record(cell),
+    }
+
+
 def program_data(plan: Plan, summary: dict) -> ProgramData:
     """The plan as the program writers need it (poses in the robot base B)."""
     cell, joints, traj = plan.cell, plan.joints, plan.trajectory
@@ -101,18 +122,11 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
     X_BE_dense = X_BI @ _poses(dense.p_IE, dense.R_IE)
     X_PF_dense = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE_dense @ X_EP)
     return ProgramData(
-        cell_name=cell.name or plan.cell_file.stem,
-        cell_file=str(plan.cell_file),
-        robot=plan.robot.name,
-        tool=cell.tool.name,
-        part=cell.part.name,
-        process_speed_m_s=cell.motion.speed,
+        **program_names(cell, plan.cell_file, plan.robot, summary),
         speed_reference=traj.reference,
         cycle_time_s=traj.duration,
         feasible=plan.feasible,
         failure=plan.failure,
-        joint_names=tuple(plan.robot.joint_names),
-        generated=summary["generated"],
         t=traj.t,
         sigma=traj.s,
         q=joints.q,
@@ -122,12 +136,6 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         X_BT=X_BT,
         X_EP=X_EP,
         tcp_speed=traj.tcp_speed,
-        q_lower=plan.robot.q_lower,
-        q_upper=plan.robot.q_upper,
-        qd_max=plan.robot.qd_max,
-        j23_coupled=plan.robot.j23_coupled,
-        language=plan.robot.language,
-        payload=payload_record(cell),
         sigma_dense=s_dense,
         X_PF_dense=X_PF_dense,
     )
