@@ -26,8 +26,9 @@ from offline_prog.job.seams import (
     seam_key,
 )
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.stages import Inputs
+from offline_prog.stages import Inputs, attempt_motion
 
+MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
 
 
@@ -53,7 +54,8 @@ class SeamOption:
 
     @property
     def label(self) -> str:
-        return f"{self.name} {'reverse' if self.reverse else 'forward'}"
+        direction = "reverse" if self.reverse else "forward"
+        return f"{self.name} {direction} branch {self.plan.joints.branch}"
 
 
 def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
@@ -110,8 +112,14 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
                     plan = plan_seam(seam_in, scene)
-                    approach, retract = _ends(seam_in, plan, seam)
-                found.append(SeamOption(k, seam.name, reverse, plan, approach, retract))
+                    for variant in [plan, *_other_branches(seam_in, scene, plan)]:
+                        try:
+                            approach, retract = _ends(seam_in, variant, seam)
+                        except PlanFailedError:
+                            if variant is plan:
+                                raise
+                            continue  # this branch cannot approach or retract
+                        found.append(SeamOption(k, seam.name, reverse, variant, approach, retract))
             except PlanFailedError as error:
                 errors.append(error)
         if not found:
@@ -121,6 +129,38 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
             )
         options.append(found)
     return options
+
+
+def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
+    """The seam on up to MAX_OTHER_BRANCHES other IK branches that follow the whole path
+    within the limits (largest margin first), each collision-free at the clearances, as
+    plans beside the chosen one: the seam order may pick them (issue 13: the branch is
+    part of the choice). Not for a plan that needed collision avoidance."""
+    if plan.avoidance is not None or not plan.feasible:
+        return []
+    joints = plan.joints
+    others = sorted(
+        (b for b in joints.branches if b.feasible and b.branch != joints.branch),
+        key=lambda b: -b.margin_rad,
+    )[:MAX_OTHER_BRANCHES]
+    variants = []
+    for other in others:
+        try:
+            attempt = attempt_motion(inputs, scene, plan.tool_rotation_rad, plan.flange,
+                                     other.branch)  # fmt: skip
+        except PlanFailedError:
+            continue
+        if attempt.collisions.collision_free:
+            variants.append(
+                dataclasses.replace(
+                    plan,
+                    joints=attempt.joints,
+                    trajectory=attempt.joints.trajectory,
+                    collisions=attempt.collisions,
+                    clearance_profile=None,
+                )  # fmt: skip
+            )
+    return variants
 
 
 def _ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:

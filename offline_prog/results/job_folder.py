@@ -134,10 +134,16 @@ def job_report(job: JobPlan) -> dict:
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
             "order_mode": job_config(job.cell).order,
             "order": [
-                {"seam": o.name, "direction": "reverse" if o.reverse else "forward"}
+                {
+                    "seam": o.name,
+                    "direction": "reverse" if o.reverse else "forward",
+                    "branch": int(o.plan.joints.branch),
+                    "tool_rotation_deg": float(np.rad2deg(o.plan.tool_rotation_rad)),
+                }
                 for o in job.chosen
             ],
             "order_method": order.method,
+            "options_per_seam": [len(seam) for seam in job.options],
             "estimated_air_time_s": order.air_time_s,
             "estimated_air_time_given_order_s": order.given_air_time_s,
             "estimated_saving_s": order.saved_s,

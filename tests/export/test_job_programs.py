@@ -266,10 +266,10 @@ def test_urscript_job_links_and_io(folders):
                 p = tool_in_part_from_joints(data, last_q)
                 gap = np.linalg.norm(p_seam - p, axis=1)
                 i = int(np.argmin(gap))
-                if i == 0 and gap[0] > 1e-4:  # before the seam: on the approach line
-                    position = -gap[0]
+                if seam.sigma[i] < 1e-6 and gap[i] > 1e-4:  # off the seam's start: approach
+                    position = -gap[i]
                 else:
-                    position = seam.sigma[i] + (gap[i] if i == len(gap) - 1 else 0.0)
+                    position = seam.sigma[i]
                 switched[pending] = position
                 pending = None
     on, off = asked(data, 0)
