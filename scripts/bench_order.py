@@ -2,8 +2,9 @@
 
 A job of eight seams on the demo plate (KUKA KR 16-2, fixed nozzle): six holes and two
 stripes, each allowed to run either way (``direction: auto``), every seam planned by the
-one-seam pipeline in both directions with its approach and retract. Brute force tries
-every order (8! = 40,320) with the best directions for each; ``order: auto`` solves it
+one-seam pipeline in both directions (and on other collision-free IK branches) with its
+approach and retract. Brute force tries every order (8! = 40,320) with the best options
+for each; ``order: auto`` solves it
 exactly (Held–Karp) — both by the synchronised-PTP link estimate (job.order). Then the
 exact and heuristic solvers on random instances of 8–14 seams: runtime and the
 heuristic's gap.
@@ -72,9 +73,9 @@ def main() -> None:
     start = time.perf_counter()
     auto = order_job(flat, q_home, mode="auto", **limits)
     t_auto = time.perf_counter() - start
-    print(f"== seam order: {n} seams, {len(flat)} options (both directions), KR 16-2 ==")
+    print(f"== seam order: {n} seams, {len(flat)} options (directions, branches), KR 16-2 ==")
     print(f"planning the seam options: {planning:.1f} s")
-    print(f"brute force ({n}! orders x best directions): air {brute:.3f} s in {t_brute:.2f} s")
+    print(f"brute force ({n}! orders x best options): air {brute:.3f} s in {t_brute:.2f} s")
     print(f"order: auto ({auto.method}): air {auto.air_time_s:.3f} s in {t_auto * 1e3:.1f} ms")
     print(f"ratio auto / brute force: {auto.air_time_s / brute:.4f} (target <= 1.05)")
     print(
