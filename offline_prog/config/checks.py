@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from offline_prog.config.cell import Cell, JobConfig, PathConfig
+from offline_prog.config.cell import Cell, JobConfig, PathConfig, SeamConfig
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -180,6 +180,7 @@ def _check_job(file: Path, cell: Cell) -> None:
                     f"tool.process_io.{name}.lead_mm",
                     f"must be within ±{MAX_APPROACH_MM:g} mm",
                 )
+        _check_leads(file, cell, io)
         if (io.on is None) != (io.off is None):
             raise _error(file, "tool.process_io", "give both on and off (or neither)")
         if io.on is not None and io.on.digital_output != io.off.digital_output:
@@ -196,6 +197,29 @@ OUTPUT_RANGES = {
     "urscript": {"digital_output": (0, 7), "analog_output": (0, 1)},
     "rapid": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
 }
+
+
+def _check_leads(file: Path, cell: Cell, io) -> None:
+    """An output switched on ``lead_mm`` before a seam's start lies on its approach (a
+    negative lead: on the seam); one switched off before the end, on the seam or (a
+    negative lead) on the retract. What depends on the seam's length is checked when it
+    is planned."""
+    for seam in cell.seams or [SeamConfig(name="seam")]:  # path: has the default moves
+        name = f"seam {seam.name}"
+        room_on = seam.approach.distance_mm * (seam.approach.kind != "none")
+        room_off = seam.retract.distance_mm * (seam.retract.kind != "none")
+        if io.on is not None and io.on.lead_mm > room_on:
+            raise _error(
+                file, "tool.process_io.on.lead_mm",
+                f"{io.on.lead_mm:g} mm before the start of {name} is beyond its approach "
+                f"({room_on:g} mm)",
+            )  # fmt: skip
+        if io.off is not None and -io.off.lead_mm > room_off:
+            raise _error(
+                file, "tool.process_io.off.lead_mm",
+                f"{-io.off.lead_mm:g} mm after the end of {name} is beyond its retract "
+                f"({room_off:g} mm)",
+            )  # fmt: skip
 
 
 def check_process_io(file: Path, cell: Cell, language: str | None) -> None:

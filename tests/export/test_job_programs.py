@@ -42,22 +42,36 @@ def one_seam_job(tmp_path, name: str, home: str) -> object:
     return file
 
 
+JOBS = {  # robot language ↦ (demo cell, job.home)
+    "rapid": ("weld_seam_irb2400", ", home: {joints_deg: [0, -20, 20, 0, 60, 0]}"),
+    "urscript": ("tape_cylinder_ur10e", ""),
+}
+
+
+class Folders(dict):
+    """language ↦ (JobProgramData, programs folder, plan folder), planned when asked."""
+
+    def __init__(self, planned_job, work):
+        super().__init__()
+        self.planned_job, self.work = planned_job, work
+
+    def __missing__(self, language):
+        if language == "krl":
+            folder = self.planned_job("seal_job_kr16")[1]
+        else:
+            if not (self.work / "data").exists():
+                shutil.copytree(CELLS / "data", self.work / "data")  # path and mesh files
+            job = plan_job(one_seam_job(self.work, *JOBS[language]))
+            assert job.feasible, job.failure
+            folder = self.work / language
+            write_job_outputs(job, folder)
+        self[language] = (JobProgramData.load(folder), folder / "programs", folder)
+        return self[language]
+
+
 @pytest.fixture(scope="module")
 def folders(planned_job, tmp_path_factory):
-    """robot language ↦ (JobProgramData, programs folder, cell)."""
-    out = {"krl": planned_job("seal_job_kr16")[1]}
-    work = tmp_path_factory.mktemp("jobs")
-    shutil.copytree(CELLS / "data", work / "data")  # the cells' path and mesh files
-    for language, name, home in (
-        ("rapid", "weld_seam_irb2400", ", home: {joints_deg: [0, -20, 20, 0, 60, 0]}"),
-        ("urscript", "tape_cylinder_ur10e", ""),
-    ):
-        cell = one_seam_job(work, name, home)
-        job = plan_job(cell)
-        assert job.feasible, job.failure
-        out[language] = work / language
-        write_job_outputs(job, out[language])
-    return {k: (JobProgramData.load(f), f / "programs", f) for k, f in out.items()}
+    return Folders(planned_job, tmp_path_factory.mktemp("jobs"))
 
 
 def asked(data: JobProgramData, k: int) -> tuple[float, float]:
@@ -188,6 +202,7 @@ def rapid_run(module_text: str):
     return run, points, joints
 
 
+@pytest.mark.slow  # plans a job of its own (CI runs it: pytest -m slow)
 def test_rapid_job_links_approach_retract_and_io(folders):
     from offline_prog.export.abb import abb_axes_deg
 
@@ -234,6 +249,7 @@ def test_rapid_job_links_approach_retract_and_io(folders):
 
 
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
+@pytest.mark.slow
 def test_rapid_job_passes_rapidchecker(folders):
     rapidchecker = pytest.importorskip("rapidchecker.cli", reason="rapidchecker not installed")
     _, folder, _ = folders["rapid"]
@@ -243,6 +259,7 @@ def test_rapid_job_passes_rapidchecker(folders):
 # --- URScript ---------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # plans a job of its own
 def test_urscript_job_links_and_io(folders):
     data, folder, _ = folders["urscript"]
     lines = (folder / "offline_prog.script").read_text().splitlines()

@@ -53,9 +53,14 @@ def run(tmp_path, text, capsys):
         (
             ("on:  {digital_output: 1, lead_mm: 5}", "on:  {digital_output: 1, lead_mm: 80}"),
             "tool.process_io.on.lead_mm",
-            "outside its",
+            "80 mm before the start of seam border is beyond its approach (50 mm)",
         ),
         (("seams:", "path: {units: mm, points: a.csv}\nseams:"), "seams", "exactly one of"),
+        (
+            ("off: {digital_output: 1, lead_mm: 2}", "off: {digital_output: 1, lead_mm: 400}"),
+            "tool.process_io.off.lead_mm",
+            "outside its approach, seam and retract",  # longer than a hole: after planning
+        ),
         (
             ("digital_output: 1,", "digital_output: 5000,"),  # on and off
             "tool.process_io.on.digital_output",
