@@ -123,8 +123,26 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
     return list(write_rapid(data, out_dir, forced=forced, **options).files)
 
 
+# The options each job writer takes (the rest are one-seam options: refused by name).
+_JOB_OPTIONS = {"krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m"},
+                "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
+                "urscript": {"name", "period_s"}}  # fmt: skip
+
+
 def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
-    """Write one format's files of a whole job into out_dir (a fresh folder)."""
+    """Write one format's files of a whole job into out_dir (a fresh folder).
+
+    Raises:
+        ValueError: an option of one-seam programs only (style, mode, line_limit).
+    """
+    if fmt == "urscript":  # servoj streams the plan: point tolerances do not apply
+        options = {k: v for k, v in options.items() if k not in ("chord_tol_m", "angle_tol_rad")}
+    unknown = sorted(set(options) - _JOB_OPTIONS.get(fmt, set()))
+    if unknown:
+        raise ValueError(
+            f"{fmt}: {', '.join(unknown)} is for one-seam plans; a whole job's {fmt} "
+            "program has its own form (see the README, Whole jobs)"
+        )
     if fmt == "csv":
         from offline_prog.export.joint_files import write_job_joint_csv
 

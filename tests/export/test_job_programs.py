@@ -293,3 +293,17 @@ def test_urscript_job_links_and_io(folders):
     assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
     assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
     assert any(line.strip().startswith("set_standard_analog_out") for line in lines)
+
+
+def test_export_of_a_job_refuses_one_seam_options_in_one_line(folders, capsys):
+    from offline_prog.cli import main
+
+    _, _, plan_folder = folders["krl"]
+    out = plan_folder.parent / "reexport"
+    assert main(["export", str(plan_folder), "--format", "krl", "--out", str(out)]) == 0
+    assert (out / "offline_prog.src").is_file()
+    capsys.readouterr()
+    code = main(["export", str(plan_folder), "--format", "krl", "--style", "flange",
+                 "--out", str(out)])  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "style is for one-seam plans" in err[0]
