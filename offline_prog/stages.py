@@ -17,7 +17,8 @@ from pydrake.math import RigidTransform
 from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import Cell, load_cell, transform
-from offline_prog.config.checks import check_cell, check_process_io
+from offline_prog.config.checks import check_cell
+from offline_prog.config.job_checks import check_process_io
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
 from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations

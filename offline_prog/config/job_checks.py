@@ -1,0 +1,139 @@
+"""Semantic checks of a job's keys (``seams:``, ``job:``, ``tool.process_io``) that
+their types alone cannot express; every failure is an InputError naming the file and key.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from offline_prog.config.cell import Cell, JobConfig, SeamConfig
+from offline_prog.constants import MAX_SPEED_M_S
+from offline_prog.errors import InputError
+
+DIRECTIONS = ("forward", "reverse", "auto")
+APPROACH_KINDS = ("normal", "tangent", "none")
+MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
+MAX_LINK_TIME_S = 600.0  # planning time per link
+MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
+SEAM_NAME = re.compile(rf"[A-Za-z][A-Za-z0-9_]{{0,{MAX_SEAM_NAME_CHARS - 1}}}")
+
+
+def _error(file, key, reason) -> InputError:
+    return InputError(file, key, reason)
+
+
+def check_job(file: Path, cell: Cell) -> None:
+    """Seam names unique and safe in a controller program; directions, speeds,
+    approach and retract; job order; process I/O numbers and ranges."""
+    names: set[str] = set()
+    for k, seam in enumerate(cell.seams):
+        key = f"seams[{k}]"
+        if not SEAM_NAME.fullmatch(seam.name):
+            raise _error(
+                file,
+                f"{key}.name",
+                f"{seam.name!r} is not a seam name (letters, digits and _, starting "
+                f"with a letter, at most {MAX_SEAM_NAME_CHARS} characters: it names "
+                "labels in controller programs)",
+            )
+        if seam.name.lower() in names:
+            raise _error(file, f"{key}.name", f"{seam.name!r} is used twice")
+        names.add(seam.name.lower())
+        if seam.direction not in DIRECTIONS:
+            raise _error(
+                file, f"{key}.direction", f"{seam.direction!r} (use {', '.join(DIRECTIONS)})"
+            )
+        if seam.speed is not None and not 0 < seam.speed <= MAX_SPEED_M_S:
+            raise _error(file, f"{key}.speed", f"must be within (0, {MAX_SPEED_M_S:g}] m/s")
+        for end in ("approach", "retract"):
+            move = getattr(seam, end)
+            if move.kind not in APPROACH_KINDS:
+                raise _error(
+                    file, f"{key}.{end}.kind", f"{move.kind!r} (use {', '.join(APPROACH_KINDS)})"
+                )
+            if not 0 <= move.distance_mm <= MAX_APPROACH_MM:
+                raise _error(
+                    file,
+                    f"{key}.{end}.distance_mm",
+                    f"must be within [0, {MAX_APPROACH_MM:g}] mm, got {move.distance_mm:g}",
+                )
+    job = cell.job or JobConfig()
+    if job.order not in ("given", "auto"):
+        raise _error(file, "job.order", f"{job.order!r} (use given or auto)")
+    if not 0 < job.link_time_s <= MAX_LINK_TIME_S:
+        raise _error(file, "job.link_time_s", f"must be within (0, {MAX_LINK_TIME_S:g}] s")
+    if job.home is not None and len(job.home.joints_deg) != 6:
+        raise _error(file, "job.home.joints_deg", "expected 6 joint values [deg]")
+    io = cell.tool.process_io
+    if io is not None:
+        for name in ("on", "off"):
+            switch = getattr(io, name)
+            if switch is not None and abs(switch.lead_mm) > MAX_APPROACH_MM:
+                raise _error(
+                    file,
+                    f"tool.process_io.{name}.lead_mm",
+                    f"must be within ±{MAX_APPROACH_MM:g} mm",
+                )
+        _check_leads(file, cell, io)
+        if (io.on is None) != (io.off is None):
+            raise _error(file, "tool.process_io", "give both on and off (or neither)")
+        if io.on is not None and io.on.digital_output != io.off.digital_output:
+            raise _error(file, "tool.process_io.off.digital_output", "must equal on's")
+        if io.flow is not None and not io.flow.min < io.flow.max:
+            raise _error(file, "tool.process_io.flow", "needs min < max")
+
+
+# The process outputs each controller family can have (its own numbering):
+# KUKA KSS 8: $OUT[1..4096], $ANOUT[1..32]; UR e-Series: standard digital out 0..7,
+# standard analog out 0..1; ABB: signals named do<n> / ao<n> in the I/O configuration.
+OUTPUT_RANGES = {
+    "krl": {"digital_output": (1, 4096), "analog_output": (1, 32)},
+    "urscript": {"digital_output": (0, 7), "analog_output": (0, 1)},
+    "rapid": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
+}
+
+
+def _check_leads(file: Path, cell: Cell, io) -> None:
+    """An output switched on ``lead_mm`` before a seam's start lies on its approach (a
+    negative lead: on the seam); one switched off before the end, on the seam or (a
+    negative lead) on the retract. What depends on the seam's length is checked when it
+    is planned."""
+    for seam in cell.seams or [SeamConfig(name="seam")]:  # path: has the default moves
+        name = f"seam {seam.name}"
+        room_on = seam.approach.distance_mm * (seam.approach.kind != "none")
+        room_off = seam.retract.distance_mm * (seam.retract.kind != "none")
+        if io.on is not None and io.on.lead_mm > room_on:
+            raise _error(
+                file, "tool.process_io.on.lead_mm",
+                f"{io.on.lead_mm:g} mm before the start of {name} is beyond its approach "
+                f"({room_on:g} mm)",
+            )  # fmt: skip
+        if io.off is not None and -io.off.lead_mm > room_off:
+            raise _error(
+                file, "tool.process_io.off.lead_mm",
+                f"{-io.off.lead_mm:g} mm after the end of {name} is beyond its retract "
+                f"({room_off:g} mm)",
+            )  # fmt: skip
+
+
+def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
+    """The process output numbers exist on the robot's controller (``OUTPUT_RANGES``)."""
+    io = cell.tool.process_io
+    if io is None:
+        return
+    ranges = OUTPUT_RANGES.get(language, {"digital_output": (0, 9999), "analog_output": (0, 9999)})
+    for name, kind in (("on", "digital_output"), ("off", "digital_output"),
+                       ("flow", "analog_output")):  # fmt: skip
+        part = getattr(io, name)
+        if part is None:
+            continue
+        low, high = ranges[kind]
+        number = getattr(part, kind)
+        if not low <= number <= high:
+            raise _error(
+                file,
+                f"tool.process_io.{name}.{kind}",
+                f"{number} is not an output of the robot's {language or 'controller'} "
+                f"controller (use {low}..{high})",
+            )
