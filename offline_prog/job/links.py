@@ -165,9 +165,8 @@ def _ompl_path(robot, checker, q_start, q_goal, seed, time_budget_s) -> np.ndarr
         planner = og.RRTConnect(info)
         planner.setRange(PLANNER_RANGE_RAD)
         setup.setPlanner(planner)
-        status = setup.solve(time_budget_s)
+        setup.solve(time_budget_s)
         if not setup.haveExactSolutionPath():
-            del status
             return None
         path = setup.getSolutionPath()
         simplifier = og.PathSimplifier(info)  # its random numbers: seeded above
