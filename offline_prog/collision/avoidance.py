@@ -31,6 +31,7 @@ INFLUENCE_M = 0.05  # distance at which pairs start to count in the constraint
 NORMAL_TOL_RAD = 1e-6
 POSITION_TOL_M = 1e-7
 SPLINE_CONTROL_POINTS = 10
+N_NUDGES, NUDGE_RAD = 4, 0.1  # more IK starts at a sample where the first two fail
 
 
 def _turn_angle(x_T: np.ndarray, axis_I: np.ndarray, t_I: np.ndarray) -> float:
@@ -86,7 +87,11 @@ def turn_profile(
         ik.AddMinimumDistanceLowerBoundConstraint(clearance + CLEARANCE_MARGIN_M, INFLUENCE_M)
         q = ik.q()
         ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(q_prev)), q_prev, q)
-        for seed in (q_prev, q_seed_plan[k]):  # the previous solution, else the plan's
+        # The previous solution, the plan's, then a few seeded nudges of the previous one
+        # (SNOPT can stall on a distance constraint's kinks from one start).
+        rng = np.random.default_rng(k)
+        nudges = [q_prev + rng.uniform(-NUDGE_RAD, NUDGE_RAD, len(q_prev)) for _ in range(N_NUDGES)]
+        for seed in (q_prev, q_seed_plan[k], *nudges):
             result = Solve(ik.prog(), seed)
             if result.is_success():
                 break
