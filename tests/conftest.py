@@ -62,6 +62,21 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
     return Rotation.from_matrix(R).as_rotvec()
 
 
+def _planned_once(tmp_path_factory, plan, write):
+    """name ↦ (plan, folder): cells/<name>.yaml planned and written once per session."""
+    cache = {}
+
+    def get(name: str):
+        if name not in cache:
+            out = tmp_path_factory.mktemp(name)
+            result = plan(CELLS / f"{name}.yaml")
+            write(result, out)
+            cache[name] = (result, out)
+        return cache[name]
+
+    return get
+
+
 @pytest.fixture(scope="session")
 def planned_folder(tmp_path_factory):
     """name ↦ (plan, folder): a demo cell planned once per session with all its outputs
@@ -69,17 +84,7 @@ def planned_folder(tmp_path_factory):
     from offline_prog.plan import plan_cell
     from offline_prog.results.plan_folder import write_outputs
 
-    cache = {}
-
-    def get(name: str):
-        if name not in cache:
-            out = tmp_path_factory.mktemp(name)
-            plan = plan_cell(CELLS / f"{name}.yaml")
-            write_outputs(plan, out)
-            cache[name] = (plan, out)
-        return cache[name]
-
-    return get
+    return _planned_once(tmp_path_factory, plan_cell, write_outputs)
 
 
 @pytest.fixture
@@ -93,17 +98,7 @@ def planned_job(tmp_path_factory):
     from offline_prog.plan import plan_job
     from offline_prog.results.job_folder import write_job_outputs
 
-    cache = {}
-
-    def get(name: str):
-        if name not in cache:
-            out = tmp_path_factory.mktemp(name)
-            job = plan_job(CELLS / f"{name}.yaml")
-            write_job_outputs(job, out)
-            cache[name] = (job, out)
-        return cache[name]
-
-    return get
+    return _planned_once(tmp_path_factory, plan_job, write_job_outputs)
 
 
 def _one_seam(file: Path) -> bool:
