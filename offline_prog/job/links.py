@@ -35,9 +35,6 @@ from offline_prog.timing.trajectory import sample_times
 # RRTConnect's longest edge in joint space [rad, Euclidean]: long edges, few vertices
 # (each edge is certified by conservative advancement, which steps as far as it may).
 PLANNER_RANGE_RAD = 1.5
-# Not published by the vendors: the time in which a joint may build up its full
-# acceleration, hence jerk limits j_k = a_k / JERK_RAMP_S.
-JERK_RAMP_S = 0.1
 MIN_CLEARANCE_SAMPLES = 200  # samples of a link measured for its reported clearance
 
 
@@ -193,8 +190,7 @@ def timed_polyline(robot: RobotModel, waypoints: np.ndarray, rate_hz: float):
     from ruckig import InputParameter, Result, Ruckig, Trajectory
 
     q_c = robot.controller_joints(waypoints)
-    jerk = getattr(robot, "qddd_max", None)
-    jerk = robot.qdd_max / JERK_RAMP_S if jerk is None else jerk
+    jerk = robot.jerk_limits
     ts, qs, qds, clock = [np.zeros(1)], [waypoints[:1]], [np.zeros((1, 6))], 0.0
     for a, b, a_c, b_c in zip(waypoints[:-1], waypoints[1:], q_c[:-1], q_c[1:], strict=True):
         delta = np.abs(b_c - a_c)

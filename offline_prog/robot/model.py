@@ -24,6 +24,7 @@ import yaml
 from offline_prog.robot import kinematics_opw, kinematics_ur
 from offline_prog.robot.kinematics_opw import OpwParameters
 from offline_prog.robot.kinematics_ur import UrParameters
+from offline_prog.robot.record_checks import RecordChecker as _Checker
 
 ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
 PARAMS_FILE = "robot.yaml"
@@ -36,6 +37,9 @@ _KINEMATIC_KEYS = {
     "drake": (),  # no closed form: joint paths come from Drake InverseKinematics
 }
 _LIMIT_KEYS = ("position_deg", "velocity_deg_s", "acceleration_deg_s2")
+# limits.jerk_deg_s3 is optional: without it a joint reaches its acceleration limit in
+# this time [s] (the bundled robots state the same assumption with its source).
+JERK_RAMP_S = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,6 +56,8 @@ class RobotModel:
         q_upper: (6,) upper joint position limits [rad].
         qd_max: (6,) joint speed limits [rad/s].
         qdd_max: (6,) joint acceleration limits [rad/s^2].
+        qddd_max: (6,) joint jerk limits [rad/s^3] (``limits.jerk_deg_s3``, else
+            qdd_max / JERK_RAMP_S).
         urdf_path: Absolute path of the URDF.
         j23_coupled: the controller counts axis 3 as q2 + q3 (see controller_joints).
         vendor: the maker, e.g. ``"kuka"`` (robot.yaml ``vendor``).
@@ -70,10 +76,16 @@ class RobotModel:
     qd_max: np.ndarray
     qdd_max: np.ndarray
     urdf_path: Path
+    qddd_max: np.ndarray | None = None  # (6,) [rad/s³]; None: qdd_max / JERK_RAMP_S
     j23_coupled: bool = False
     vendor: str = ""
     language: str | None = None
     home_c: np.ndarray | None = None  # (6,) the controller's home axes [rad], or None
+
+    @property
+    def jerk_limits(self) -> np.ndarray:
+        """(6,) joint jerk limits [rad/s³]: qddd_max, else qdd_max / JERK_RAMP_S."""
+        return self.qdd_max / JERK_RAMP_S if self.qddd_max is None else self.qddd_max
 
     def controller_joints(self, q: np.ndarray) -> np.ndarray:
         """(..., 6) the joint values the controller counts (and limits) from URDF q.
@@ -161,7 +173,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     ):
         check.fail("joint_names", names, "6 distinct joint names")
     limits = record["limits"]
-    check.keys(limits, "limits", required=set(_LIMIT_KEYS), allowed=set(_LIMIT_KEYS))
+    check.keys(limits, "limits", required=set(_LIMIT_KEYS), allowed={*_LIMIT_KEYS, "jerk_deg_s3"})
     position = check.numbers(limits["position_deg"], "limits.position_deg", shape=(6, 2))
     if not np.all(position[:, 0] < position[:, 1]):
         check.fail(
@@ -170,6 +182,11 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     velocity = check.numbers(limits["velocity_deg_s"], "limits.velocity_deg_s", positive=True)
     acceleration = check.numbers(
         limits["acceleration_deg_s2"], "limits.acceleration_deg_s2", positive=True
+    )
+    jerk = (
+        np.radians(check.numbers(limits["jerk_deg_s3"], "limits.jerk_deg_s3", positive=True))
+        if "jerk_deg_s3" in limits
+        else np.radians(acceleration) / JERK_RAMP_S
     )
     return RobotModel(
         name=name,
@@ -183,6 +200,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         qd_max=_frozen(np.radians(velocity)),
         qdd_max=_frozen(np.radians(acceleration)),
         urdf_path=(folder / urdf_name).resolve(),
+        qddd_max=_frozen(jerk),
         j23_coupled=_j23_coupled(check, record.get("controller")),
         vendor=str(record.get("vendor", "")),
         language=_language(check, record.get("controller")),
@@ -252,46 +270,3 @@ def _frozen(array: np.ndarray) -> np.ndarray:
     array = np.array(array, dtype=float)
     array.flags.writeable = False
     return array
-
-
-class _Checker:
-    """Validates values read from one record file; failures are one-line ValueErrors."""
-
-    def __init__(self, path: Path):
-        self.path = path
-
-    def fail(self, key: str, value: Any, expected: str) -> None:
-        raise ValueError(f"{self.path}: key '{key}': expected {expected}, got {value!r}")
-
-    def keys(self, mapping: Any, where: str, *, required: set[str], allowed: set[str]) -> None:
-        if not isinstance(mapping, dict):
-            self.fail(where or "<top level>", mapping, "a mapping")
-        prefix = f"{where}." if where else ""
-        for key in sorted(required - mapping.keys()):
-            raise ValueError(f"{self.path}: key '{prefix}{key}': missing")
-        for key in sorted(mapping.keys() - allowed):
-            raise ValueError(
-                f"{self.path}: key '{prefix}{key}': unknown (allowed: {', '.join(sorted(allowed))})"
-            )
-
-    def numbers(
-        self, value: Any, key: str, *, shape: tuple[int, ...] = (6,), positive: bool = False
-    ) -> np.ndarray:
-        expected = "a number" if shape == () else f"finite numbers of shape {list(shape)}"
-        if positive:
-            expected = expected.replace("finite", "positive finite")
-        try:
-            array = np.array(value, dtype=float)
-            ok = not _has_bool_or_str(value) and array.shape == shape
-        except (TypeError, ValueError):
-            ok = False
-        if not ok or not np.all(np.isfinite(array)) or (positive and not np.all(array > 0)):
-            self.fail(key, value, expected)
-        return array
-
-
-def _has_bool_or_str(value: Any) -> bool:
-    """True if value (possibly nested lists) holds a bool or a string."""
-    if isinstance(value, list):
-        return any(_has_bool_or_str(v) for v in value)
-    return isinstance(value, (bool, str))
