@@ -1,8 +1,10 @@
 """From the flange trajectory to a joint trajectory q(t) within the robot's limits.
 
 Stages: pick one configuration branch and 2π start for the whole path
-(``path_ik``), get q′(σ), q″(σ) by differencing the exact analytic IK at σ ± h
-on that branch, slow down where the joints need it (``joint_timing``), and
+(``path_ik``), get q′(σ), q″(σ) exactly from the flange path's analytic
+σ-derivatives through the robot's Jacobian (``robot.jacobian``), time the path
+under the joint limits (``time_optimal`` + ``jerk_stage``, or the paper's sin²
+law with ``joint_timing``), and
 sample the final trajectory with its joint positions, speeds, accelerations,
 singularity distances and joint steps. Failures are results that say where
 (σ, t) and why.
@@ -23,9 +25,12 @@ from offline_prog.joints.path_ik import (
     choose_branch,
     singularity_distances,
 )
+from offline_prog.joints.path_timing import path_timing
+from offline_prog.robot.jacobian import joint_path_rates, urdf_chain
 from offline_prog.robot.kinematics_opw import wrap_to_pi
 from offline_prog.robot.model import RobotModel
-from offline_prog.timing.joint_timing import JointRates, Retiming, retime
+from offline_prog.timing.jerk_stage import JerkLimitedTiming
+from offline_prog.timing.joint_timing import JointRates, Retiming
 from offline_prog.timing.time_law import Sin2TimeLaw
 from offline_prog.timing.trajectory import (
     TimeLawParameter,
@@ -33,13 +38,12 @@ from offline_prog.timing.trajectory import (
     sample_workspace_trajectory,
 )
 
-# σ grid for branch choice and joint rates [m], and the IK difference step [m].
+# σ grid for branch choice and joint rates [m].
 GRID_SPACING_M = 5e-4
 # Fewest path-IK grid points, however short the path (a short seam still gets a fine look).
 MIN_GRID_POINTS = 2001
 # Time grid that inverts σ(t) for failure messages (t to ~duration / 20000).
 TIME_INVERSION_POINTS = 20001
-DIFF_STEP_M = 1e-4
 # Singularity thresholds: |sin θ5| and |sin elbow| below sin(5°), shoulder 30 mm.
 NEAR_SINGULAR = {
     "wrist": np.sin(np.deg2rad(5.0)),
@@ -79,7 +83,7 @@ class JointTrajectory:
     margin_rad: np.ndarray
     largest_step: tuple[int, float, float]
     singularities: dict
-    retiming: Retiming
+    retiming: Retiming | JerkLimitedTiming
 
 
 class BranchPath:
@@ -104,19 +108,22 @@ class BranchPath:
         return singularity_distances(self.robot, q, self.poses(sigma))
 
     def rates(self, sigma: np.ndarray, q_near: np.ndarray) -> JointRates:
-        """q, q′, q″ at σ by central differences of the exact IK (error O(h²))."""
-        length = self.parameter.length
-        h = min(DIFF_STEP_M, length / 4)
-        center = np.clip(sigma, h, length - h)
-        q0 = self.q(center, q_near)
-        q_minus, q_plus = self.q(center - h, q0), self.q(center + h, q0)
-        dq = (q_plus - q_minus) / (2 * h)
-        ddq = (q_plus - 2 * q0 + q_minus) / h**2
-        shifted = sigma != center  # only within h of the path's ends
-        q = q0.copy()
-        if shifted.any():
-            q[shifted] = self.q(sigma[shifted], q0[shifted])
-        return JointRates(sigma, q, dq + ddq * (sigma - center)[:, None], ddq)
+        """q at σ by the exact IK; q′ and q″ exactly, through the Jacobian, from the
+        flange path's analytic σ-derivatives (``robot.jacobian.joint_path_rates``)."""
+        q = self.q(sigma, q_near)
+        s, ds, dds = self.parameter.s(sigma)
+        f = self.flange(s)
+        R_BI = self.X_IB.rotation().inverse().matrix()
+        # Twist rates per σ in I (chain rule through s(σ)), then expressed in B.
+        w1 = f.w_s * ds[:, None]
+        v1 = f.dp_IE * ds[:, None]
+        w2 = f.dw_s * (ds**2)[:, None] + f.w_s * dds[:, None]
+        v2 = f.ddp_IE * (ds**2)[:, None] + f.dp_IE * dds[:, None]
+        V1 = np.hstack([w1 @ R_BI.T, v1 @ R_BI.T])
+        V2 = np.hstack([w2 @ R_BI.T, v2 @ R_BI.T])
+        dq, ddq = joint_path_rates(urdf_chain(self.robot.urdf_path, self.robot.joint_names),
+                                   q, V1, V2)  # fmt: skip
+        return JointRates(sigma, q, dq, ddq)
 
 
 # Step between tried tool rotations [rad] and the σ grid for trying them [points].
@@ -171,6 +178,8 @@ def plan_joint_trajectory(
     *,
     rate_hz: float,
     branch: int | None = None,
+    time_law: str = "sin2",
+    process: str = "constant_speed",
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -182,6 +191,9 @@ def plan_joint_trajectory(
         nominal: the process time law (before joint limits).
         rate_hz: output sample rate.
         branch: use this analytic branch (if feasible) instead of the best one.
+        time_law: "time_optimal" (TOPP-RA, then the jerk stage) or "sin2" (the
+            paper's law, plateaus lowered where the joints need it).
+        process: the time-optimal intent, "constant_speed" or "cycle_time".
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
@@ -203,14 +215,14 @@ def plan_joint_trajectory(
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
-    retiming = retime(controller, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
+    retiming = path_timing(robot, controller, nominal, time_law, process)
     if not retiming.feasible:
         joint, sigma, use = retiming.worst
+        kinds = "speed/acceleration/jerk" if time_law == "time_optimal" else "speed/acceleration"
         raise JointPlanError(
             sigma,
             _time_at(retiming.law, sigma),
-            f"joint speed/acceleration limit on axis {joint + 1} "
-            f"({use:.2f}× the limit) even at reduced speed",
+            f"joint {kinds} limit on axis {joint + 1} ({use:.2f}× the limit) even at reduced speed",
         )
     trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
     sigma, sd, sdd, _ = retiming.law(trajectory.t)
