@@ -213,6 +213,8 @@ def attempt_motion(
         nominal,
         rate_hz=motion.sample_rate_hz,
         branch=branch,
+        time_law=motion.time_law,
+        process=motion.process,
     )
     traj = joints.trajectory
     collisions = check_trajectory(

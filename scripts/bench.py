@@ -36,6 +36,9 @@ from offline_prog.plan import plan_cell
 from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # py_opw_reference
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_timing
+
+from bench_timing import bench_timing  # noqa: E402
 
 CELLS = Path(__file__).resolve().parents[1] / "cells"
 
@@ -244,12 +247,15 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=5000)
     parser.add_argument("--drake-samples", type=int, default=300)
     parser.add_argument(
-        "--only", choices=["command", "collision"], help="run one part of the benchmark"
+        "--only", choices=["command", "collision", "timing"], help="run one part of the benchmark"
     )
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
     if args.only == "collision":
         bench_collision(cells)
+        return
+    if args.only == "timing":
+        bench_timing()
         return
     bench_command(CELLS / "seal_plate_kr16.yaml")
     if args.only == "command":
@@ -258,6 +264,7 @@ def main() -> None:
     bench_collision(cells)
     for file in cells:
         bench_path_ik(file, args.samples, args.drake_samples)
+    bench_timing()
 
 
 if __name__ == "__main__":

@@ -17,6 +17,8 @@ from offline_prog.constants import (
     MAX_PAYLOAD_KG,
     MAX_SAMPLE_RATE_HZ,
     MAX_SPEED_M_S,
+    PROCESS_INTENTS,
+    TIME_LAWS,
     UNIT_SCALE,
 )
 from offline_prog.errors import InputError
@@ -74,6 +76,12 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     if motion.speed_reference not in ("tcp", "flange"):
         raise _error(
             file, "motion.speed_reference", f"{motion.speed_reference!r} (use tcp or flange)"
+        )
+    if motion.time_law not in TIME_LAWS:
+        raise _error(file, "motion.time_law", f"{motion.time_law!r} (use {' or '.join(TIME_LAWS)})")
+    if motion.process not in PROCESS_INTENTS:
+        raise _error(
+            file, "motion.process", f"{motion.process!r} (use {' or '.join(PROCESS_INTENTS)})"
         )
     if not 0.0 <= cell.tool.free_rotation_deg <= 180.0:
         raise _error(file, "tool.free_rotation_deg", "must be within [0, 180]")

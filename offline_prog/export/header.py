@@ -25,7 +25,7 @@ def header_lines(data: ProgramData, *, conventions: list[str], forced: bool = Fa
         f"Robot: {data.robot}   Tool (fixed, remote TCP): {data.tool}   Part: {data.part}",
         f"Process speed: {data.process_speed_m_s * 1e3:.3f} mm/s at the "
         f"{'TCP' if data.speed_reference == 'tcp' else 'flange'}   "
-        f"Planned cycle time: {data.cycle_time_s:.3f} s",
+        f"Planned cycle time: {data.cycle_time_s:.3f} s   Time law: {data.time_law}",
     ]
     if forced or not data.feasible:
         lines.append(f"WARNING: EXPORTED WITH --force FROM A FAILED PLAN: {data.failure}")

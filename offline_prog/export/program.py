@@ -88,6 +88,8 @@ class ProgramData:
     j23_coupled: bool = False  # the controller counts axis 3 as q2 + q3 (ABB IRB 2400)
     language: str | None = None  # the controller's program format (robot.yaml)
     payload: dict | None = None  # export.payload.payload_record (None: plan before payloads)
+    # The process time law (motion.time_law, and motion.process for time_optimal).
+    time_law: str = "sin2"
     sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
     X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
 

@@ -30,6 +30,7 @@ from offline_prog.results.plan_folder import (
     check_out_dir,
     program_data,
     program_names,
+    time_law_name,
 )
 from offline_prog.results.report import collision_summary, report
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
@@ -218,6 +219,7 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         **program_names(cell, job.cell_file, robot, summary),
         speed_reference=cell.motion.speed_reference,
         cycle_time_s=float(s.t[-1]),
+        time_law=time_law_name(cell.motion),
         feasible=job.feasible,
         failure=job.failure,
         t=s.t,

@@ -85,6 +85,14 @@ def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
     return X
 
 
+def time_law_name(motion) -> str:
+    """The time law as the program header names it: "sin2", or "time_optimal
+    (constant_speed)" / "time_optimal (cycle_time)"."""
+    if motion.time_law == "time_optimal":
+        return f"time_optimal ({motion.process})"
+    return motion.time_law
+
+
 def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
     """The ProgramData fields that name the cell, robot, tool and part and carry the
     robot's limits and the payload (the same for a seam and a job)."""
@@ -125,6 +133,7 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         **program_names(cell, plan.cell_file, plan.robot, summary),
         speed_reference=traj.reference,
         cycle_time_s=traj.duration,
+        time_law=time_law_name(cell.motion),
         feasible=plan.feasible,
         failure=plan.failure,
         t=traj.t,

@@ -88,6 +88,46 @@ def robot_report(plan: Plan) -> dict:
         ],
         "ramp_acceleration_scale": retiming.a_scale,
         "cycle_time_without_joint_limits_s": plan.nominal_duration_s,
+        **timing_report(plan),
+    }
+
+
+def timing_report(plan: Plan) -> dict:
+    """The time law, the joints' jerk use and, for the time-optimal law, TOPP-RA's
+    duration and every slowdown with its limiting joint and constraint."""
+    motion, robot, joints = plan.cell.motion, plan.robot, plan.joints
+    t = plan.trajectory.t
+    qd = robot.controller_joints(joints.qd)
+    qdd = np.diff(qd, axis=0) / np.diff(t)[:, None]
+    qddd = np.diff(qdd, axis=0) / np.diff(0.5 * (t[1:] + t[:-1]))[:, None]
+    jerk_use = (np.abs(qddd) / robot.jerk_limits).max(axis=0) if len(t) > 2 else np.zeros(6)
+    out = {
+        "time_law": motion.time_law,
+        "max_joint_jerk_use": jerk_use.round(4).tolist(),  # finite differences of qd
+    }
+    retiming = joints.retiming
+    if motion.time_law != "time_optimal":
+        return out
+    return out | {
+        "process": motion.process,
+        # TOPP-RA under the joint velocity/acceleration limits, the TCP cap and the path
+        # acceleration; then with the steady jerk limit as a speed limit curve too.
+        "time_optimal_without_jerk_stage_s": retiming.topp_plain_s,
+        "time_optimal_steady_jerk_s": retiming.topp.duration,
+        "time_optimal_solve_s": retiming.topp.solve_s,
+        "slowdowns": [
+            {
+                "sigma_start_m": slow.sigma_m[0],
+                "sigma_end_m": slow.sigma_m[1],
+                "t_start_s": slow.t_s[0],
+                "t_end_s": slow.t_s[1],
+                "speed_min_m_s": slow.speed_min_m_s,
+                "joint": slow.joint,
+                "constraint": slow.constraint,
+                "limit_use": slow.use,
+            }
+            for slow in retiming.slowdowns
+        ],
     }
 
 

@@ -33,6 +33,8 @@ class Sin2TimeLaw:
         signs: (K,) jerk sign per segment (+1, 0, −1).
         durations: (K,) segment durations [s].
         plateaus: ((v, σ_start, σ_end), ...) the cruise speeds and where they hold.
+        jerks: (K,) peak jerk of each segment's pulse [m/s³] (None: j_max everywhere;
+            the time-optimal law softens single transitions where joints need it).
     """
 
     length: float
@@ -43,6 +45,10 @@ class Sin2TimeLaw:
     signs: np.ndarray
     durations: np.ndarray
     plateaus: tuple[tuple[float, float, float], ...] = ()
+    jerks: np.ndarray | None = None
+
+    def _jerks(self) -> np.ndarray:
+        return np.full(len(self.durations), self.j_max) if self.jerks is None else self.jerks
 
     @property
     def duration(self) -> float:
@@ -58,10 +64,11 @@ class Sin2TimeLaw:
         starts = np.concatenate([[0.0], np.cumsum(self.durations)[:-1]])
         state = np.zeros((len(self.durations), 3))
         s = v = a = 0.0
+        jerks = self._jerks()
         for i in range(len(self.durations)):
             state[i] = s, v, a
             s, v, a, _ = _pulse(
-                self.signs[i], self.durations[i], self.j_max, s, v, a, np.array([self.durations[i]])
+                self.signs[i], self.durations[i], jerks[i], s, v, a, np.array([self.durations[i]])
             )
             s, v, a = float(s[0]), float(v[0]), float(a[0])
         return starts, state
@@ -75,7 +82,7 @@ class Sin2TimeLaw:
         s, v, a, j = _pulse(
             self.signs[seg],
             self.durations[seg],
-            self.j_max,
+            self._jerks()[seg],
             state[seg, 0],
             state[seg, 1],
             state[seg, 2],
@@ -128,6 +135,7 @@ def sin2_plateau_law(
     a_max: float,
     j_max: float,
     v_max: float | None = None,
+    scales: list[tuple[float, float]] | None = None,
 ) -> Sin2TimeLaw:
     """Rest-to-rest sin² profile under piecewise-constant speed caps.
 
@@ -137,6 +145,10 @@ def sin2_plateau_law(
             with the highest speed allowed on each [m/s].
         a_max, j_max: limits of σ̈ and σ⃛.
         v_max: the speed asked for (reported; default the highest cap).
+        scales: per stretch, (in, out) factors in (0, 1] on a_max and j_max for the
+            speed changes it hosts (default 1): a stretch hosts the speed-up from a
+            slower stretch before it (or from rest) at its start, and the slow-down
+            to a slower one after it (or to rest) at its end.
 
     Returns:
         A Sin2TimeLaw whose speed never exceeds the cap of the stretch it is on:
@@ -149,21 +161,24 @@ def sin2_plateau_law(
     for v in speeds:
         _check_limits(speed_cap=v)
     v_max = max(speeds) if v_max is None else v_max
+    factors = [(1.0, 1.0)] * len(speeds) if scales is None else [tuple(f) for f in scales]
 
     def need(i: int, v: float) -> float:
         """Room plateau i needs at speed v for the transitions it hosts."""
         before = speeds[i - 1] if i > 0 else 0.0
         after = speeds[i + 1] if i + 1 < len(speeds) else 0.0
-        return (_transition_distance(before, v, a_max, j_max) if before < v else 0.0) + (
-            _transition_distance(v, after, a_max, j_max) if after < v else 0.0
-        )
+        f_in, f_out = factors[i]
+        return (
+            _transition_distance(before, v, a_max * f_in, j_max * f_in) if before < v else 0.0
+        ) + (_transition_distance(v, after, a_max * f_out, j_max * f_out) if after < v else 0.0)
 
     for _ in range(10_000):  # speeds only decrease, so this settles
         # Merge neighbours with equal speed.
         i = 0
         while i + 1 < len(speeds):
             if speeds[i] == speeds[i + 1]:
-                del speeds[i + 1], edges[i + 1]
+                factors[i] = (factors[i][0], factors[i + 1][1])
+                del speeds[i + 1], edges[i + 1], factors[i + 1]
             else:
                 i += 1
         short = [
@@ -189,24 +204,26 @@ def sin2_plateau_law(
     else:
         raise RuntimeError("sin2_plateau_law: plateau speeds did not settle")
 
-    signs, durations = [], []
+    signs, durations, jerks = [], [], []
 
-    def transition(v_a: float, v_b: float) -> None:
-        t_j, t_a = _acceleration_phase(abs(v_b - v_a), a_max, j_max)
+    def transition(v_a: float, v_b: float, factor: float) -> None:
+        t_j, t_a = _acceleration_phase(abs(v_b - v_a), a_max * factor, j_max * factor)
         sign = 1.0 if v_b > v_a else -1.0
         signs.extend([sign, 0.0, -sign])
         durations.extend([t_j, t_a, t_j])
+        jerks.extend([j_max * factor] * 3)
 
     for i, v in enumerate(speeds):
         before = speeds[i - 1] if i > 0 else 0.0
         after = speeds[i + 1] if i + 1 < len(speeds) else 0.0
         if before < v:
-            transition(before, v)
+            transition(before, v, factors[i][0])
         cruise = edges[i + 1] - edges[i] - need(i, v)
         signs.append(0.0)
         durations.append(max(cruise, 0.0) / v)
+        jerks.append(j_max)
         if after < v:
-            transition(v, after)
+            transition(v, after, factors[i][1])
     keep = np.asarray(durations) > 0.0
     plateaus = tuple((v, edges[i], edges[i + 1]) for i, v in enumerate(speeds))
     return Sin2TimeLaw(
@@ -218,6 +235,7 @@ def sin2_plateau_law(
         np.asarray(signs)[keep],
         np.asarray(durations)[keep],
         plateaus,
+        None if scales is None else np.asarray(jerks)[keep],
     )
 
 

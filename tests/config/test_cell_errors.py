@@ -106,6 +106,13 @@ CASES = [  # (replace, with, key in message, reason fragment)
         "must be > 0",
     ),
     ("units: mm", "units: mm\n  degree: 3", "path.degree", "< 5"),
+    (
+        "max_jerk: 10.0",
+        "max_jerk: 10.0\n  time_law: fastest",
+        "motion.time_law",
+        "use time_optimal",
+    ),
+    ("max_jerk: 10.0", "max_jerk: 10.0\n  process: glue", "motion.process", "constant_speed"),
     ("  closed: false", "  closed: false\n  dxf: a.dxf", "path", "exactly one of"),
     ("path:\n", "path:\n  analytic: {kind: spiral}\n", "path", "exactly one of"),
 ]

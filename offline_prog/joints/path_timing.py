@@ -1,0 +1,49 @@
+"""The process time law under the robot's joint limits, as motion.time_law asks.
+
+``time_optimal``: TOPP-RA (``timing.time_optimal``) under the joint velocity and
+acceleration limits, the process speed cap and the path acceleration, with the
+steady-speed joint jerk limit as a speed limit curve; then the jerk stage
+(``timing.jerk_stage``). ``sin2``: the paper's law with plateaus lowered where the
+joints need it (``timing.joint_timing``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from offline_prog.errors import Failure, PlanFailedError, PlanFailure
+from offline_prog.robot.model import RobotModel
+from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
+from offline_prog.timing.joint_timing import JointRates, retime
+from offline_prog.timing.time_law import Sin2TimeLaw
+from offline_prog.timing.time_optimal import topp_profile
+
+
+def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time_law: str,
+            process: str):  # fmt: skip
+    """The time law under the joint limits: TOPP-RA plus the jerk stage, or sin²
+    plateaus (``joint_timing.retime``)."""
+    if time_law == "sin2":
+        return retime(rates, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
+    limits = (robot.qd_max, robot.qdd_max, robot.jerk_limits)
+    profile = topp_profile(
+        rates, qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=nominal.v_max,
+        a_path=nominal.a_max, v_steady=steady_jerk_limit(rates, limits),
+    )  # fmt: skip
+    if not profile.ok:
+        reason = f"TOPP-RA found no parameterization ({profile.reason})"
+        raise PlanFailedError(PlanFailure(Failure.of(reason), 0.0, 0.0, reason))
+    plain = topp_profile(
+        rates, qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=nominal.v_max,
+        a_path=nominal.a_max,
+    )  # fmt: skip
+    timing = jerk_limited_law(
+        rates,
+        profile,
+        v_process=nominal.v_max,
+        a_max=nominal.a_max,
+        j_max=nominal.j_max,
+        limits=limits,
+        process=process,
+    )
+    return dataclasses.replace(timing, topp_plain_s=plain.duration)

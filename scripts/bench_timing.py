@@ -1,0 +1,159 @@
+"""Benchmark: the time-optimal process law (issue 14) on every one-seam demo cell.
+
+Run: ``python scripts/bench_timing.py`` (``python scripts/bench.py --only timing``).
+
+For each cell, in one process: the sin² plan and the time-optimal plan of the same
+cell (both intents), and TOPP-RA's own duration without the jerk stage. Prints
+
+- cycle times and the ratios time_optimal / TOPP-RA (acceptance ≤ 1.05) and
+  time_optimal / sin² (≤ 1);
+- constant_speed: the share of the path length where the TCP speed is within ±0.5 %
+  of the commanded speed (≥ 90 % where the speed is feasible);
+- the largest joint velocity, acceleration and jerk use on trajectory.csv, by finite
+  differences of its qd columns (≤ 1.01);
+- the solve time of TOPP-RA + the jerk stage on a 5,000-sample path (< 100 ms).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.plan import StageTimer, plan_seam
+from offline_prog.results.plan_folder import trajectory_csv
+from offline_prog.stages import build_scene, load_inputs
+from offline_prog.timing.jerk_stage import jerk_limited_law
+from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.time_optimal import topp_profile
+
+ROOT = Path(__file__).resolve().parents[1]
+ONE_SEAM_CELLS = ["seal_plate_kr16", "tape_cylinder_ur10e", "weld_seam_irb2400"]
+HOLD = 0.005  # ±0.5 % of the commanded speed
+
+
+def plan_with(inputs, scene, **motion):
+    """The one-seam plan of ``inputs`` with motion keys replaced."""
+    cell = dataclasses.replace(
+        inputs.cell, motion=dataclasses.replace(inputs.cell.motion, **motion)
+    )
+    return plan_seam(dataclasses.replace(inputs, cell=cell), scene, StageTimer(lambda s: None))
+
+
+def csv_limit_use(plan) -> tuple[float, float, float]:
+    """Largest joint velocity, acceleration and jerk use on trajectory.csv, from its
+    qd columns by finite differences (controller axes)."""
+    table = np.genfromtxt(io.StringIO(trajectory_csv(plan)), delimiter=",", names=True)
+    t = table["t"]
+    qd = np.column_stack([table[f"qd{k + 1}"] for k in range(6)])
+    robot = plan.robot
+    qd = robot.controller_joints(qd)
+    qdd = np.diff(qd, axis=0) / np.diff(t)[:, None]
+    t_mid = 0.5 * (t[1:] + t[:-1])
+    qddd = np.diff(qdd, axis=0) / np.diff(t_mid)[:, None]
+    return (
+        float((np.abs(qd) / robot.qd_max).max()),
+        float((np.abs(qdd) / robot.qdd_max).max()),
+        float((np.abs(qddd) / robot.jerk_limits).max()),
+    )
+
+
+def held_share(plan) -> float:
+    """Share of the path length where the TCP speed is within ±HOLD of the command."""
+    tr = plan.trajectory
+    v = plan.cell.motion.speed
+    held = np.abs(tr.tcp_speed - v) <= HOLD * v
+    ds = np.abs(np.diff(tr.s))
+    return float(np.sum(ds * (held[1:] & held[:-1])) / np.sum(ds))
+
+
+def solve_time_5000(plan) -> tuple[float, float]:
+    """(best wall time [s] of TOPP-RA + jerk stage, TOPP-RA alone) on rates resampled
+    to 5,000 samples of the plan's path."""
+    rates = plan.joints.retiming.topp
+    if rates is None:
+        return float("nan"), float("nan")
+    robot, tr = plan.robot, plan.trajectory
+    sigma = np.linspace(0.0, tr.law.length, 5000)
+    from offline_prog.joints.joint_plan import BranchPath
+    from offline_prog.timing.trajectory import TimeLawParameter
+
+    parameter = TimeLawParameter(plan.flange, plan.cell.motion.speed_reference)
+    X_IB = _X_IB(plan)
+    path = BranchPath(robot, X_IB, plan.flange, parameter, plan.joints.branch)
+    q_near = np.column_stack(
+        [np.interp(sigma, tr.law_position, plan.joints.q[:, k]) for k in range(6)]
+    )
+    r = path.rates(sigma, q_near)
+    rates = JointRates(sigma, *(robot.controller_joints(x) for x in (r.q, r.dq, r.ddq)))
+    motion = plan.cell.motion
+    best, best_topp = np.inf, np.inf
+    for _ in range(5):
+        start = time.perf_counter()
+        profile = topp_profile(
+            rates, qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=motion.speed,
+            a_path=motion.max_acceleration,
+        )  # fmt: skip
+        jerk_limited_law(
+            rates, profile, v_process=motion.speed, a_max=motion.max_acceleration,
+            j_max=motion.max_jerk, limits=(robot.qd_max, robot.qdd_max, robot.jerk_limits),
+            process=motion.process,
+        )  # fmt: skip
+        best = min(best, time.perf_counter() - start)
+        best_topp = min(best_topp, profile.solve_s)
+    return best, best_topp
+
+
+def _X_IB(plan):
+    from offline_prog.config.cell import transform
+
+    return transform(plan.cell.robot.X_IB)
+
+
+def bench_timing(cells: list[str] = ONE_SEAM_CELLS) -> None:
+    print("time-optimal process law vs sin² and TOPP-RA (same process, same cells)")
+    for name in cells:
+        file = ROOT / "cells" / f"{name}.yaml"
+        inputs = load_inputs(file, ROOT / "offline_prog" / "robots")
+        scene = build_scene(inputs)
+        sin2 = plan_with(inputs, scene, time_law="sin2")
+        held = plan_with(inputs, scene, time_law="time_optimal", process="constant_speed")
+        fast = plan_with(inputs, scene, time_law="time_optimal", process="cycle_time")
+        topp = held.joints.retiming.topp_plain_s
+        topp_jerk = held.joints.retiming.topp.duration
+        print(f"\n{name}: path {held.path.length * 1e3:.0f} mm at {inputs.cell.motion.speed} m/s")
+        print(f"  {'law':<28} {'cycle [s]':>9} {'/TOPP-RA':>9} {'/sin²':>7} {'held ±0.5%':>11} "
+              f"{'vel use':>8} {'acc use':>8} {'jerk use':>8}")  # fmt: skip
+        print(f"  {'TOPP-RA (no jerk stage)':<28} {topp:9.3f}")
+        print(f"  {'TOPP-RA + steady jerk limit':<28} {topp_jerk:9.3f} {topp_jerk / topp:9.3f}")
+        for label, plan in (
+            ("sin² (paper)", sin2),
+            ("time_optimal constant_speed", held),
+            ("time_optimal cycle_time", fast),
+        ):
+            uses = csv_limit_use(plan)
+            duration = plan.trajectory.duration
+            print(
+                f"  {label:<28} {duration:9.3f} {duration / topp:9.3f} "
+                f"{duration / sin2.trajectory.duration:7.3f} {100 * held_share(plan):10.1f}% "
+                + " ".join(f"{u:8.3f}" for u in uses)
+            )
+        for slow in held.joints.retiming.slowdowns:
+            print(
+                f"    slowdown σ {slow.sigma_m[0] * 1e3:7.1f}–{slow.sigma_m[1] * 1e3:7.1f} mm, "
+                f"t {slow.t_s[0]:6.2f}–{slow.t_s[1]:6.2f} s, min {slow.speed_min_m_s * 1e3:6.1f} "
+                f"mm/s: {slow.constraint}" + (f" of axis {slow.joint}" if slow.joint else "")
+            )
+        total, alone = solve_time_5000(held)
+        print(
+            f"  5,000-sample path: TOPP-RA {alone * 1e3:.1f} ms, TOPP-RA + jerk stage "
+            f"{total * 1e3:.1f} ms (best of 5)"
+        )
+
+
+if __name__ == "__main__":
+    bench_timing(sys.argv[1:] or ONE_SEAM_CELLS)

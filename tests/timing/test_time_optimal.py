@@ -1,0 +1,160 @@
+"""The time-optimal process law: TOPP-RA agrees with toppra's own use, the jerk
+stage keeps every joint limit (velocity, acceleration, jerk), a binding velocity
+limit is reported with the right joint and σ band, and a tight jerk limit holds."""
+
+import io
+
+import numpy as np
+import pytest
+
+from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
+from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.time_optimal import topp_profile
+
+QD_MAX = np.full(6, 2.0)  # rad/s
+QDD_MAX = np.full(6, 8.0)  # rad/s²
+QDDD_MAX = np.full(6, 80.0)  # rad/s³
+LENGTH = 1.0  # m
+
+
+def bump_rates(gain: float = 3.0, joint: int = 2, sigma=None) -> JointRates:
+    """A smooth joint path on σ ∈ [0, 1] m, exact at any σ: slow sines on every joint
+    plus a steep stretch of ``joint`` around σ = 0.5 (q′ up to 1 + gain rad/m there)."""
+    from scipy.special import erf
+
+    sigma = np.linspace(0.0, LENGTH, 2001) if sigma is None else sigma
+    k = np.arange(6)[None, :] + 1.0
+    q = 0.3 * np.sin(k * sigma[:, None])
+    dq = 0.3 * k * np.cos(k * sigma[:, None])
+    ddq = -0.3 * k**2 * np.sin(k * sigma[:, None])
+    x = (sigma - 0.5) / 0.05
+    q[:, joint] += gain * 0.05 * np.sqrt(np.pi) / 2 * erf(x)  # ∫ gain · exp(−x²) dσ
+    dq[:, joint] += gain * np.exp(-(x**2))
+    ddq[:, joint] += gain * np.exp(-(x**2)) * (-2 * x / 0.05)
+    return JointRates(sigma, q, dq, ddq)
+
+
+def bump_rates_at(**kwargs):
+    """bump_rates as a function of σ (exact at every sample, no interpolation)."""
+    return lambda sigma: bump_rates(sigma=sigma, **kwargs)
+
+
+def sampled_use(rates, law, limits=(QD_MAX, QDD_MAX, QDDD_MAX), rate_hz=1000.0):
+    """Largest |q̇|/q̇max, |q̈|/q̈max, |q⃛|/q⃛max on samples of the law: q̇ = q′σ̇ at
+    each sample, q̈ and q⃛ by finite differences of it (the check a user would do on
+    trajectory.csv's qd columns)."""
+    t = np.arange(0.0, law.duration, 1.0 / rate_hz)
+    sigma, sd, _, _ = law(t)
+    qd = rates(sigma).dq * sd[:, None]
+    qdd = np.diff(qd, axis=0) * rate_hz
+    qddd = np.diff(qdd, axis=0) * rate_hz
+    return tuple(
+        float((np.abs(x) / limit).max()) for x, limit in zip((qd, qdd, qddd), limits, strict=True)
+    )
+
+
+def test_topp_ra_agrees_with_toppra_used_directly():
+    import toppra
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    rates = bump_rates()
+    profile = topp_profile(rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=1e3, a_path=1e3)
+    waypoints = rates.q[::20]
+    spline = toppra.SplineInterpolator(rates.sigma[::20], waypoints)
+    instance = algo.TOPPRA(
+        [
+            constraint.JointVelocityConstraint(np.column_stack([-QD_MAX, QD_MAX])),
+            constraint.JointAccelerationConstraint(np.column_stack([-QDD_MAX, QDD_MAX])),
+        ],
+        spline,
+        gridpoints=np.linspace(0.0, LENGTH, 1000),
+    )
+    reference = instance.compute_trajectory(0, 0).duration
+    assert profile.ok
+    assert profile.duration == pytest.approx(reference, rel=5e-3)
+
+
+def test_jerk_stage_holds_every_joint_limit_and_stays_near_topp_ra():
+    rates = bump_rates()
+    limits = (QD_MAX, QDD_MAX, QDDD_MAX)
+    profile = topp_profile(
+        rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+        v_steady=steady_jerk_limit(rates, limits),
+    )  # fmt: skip
+    for process in ("constant_speed", "cycle_time"):
+        timing = jerk_limited_law(
+            rates, profile, v_process=0.5, a_max=2.0, j_max=20.0, limits=limits, process=process
+        )
+        assert timing.feasible
+        assert max(sampled_use(bump_rates_at(), timing.law)) <= 1.01
+        assert timing.law.duration <= 1.25 * profile.duration
+
+
+def test_a_binding_velocity_limit_names_the_joint_and_the_band():
+    rates = bump_rates(gain=8.0, joint=2)  # joint 3 needs σ̇ ≤ 2 / 8.06 m/s at σ = 0.5
+    limits = (QD_MAX, QDD_MAX, QDDD_MAX * 100)
+    profile = topp_profile(rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0)
+    timing = jerk_limited_law(rates, profile, v_process=0.5, a_max=2.0, j_max=20.0, limits=limits)
+    inner = [s for s in timing.slowdowns if s.constraint not in ("start/stop",)]
+    assert len(inner) == 1
+    slow = inner[0]
+    assert (slow.joint, slow.constraint) == (3, "velocity")
+    assert slow.sigma_m[0] < 0.5 < slow.sigma_m[1]
+    assert slow.sigma_m[1] - slow.sigma_m[0] < 0.45  # the band ±0.05 m and the ramps
+    assert slow.speed_min_m_s <= QD_MAX[2] / np.abs(rates.dq[:, 2]).max()
+    assert 0.85 <= slow.use <= 1.0  # plateaus are planned to 90 % of the limit
+    assert slow.t_s[0] < slow.t_s[1]
+
+
+def test_a_tight_jerk_limit_holds_and_costs_time():
+    rates = bump_rates()
+    loose = (QD_MAX, QDD_MAX, QDDD_MAX)
+    tight = (QD_MAX, QDD_MAX, QDDD_MAX / 10)
+    durations = []
+    for limits in (loose, tight):
+        profile = topp_profile(
+            rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+            v_steady=steady_jerk_limit(rates, limits),
+        )  # fmt: skip
+        timing = jerk_limited_law(
+            rates, profile, v_process=0.5, a_max=2.0, j_max=20.0, limits=limits
+        )
+        assert timing.feasible
+        assert max(sampled_use(bump_rates_at(), timing.law, limits)) <= 1.01
+        durations.append(timing.law.duration)
+    assert durations[1] > durations[0]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("process", ["constant_speed", "cycle_time"])
+def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
+    """trajectory.csv of the time-optimal seal demo, checked by finite differences of
+    its qd columns with a 1 % margin; and it is never slower than the sin² plan."""
+    from offline_prog.plan import plan_cell
+    from offline_prog.results.plan_folder import trajectory_csv
+
+    from conftest import CELLS
+
+    text = (CELLS / "seal_plate_kr16.yaml").read_text()
+    text = text.replace("speed_reference: tcp", f"speed_reference: tcp\n  time_law: "
+                        f"time_optimal\n  process: {process}")  # fmt: skip
+    cell = CELLS / f"_test_time_optimal_{process}.yaml"
+    cell.write_text(text)
+    try:
+        plan = plan_cell(cell)
+        sin2 = plan_cell(CELLS / "seal_plate_kr16.yaml")
+    finally:
+        cell.unlink()
+    table = np.genfromtxt(io.StringIO(trajectory_csv(plan)), delimiter=",", names=True)
+    robot = plan.robot
+    t = table["t"]
+    qd = robot.controller_joints(np.column_stack([table[f"qd{k + 1}"] for k in range(6)]))
+    qdd = np.diff(qd, axis=0) / np.diff(t)[:, None]
+    qddd = np.diff(qdd, axis=0) / np.diff(0.5 * (t[1:] + t[:-1]))[:, None]
+    assert (np.abs(qd) / robot.qd_max).max() <= 1.01
+    assert (np.abs(qdd) / robot.qdd_max).max() <= 1.01
+    assert (np.abs(qddd) / robot.jerk_limits).max() <= 1.01
+    assert plan.trajectory.duration <= sin2.trajectory.duration
+    kinds = {s.constraint for s in plan.joints.retiming.slowdowns}
+    assert "jerk" in kinds  # the wrist's jerk limit slows the corners
