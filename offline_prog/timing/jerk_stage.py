@@ -5,8 +5,9 @@ jumps, which neither a controller nor a bead of sealant accepts. The jerk stage 
 a rest-to-rest sin² law (``time_law.sin2_plateau_law``: continuous acceleration,
 bounded jerk) under it:
 
-* ``constant_speed``: the process speed, except on the stretches where TOPP-RA must
-  go slower; each of those holds one steady speed (the lowest TOPP-RA reaches there).
+* ``constant_speed``: the process speed, except on the stretches where the joints
+  cannot hold it steadily; each of those holds one steady speed (the lowest the
+  joints allow on it, ``static_limit``).
 * ``cycle_time``: a staircase under the TOPP-RA profile in steps of LEVEL_STEP.
 
 Along the path the joints move with (′ = d/dσ)
@@ -180,12 +181,13 @@ def jerk_limited_law(
             break
         # On a plateau (σ̈ = σ⃛ = 0) every term is the speed's, and so is the velocity
         # and any term over on its own: lower the cap there by the excess.
-        steady = (np.abs(use["sdd"]) < 1e-9) & (np.abs(use["sddd"]) < 1e-9)
+        on_plateau = (np.abs(use["sdd"]) < 1e-9) & (np.abs(use["sddd"]) < 1e-9)
+        plateau = on_plateau[:, None]
         speed_over = np.maximum.reduce(
             [
                 use["velocity"],
-                np.sqrt(np.where(steady[:, None], use["acceleration"], use["acceleration_speed"])),
-                np.cbrt(np.where(steady[:, None], use["jerk"], use["jerk_speed"])),
+                np.sqrt(np.where(plateau, use["acceleration"], use["acceleration_speed"])),
+                np.cbrt(np.where(plateau, use["jerk"], use["jerk_speed"])),
             ]
         ).max(axis=1)
         over = speed_over > 1.0
@@ -197,7 +199,7 @@ def jerk_limited_law(
         # Over during a speed change: soften that change (the speed-up at the start of
         # the law's plateau it lies on, or the slow-down at its end).
         change_over = np.where(
-            steady, 0.0, np.maximum(use["acceleration"], use["jerk"]).max(axis=1)
+            on_plateau, 0.0, np.maximum(use["acceleration"], use["jerk"]).max(axis=1)
         )
         sdd = use["sdd"]
         ends = np.array([b for _, _, b in law.plateaus])
