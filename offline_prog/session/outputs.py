@@ -15,7 +15,7 @@ from pathlib import Path
 
 from pydrake.common.yaml import yaml_dump_typed
 
-from offline_prog.config.cell import load_cell
+from offline_prog.config.cell import Cell, load_cell
 from offline_prog.config.safe_yaml import read_text
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
@@ -36,15 +36,15 @@ def free_name(file: Path) -> Path:
     raise FileExistsError(f"{file.parent}: {MAX_SAVES} saved copies of {file.name}")
 
 
-def save_cell(replanner: Replanner, state: SessionState) -> Path:
-    """Write the state's cell next to the original; returns the new file.
+def save_cell(original: Path, initial: SessionState, state: SessionState, cell: Cell) -> Path:
+    """Write ``cell`` (``state``'s, edited from ``initial``) next to ``original``; returns
+    the new file.
 
     Raises:
         OSError: the folder is not writable.
-        RuntimeError: the written file does not load to the session's cell (removed).
+        RuntimeError: the written file does not load to ``cell`` (it is removed).
     """
-    original = replanner.file
-    text = edited_text(read_text(original), replanner.initial, state)
+    text = edited_text(read_text(original), initial, state)
     while True:
         target = free_name(original)
         try:
@@ -54,7 +54,7 @@ def save_cell(replanner: Replanner, state: SessionState) -> Path:
         except FileExistsError:  # taken since free_name looked: the next one
             continue
     try:
-        same = yaml_dump_typed(load_cell(target)) == yaml_dump_typed(replanner.cell(state))
+        same = yaml_dump_typed(load_cell(target)) == yaml_dump_typed(cell)
     except Exception:
         same = False
     if not same:

@@ -183,7 +183,8 @@ class Session:
             return self.replanner.plan(state, progress)
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
-            saved = outputs.save_cell(self.replanner, state)
+            planner = self.replanner
+            saved = outputs.save_cell(planner.file, planner.initial, state, planner.cell(state))
             self.saved[state] = saved
         if kind == "save":
             return saved
