@@ -84,6 +84,7 @@ def node_pose(frame, path: list[str]) -> RigidTransform:
 
 
 def test_session_in_the_browser(session):
+    pytest.importorskip("playwright.sync_api", reason="pip install playwright (the test extras)")
     from playwright.sync_api import expect, sync_playwright
 
     folder, cell, port, process = session
