@@ -54,6 +54,7 @@ class Session:
         self.saved: dict = {}  # state → saved file
         self.last_saved = self.last_exported = None
         self.playing, self.t, self.sigma = False, 0.0, 0.0
+        self.last_step = time.monotonic()
         self.seek: float | None = None  # σ [m] asked for by the panel
         self.plan_line = {"kind": "planning", "line": "planning…"}
         self.requests: queue.Queue = queue.Queue()
@@ -189,8 +190,8 @@ class Session:
         if kind == "save":
             return saved
         result = self.replanner.plan(state, progress)
-        return outputs.export(self.replanner, result, saved, self.out_root / saved.stem,
-                              progress)  # fmt: skip
+        out = self.out_root / saved.stem
+        return saved, *outputs.export(self.replanner, result, saved, out, progress)
 
     # --- the main thread: MeshCat -------------------------------------------------------
 
@@ -207,21 +208,27 @@ class Session:
             X_IT = transform(self.replanner.cell(self.state).tool.X_IT)
             outdated = self.generation != self.shown_generation
             seek, self.seek = self.seek, None
-        self.view.show_tool(X_IT)
-        while True:
-            try:
-                kind, generation, answer = self.answers.get_nowait()
-            except queue.Empty:
-                break
-            self._answer(kind, generation, answer)
-        if self.view.shown is not None and self.view.shown.plan is not None:
-            traj = self.view.shown.plan.trajectory
-            if seek is not None:
-                self.t = float(_time_at(traj, seek))
-            elif self.playing:
-                self.t = (self.t + FRAME_S) % max(traj.t[-1], FRAME_S)
-            self.sigma = self.view.pose(min(self.t, traj.t[-1]))
-        self.view.set_outdated(outdated)
+        elapsed, self.last_step = now - self.last_step, now
+        try:
+            self.view.show_tool(X_IT)
+            while True:
+                try:
+                    kind, generation, answer = self.answers.get_nowait()
+                except queue.Empty:
+                    break
+                self._answer(kind, generation, answer)
+            if self.view.shown is not None and self.view.shown.plan is not None:
+                traj = self.view.shown.plan.trajectory
+                if seek is not None:
+                    self.t = float(_time_at(traj, seek))
+                elif self.playing:  # real time, looping
+                    self.t = (self.t + min(elapsed, 0.2)) % max(traj.t[-1], FRAME_S)
+                self.sigma = self.view.pose(min(self.t, traj.t[-1]))
+            self.view.set_outdated(outdated)
+        except Exception as error:  # a drawing error costs the picture, not the session
+            log.exception("session scene update failed")
+            with self.lock:
+                self.message = ("refused", f"scene update failed: {error}")
 
     def _answer(self, kind: str, generation: int, answer) -> None:
         if isinstance(answer, Exception):
@@ -237,20 +244,24 @@ class Session:
                 self.message = ("info", f"saved {answer}")
             return
         if kind == "export":
-            folder, line = answer
+            saved, folder, line = answer
             with self.lock:
-                self.last_exported = folder
+                self.last_saved, self.last_exported = saved, folder
                 self.message = ("info", line)
             return
         with self.lock:
             if generation != self.generation:
                 return  # stale: the controls moved on while it was planned
         self.view.show(answer)
-        line = plan_status(answer)
+        planner = self.replanner
+        line = plan_status(answer, planner.seam_names[answer.state.seam] if planner.is_job else "")
         with self.lock:
             self.shown_generation, self.plan_line = generation, line
-        if answer.plan is not None:
-            self.t = min(self.t, float(answer.plan.trajectory.t[-1]))
+        plan = answer.plan
+        if plan is not None and not plan.feasible and plan.collisions.closest is not None:
+            self.t, self.playing = plan.collisions.closest.t_s, False  # show the worst pose
+        elif plan is not None:
+            self.t = min(self.t, float(plan.trajectory.t[-1]))
 
 
 def _time_at(traj, sigma: float) -> float:

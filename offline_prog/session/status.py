@@ -13,8 +13,8 @@ import numpy as np
 from offline_prog.session.sample_states import counts, sample_states
 
 
-def plan_status(result) -> dict:
-    """{"kind", "line", "details"} of a SessionPlan.
+def plan_status(result, seam: str = "") -> dict:
+    """{"kind", "line", "details"} of a SessionPlan (of ``seam`` of a job, if named).
 
     kind: "feasible", "collision" (a plan that fails its collision check), "failed"
     (no joint plan: out of reach, a limit, a singularity) or "error" (the cell as set
@@ -22,6 +22,13 @@ def plan_status(result) -> dict:
     """
     timing = f"planned in {result.seconds:.2f} s (ran: {', '.join(result.ran) or 'nothing'})"
     details = {"seconds": result.seconds, "ran": result.ran, "feasible": False}
+    status = _status(result, timing, details)
+    if seam:
+        status["line"] = f"seam {seam}: {status['line']}"
+    return status
+
+
+def _status(result, timing: str, details: dict) -> dict:
     plan = result.plan
     if plan is None:
         failure = result.failure

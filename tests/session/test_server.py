@@ -72,3 +72,30 @@ def test_a_running_plan_stops_when_the_controls_move_on(session):
     with pytest.raises(SupersededError):
         progress("joints")
     run_until(session, lambda: session.snapshot()["current"])
+
+
+@pytest.mark.slow
+def test_a_job_plans_the_active_seam_and_exports_the_whole_job(tmp_path):
+    """seam picks the seam planned live; its own speed is the one edited; Export saves
+    the cell and writes the job's plan folder as `plan` does."""
+    import json
+    import shutil
+
+    cell = tmp_path / "job.yaml"
+    shutil.copyfile(CELLS / "seal_job_kr16.yaml", cell)
+    session = Session(cell, Meshcat(), out_root=tmp_path / "out")
+    run_until(session, lambda: session.snapshot()["current"])
+    assert session.snapshot()["status"]["line"].startswith("seam border: feasible")
+    session.set_value("seam", 3)
+    assert session.snapshot()["values"]["speed"] == 150.0  # the stripe's own speed
+    session.set_value("speed", 120)
+    run_until(session, lambda: session.snapshot()["current"])
+    assert session.snapshot()["status"]["line"].startswith("seam stripe: feasible")
+    session.action("export")
+    run_until(session, lambda: session.snapshot()["exported"] is not None)
+    saved = tmp_path / "job-1.yaml"
+    assert session.snapshot()["saved"] == str(saved)
+    assert "    speed: 0.12\n" in saved.read_text()
+    report = json.loads((tmp_path / "out" / "job-1" / "report.json").read_text())
+    assert [s["seam"] for s in report["seams"]].count("stripe") == 1
+    assert report["cell"] == str(saved)
