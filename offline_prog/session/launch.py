@@ -63,6 +63,7 @@ def run_session(
         _check_free(host, p)
     params = MeshcatParams()
     params.host, params.port = ("*" if host in ANY_HOST else host), meshcat_port
+    params.show_stats_plot = False  # a realtime-rate plot means nothing here
     meshcat = Meshcat(params)
     session = Session(Path(cell_file), meshcat)
     server = serve_panel(session, "" if host in ANY_HOST else host, port, meshcat_port)
