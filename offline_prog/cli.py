@@ -159,6 +159,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "robots":
             _run_robots(args, console)
             return 0
+        if args.command == "session":
+            from offline_prog.session.launch import run_session
+
+            run_session(args.cell, host=args.host, port=args.port, seconds=args.seconds,
+                        open_browser=not args.no_browser, say=console.print)  # fmt: skip
+            return 0
         if args.command == "preview":
             args.preview, args.out = True, None
         out = args.out or Path("out") / args.cell.stem

@@ -80,6 +80,7 @@ def parser() -> argparse.ArgumentParser:
         default=None,
         help="keep the server this long (default: until Ctrl-C)",
     )
+    _session_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
@@ -137,3 +138,24 @@ def parser() -> argparse.ArgumentParser:
         help="split programs longer than this (KRL 1400, RAPID 5000)",
     )
     return parser
+
+
+def _session_flags(commands) -> None:
+    """``session CELL.yaml [--port 7000] [--host localhost] [--no-browser]``."""
+    session = commands.add_parser(
+        "session", help="adjust the cell in the browser (MeshCat), re-plan live, export"
+    )
+    session.add_argument("cell", type=Path, help="work-cell YAML file")
+    session.add_argument(
+        "--port", type=_number(int, low=1, inclusive=True, high=65534), default=7000,
+        help="panel port (default 7000); MeshCat uses the next one",
+    )  # fmt: skip
+    session.add_argument(
+        "--host", default="localhost",
+        help="listen on this host (default localhost; 0.0.0.0: every interface)",
+    )  # fmt: skip
+    session.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    session.add_argument(
+        "--seconds", type=_number(float, low=0.0, inclusive=True), default=None,
+        help="stop after this long (default: until Ctrl-C)",
+    )  # fmt: skip

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell
@@ -52,6 +53,8 @@ from offline_prog.path.sources import PathPoints
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import (
+    FittedPath,
+    FlangePaths,
     Inputs,
     attempt_motion,
     avoid,
@@ -148,12 +151,21 @@ class StageTimer:
 def plan_seam(inputs: Inputs, scene: DrakeCell, stage: StageTimer) -> Plan:
     """The single-seam pipeline on loaded inputs and a built scene: fit, frames, joints,
     collision avoidance, clearance profile (paper §§2–4)."""
-    file = inputs.file
     fit = stage("fit", "fitting the B-spline", fit_path, inputs)
     flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
+    return plan_flanges(inputs, scene, fit, flanges, stage)
+
+
+def plan_flanges(
+    inputs: Inputs, scene: DrakeCell, fit: FittedPath, flanges: FlangePaths, stage: StageTimer,
+    *, first: Attempt | None = None, clearance_profile: bool = True,
+) -> Plan:  # fmt: skip
+    """:func:`plan_seam` after the flange paths: joints (or the caller's ``first`` joint
+    plan), collision avoidance, and the clearance profile unless told not to."""
+    file = inputs.file
     rotation, flange = flanges.rotations[0]
     try:
-        first = stage(
+        first = first or stage(
             "joints", "joint trajectory and collision check", attempt_motion, inputs, scene,
             rotation, flange,
         )  # fmt: skip
@@ -164,9 +176,11 @@ def plan_seam(inputs: Inputs, scene: DrakeCell, stage: StageTimer) -> Plan:
         stage.progress,
     )  # fmt: skip
     traj = chosen.joints.trajectory
-    profile = stage(
-        "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
-    )
+    profile = None
+    if clearance_profile:
+        profile = stage(
+            "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
+        )
     timings = stage.timings_s
     return Plan(
         file,

@@ -1,6 +1,7 @@
 """Benchmark: plan the demo cells stage by stage, and compare path IK with references.
 
-Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]``
+Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]
+[--only command|collision|session]``
 
 All figures come from the same process on the same machine, so the ratios
 hold even where the absolute numbers drift. Path IK is compared on one flange
@@ -242,15 +243,48 @@ def bench_path_ik(file: Path, n_samples: int, n_drake: int) -> None:
     print(f"  per-sample cost offline_prog / py-opw-kinematics: {opw_rate / ours_rate:6.2f}x")
 
 
+def bench_session(cells: list[Path], repeats: int = 3) -> None:
+    """Re-plan latency of ``offline-prog session``: a tool-pose change (X_IT x ± 5 mm) and
+    a speed change (± 10 %) after the first plan, each a fresh value (no cache hit); the
+    median and the slowest of ``repeats``, and the stages that ran."""
+    from offline_prog.session.replan import Replanner
+    from offline_prog.session.state import values, with_value
+
+    print(f"\n== session: re-plan latency (median / slowest of {repeats}) ==")
+    for file in cells:
+        planner = Replanner(file)
+        first = planner.plan(planner.initial)
+        line = f"{file.stem:24s} first {first.seconds:5.2f} s"
+        for name, key, steps in (
+            ("tool pose", "X_IT.x", [5.0, -5.0] * repeats),
+            ("speed", "speed", [1.1, 0.9] * repeats),
+        ):
+            state, seconds, ran = planner.initial, [], None
+            planner.plan(state)
+            for step in steps[:repeats]:
+                value = values(planner.initial)[key]
+                state = with_value(state, key, value + step if key == "X_IT.x" else value * step)
+                result = planner.plan(state)
+                seconds.append(result.seconds)
+                ran = result.ran
+            line += f"  {name} {np.median(seconds):5.2f} / {max(seconds):5.2f} s ({', '.join(ran)})"
+        print(line)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=5000)
     parser.add_argument("--drake-samples", type=int, default=300)
     parser.add_argument(
-        "--only", choices=["command", "collision", "timing"], help="run one part of the benchmark"
+        "--only",
+        choices=["command", "collision", "timing", "session"],
+        help="run one part of the benchmark",
     )
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
+    if args.only == "session":
+        bench_session(cells)
+        return
     if args.only == "collision":
         bench_collision(cells)
         return
@@ -262,6 +296,7 @@ def main() -> None:
         return
     bench_stages(cells)
     bench_collision(cells)
+    bench_session(cells)
     for file in cells:
         bench_path_ik(file, args.samples, args.drake_samples)
     bench_timing()

@@ -1,0 +1,143 @@
+"""Save: the session's values written into the original cell file's text.
+
+Only the numbers that changed are replaced, each at its place in the text (the YAML
+node's marks), so comments, key order, flow or block style and every other value stay
+as the engineer wrote them. A key the file does not give (``motion.clearance`` left at
+its default) is added to its mapping; a transform whose rotation is not an ``!Rpy``
+is rewritten whole as ``{translation: [...], rotation: !Rpy {deg: [...]}}``. The
+result is loaded again and compared with the session's cell before it is written.
+"""
+
+from __future__ import annotations
+
+import yaml
+
+from offline_prog.session.state import SessionState
+
+
+def number(value: float) -> str:
+    """The shortest text that reads back as ``value`` (no ``-0.0``)."""
+    return repr(float(value) + 0.0)
+
+
+def _child(node, key: str):
+    """The value node under ``key`` of a mapping node, or None."""
+    if isinstance(node, yaml.MappingNode):
+        for k, v in node.value:
+            if isinstance(k, yaml.ScalarNode) and k.value == key:
+                return v
+    return None
+
+
+def _find(root, dotted: str):
+    node = root
+    for part in dotted.split("."):
+        if part.isdigit():
+            node = node.value[int(part)] if isinstance(node, yaml.SequenceNode) else None
+        else:
+            node = _child(node, part)
+        if node is None:
+            return None
+    return node
+
+
+class _Edits:
+    """Text replacements at node marks, applied back to front."""
+
+    def __init__(self, text: str):
+        self.text, self.edits = text, []
+
+    def replace(self, node, new: str) -> None:
+        self.edits.append((node.start_mark.index, _end(node), new))
+
+    def scalar(self, node, value: float) -> None:
+        """Replace a number, unless the text already reads as ``value``."""
+        if float(node.value) != value:
+            self.replace(node, number(value))
+
+    def add(self, mapping, key: str, value: str) -> None:
+        """Add ``key: value`` to a mapping node (flow or block)."""
+        if mapping.flow_style:
+            at = mapping.end_mark.index - 1  # before the closing brace
+            sep = ", " if mapping.value else ""
+            self.edits.append((at, at, f"{sep}{key}: {value}"))
+            return
+        last = mapping.value[-1][1]
+        indent = " " * mapping.value[0][0].start_mark.column
+        at = _end(last)
+        line_end = self.text.find("\n", at)
+        at = len(self.text) if line_end < 0 else line_end  # after a trailing comment
+        self.edits.append((at, at, f"\n{indent}{key}: {value}"))
+
+    def result(self) -> str:
+        text = self.text
+        for start, end, new in sorted(self.edits, key=lambda e: e[0], reverse=True):
+            text = text[:start] + new + text[end:]
+        return text
+
+
+def _end(node) -> int:
+    """Where a node's own text ends: a block collection's end mark lies past the
+    comments after it, so take its last child's end."""
+    if isinstance(node, yaml.ScalarNode) or getattr(node, "flow_style", False):
+        return node.end_mark.index
+    children = node.value
+    if not children:
+        return node.end_mark.index
+    last = children[-1][1] if isinstance(node, yaml.MappingNode) else children[-1]
+    return _end(last)
+
+
+def _transform(edits: _Edits, node, p: tuple, rpy_deg: tuple) -> None:
+    """Set a transform node's translation and !Rpy degrees (only the changed numbers)."""
+    translation, rotation = _child(node, "translation"), _child(node, "rotation")
+    deg = _child(rotation, "deg") if rotation is not None and rotation.tag == "!Rpy" else None
+    flat = isinstance(node, yaml.MappingNode) and all(
+        isinstance(n, yaml.SequenceNode) and len(n.value) == 3 for n in (translation, deg)
+    )
+    if not flat:
+        text = (
+            f"{{translation: [{', '.join(map(number, p))}], "
+            f"rotation: !Rpy {{deg: [{', '.join(map(number, rpy_deg))}]}}}}"
+        )
+        edits.replace(node, text)
+        return
+    for sequence, values in ((translation, p), (deg, rpy_deg)):
+        for item, value in zip(sequence.value, values, strict=True):
+            edits.scalar(item, value)
+
+
+def edited_text(text: str, initial: SessionState, state: SessionState) -> str:
+    """The cell file's ``text`` with the state's changed values written in.
+
+    Raises:
+        ValueError: the text does not hold a key it must (a cell file that loaded
+            always does).
+    """
+    # The pure-Python loader: its marks count characters (libyaml's need not).
+    root = yaml.compose(text, Loader=yaml.SafeLoader)
+    edits = _Edits(text)
+    for key, p, rpy, p0, rpy0 in (
+        ("tool.X_IT", state.p_IT, state.rpy_IT_deg, initial.p_IT, initial.rpy_IT_deg),
+        ("part.X_PE", state.p_PE, state.rpy_PE_deg, initial.p_PE, initial.rpy_PE_deg),
+    ):
+        if (p, rpy) != (p0, rpy0):
+            node = _find(root, key)
+            if node is None:
+                raise ValueError(f"{key} not found in the cell file")
+            _transform(edits, node, p, rpy)
+    for owner, key, value, value0 in (
+        ("tool", "free_rotation_deg", state.free_rotation_deg, initial.free_rotation_deg),
+        ("motion", "speed", state.motion_speed, initial.motion_speed),
+        ("motion", "clearance", state.clearance, initial.clearance),
+    ):
+        if value != value0:
+            node = _find(root, f"{owner}.{key}")
+            if node is None:
+                edits.add(_find(root, owner), key, number(value))
+            else:
+                edits.scalar(node, value)
+    for k, (speed, speed0) in enumerate(zip(state.seam_speeds, initial.seam_speeds, strict=True)):
+        if speed != speed0:  # a seam's own speed: given in the file (None is never edited)
+            edits.scalar(_find(root, f"seams.{k}.speed"), speed)
+    return edits.result()

@@ -1,0 +1,270 @@
+"""The session loop: the panel's requests, the planner thread and the MeshCat scene.
+
+Three kinds of thread, each with its own job:
+
+- the panel's HTTP threads only read a snapshot and post requests (under ``lock``);
+- one planner thread runs the cached pipeline, Save and Export, newest request first;
+- the main thread owns the MeshCat (Drake's rule): it hands requests to the planner,
+  draws the answers and animates the robot.
+
+Every change of the parameters gets a new generation number. A plan is drawn and
+reported as current only if its generation is still the newest; an older one that
+finishes late is dropped, and a plan still running when a newer request arrives stops
+at its next stage. While the shown plan is older than the controls, the status says so
+and the path is grey.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import queue
+import threading
+import time
+from pathlib import Path
+
+from offline_prog.config.cell import transform
+from offline_prog.errors import InputError
+from offline_prog.scene.drake_cell import build_cell_model
+from offline_prog.session import outputs
+from offline_prog.session.replan import Replanner, SupersededError
+from offline_prog.session.scene_view import SceneView
+from offline_prog.session.state import controls, values, with_value
+from offline_prog.session.status import plan_status
+
+log = logging.getLogger(__name__)
+
+SETTLE_S = 0.3  # a control untouched this long has settled: re-plan
+FRAME_S = 1.0 / 30.0  # main-loop period (animation frames)
+
+
+class Session:
+    """One cell file in the browser (see the module docstring)."""
+
+    def __init__(self, cell_file: Path, meshcat, *, out_root: Path = Path("out")):
+        self.replanner = Replanner(cell_file)
+        self.file, self.out_root = Path(cell_file), Path(out_root)
+        self.state = self.replanner.initial
+        self.lock = threading.Lock()
+        self.generation, self.changed_at, self.plan_now = 1, 0.0, True
+        self.auto = True
+        self.running = None  # (generation, stage) being planned
+        self.shown_generation = self.requested_generation = 0
+        self.message = ("info", "")
+        self.saved: dict = {}  # state → saved file
+        self.last_saved = self.last_exported = None
+        self.playing, self.t, self.sigma = False, 0.0, 0.0
+        self.last_step = time.monotonic()
+        self.seek: float | None = None  # σ [m] asked for by the panel
+        self.plan_line = {"kind": "planning", "line": "planning…"}
+        self.requests: queue.Queue = queue.Queue()
+        self.answers: queue.Queue = queue.Queue()
+        cell = self.replanner.base.cell
+        drake = build_cell_model(cell, self.file, self.replanner.base.robot, meshcat=meshcat)
+        self.view = SceneView(meshcat, drake, transform(cell.tool.X_IT))
+        self.worker = threading.Thread(target=self._work, name="session-planner", daemon=True)
+        self.worker.start()
+
+    # --- the panel's side (HTTP threads) --------------------------------------------
+
+    def snapshot(self) -> dict:
+        """Everything the panel shows, as JSON-ready values."""
+        with self.lock:
+            shown = self.view.shown
+            duration = length = 0.0
+            if shown is not None and shown.plan is not None:
+                duration = float(shown.plan.trajectory.t[-1])
+                length = float(shown.plan.trajectory.s[-1])
+            current = self.shown_generation == self.generation
+            return {
+                "cell": str(self.file),
+                "generation": self.generation,
+                "shown_generation": self.shown_generation,
+                "current": current,
+                "busy": None if self.running is None else self.running[1],
+                "status": self.plan_line if current else {
+                    "kind": "planning",
+                    "line": "re-planning… (the plan shown is for earlier values)"
+                    if self.shown_generation else "planning…",
+                },  # fmt: skip
+                "shown": self.plan_line,
+                "message": {"kind": self.message[0], "text": self.message[1]},
+                "values": values(self.state),
+                "controls": [dataclasses.asdict(c) for c in
+                             controls(self.replanner.initial, self.replanner.seam_names)],
+                "seams": self.replanner.seam_names,
+                "auto": self.auto,
+                "playing": self.playing,
+                "t": self.t,
+                "sigma": self.sigma,
+                "duration": duration,
+                "length": length,
+                "saved": None if self.last_saved is None else str(self.last_saved),
+                "exported": None if self.last_exported is None else str(self.last_exported),
+            }  # fmt: skip
+
+    def set_value(self, key: str, text) -> dict:
+        """A typed or slid value: the new state, or refused with a message (state kept)."""
+        with self.lock:
+            try:
+                state = with_value(self.state, str(key), text)
+            except ValueError as error:
+                self.message = ("refused", f"refused {key} = {str(text)[:40]!r}: {error}")
+                return {"ok": False, "message": self.message[1]}
+            if state != self.state:
+                self.state, self.changed_at = state, time.monotonic()
+                self.generation += 1
+                self.message = ("info", f"{key} = {values(state)[key]:g}")
+            return {"ok": True}
+
+    def action(self, name: str, value=None) -> dict:
+        """Buttons: plan, save, export, play, pause, seek (σ [mm]), auto (on/off)."""
+        with self.lock:
+            if name == "plan":
+                self.generation += 1
+                self.plan_now = True
+            elif name in ("save", "export"):
+                self.requests.put((name, self.generation, self.state))
+                self.message = ("info", f"{name}…")
+            elif name in ("play", "pause"):
+                self.playing = name == "play"
+            elif name == "seek":
+                try:
+                    self.seek = float(value) * 1e-3
+                except (TypeError, ValueError):
+                    return {"ok": False, "message": f"σ {value!r} is not a number"}
+                self.playing = False
+            elif name == "auto":
+                self.auto = bool(value)
+            else:
+                return {"ok": False, "message": f"no action {name!r}"}
+            return {"ok": True}
+
+    # --- the planner thread ------------------------------------------------------------
+
+    def _work(self) -> None:
+        while True:
+            kind, generation, state = self.requests.get()
+            if kind == "plan":  # only the newest plan request matters
+                kind, generation, state = self._newest(kind, generation, state)
+            try:
+                self.answers.put((kind, generation, self._do(kind, generation, state)))
+            except SupersededError:
+                continue
+            except Exception as error:  # the session never dies of one request
+                log.exception("session request %s failed", kind)
+                self.answers.put((kind, generation, error))
+            finally:
+                with self.lock:
+                    self.running = None
+
+    def _newest(self, kind, generation, state):
+        try:
+            while True:
+                nxt = self.requests.get_nowait()
+                if nxt[0] != "plan":
+                    self.requests.put(nxt)  # keep Save/Export for after this plan
+                    return kind, generation, state
+                kind, generation, state = nxt
+        except queue.Empty:
+            return kind, generation, state
+
+    def _progress(self, generation: int, *, supersede: bool):
+        def progress(stage: str) -> None:
+            with self.lock:
+                if supersede and generation < self.generation:
+                    raise SupersededError  # its answer would be dropped: stop here
+                self.running = (generation, stage)
+
+        return progress
+
+    def _do(self, kind: str, generation: int, state):
+        progress = self._progress(generation, supersede=kind == "plan")
+        if kind == "plan":
+            return self.replanner.plan(state, progress)
+        saved = self.saved.get(state)
+        if saved is None or not saved.exists():
+            planner = self.replanner
+            saved = outputs.save_cell(planner.file, planner.initial, state, planner.cell(state))
+            self.saved[state] = saved
+        if kind == "save":
+            return saved
+        result = self.replanner.plan(state, progress)
+        out = self.out_root / saved.stem
+        return saved, *outputs.export(self.replanner, result, saved, out, progress)
+
+    # --- the main thread: MeshCat -------------------------------------------------------
+
+    def step(self) -> None:
+        """One main-loop round: hand out a due plan, draw answers, animate."""
+        now = time.monotonic()
+        with self.lock:
+            due = self.generation != self.shown_generation and (
+                self.plan_now or (self.auto and now - self.changed_at > SETTLE_S)
+            )
+            if due and self.requested_generation != self.generation:
+                self.requests.put(("plan", self.generation, self.state))
+                self.requested_generation, self.plan_now = self.generation, False
+            X_IT = transform(self.replanner.cell(self.state).tool.X_IT)
+            outdated = self.generation != self.shown_generation
+            seek, self.seek = self.seek, None
+        elapsed, self.last_step = now - self.last_step, now
+        try:
+            self.view.show_tool(X_IT)
+            while True:
+                try:
+                    kind, generation, answer = self.answers.get_nowait()
+                except queue.Empty:
+                    break
+                self._answer(kind, generation, answer)
+            if self.view.shown is not None and self.view.shown.plan is not None:
+                traj = self.view.shown.plan.trajectory
+                if seek is not None:
+                    self.t = float(_time_at(traj, seek))
+                elif self.playing:  # real time, looping
+                    self.t = (self.t + min(elapsed, 0.2)) % max(traj.t[-1], FRAME_S)
+                self.sigma = self.view.pose(min(self.t, traj.t[-1]))
+            self.view.set_outdated(outdated)
+        except Exception as error:  # a drawing error costs the picture, not the session
+            log.exception("session scene update failed")
+            with self.lock:
+                self.message = ("refused", f"scene update failed: {error}")
+
+    def _answer(self, kind: str, generation: int, answer) -> None:
+        if isinstance(answer, Exception):
+            text = f"{kind} failed: {answer}"
+            if isinstance(answer, InputError | OSError):
+                text = f"{kind} refused: {answer}"
+            with self.lock:
+                self.message = ("refused", text)
+            return
+        if kind == "save":
+            with self.lock:
+                self.last_saved = answer
+                self.message = ("info", f"saved {answer}")
+            return
+        if kind == "export":
+            saved, folder, line = answer
+            with self.lock:
+                self.last_saved, self.last_exported = saved, folder
+                self.message = ("info", line)
+            return
+        with self.lock:
+            if generation != self.generation:
+                return  # stale: the controls moved on while it was planned
+        self.view.show(answer)
+        planner = self.replanner
+        line = plan_status(answer, planner.seam_names[answer.state.seam] if planner.is_job else "")
+        with self.lock:
+            self.shown_generation, self.plan_line = generation, line
+        plan = answer.plan
+        if plan is not None and not plan.feasible and plan.collisions.closest is not None:
+            self.t, self.playing = plan.collisions.closest.t_s, False  # show the worst pose
+        elif plan is not None:
+            self.t = min(self.t, float(plan.trajectory.t[-1]))
+
+
+def _time_at(traj, sigma: float) -> float:
+    import numpy as np
+
+    return float(np.interp(sigma, traj.s, traj.t))

@@ -1,0 +1,226 @@
+"""The parameters a session edits, the controls that edit them, and the Cell they make.
+
+:class:`SessionState` holds SI values (and degrees where the cell file keeps degrees, so
+a saved file carries the typed numbers unchanged). Controls speak millimetres and
+degrees (the edges); :func:`with_value` parses a typed value and refuses a bad one
+with a one-line reason, leaving the state as it was. :func:`apply` replaces only the
+changed fields of the original Cell, so an unchanged transform keeps its own schema
+value (an AngleAxis stays one).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from pydrake.common.schema import Rotation, Transform
+from pydrake.math import RollPitchYaw
+
+from offline_prog.config.cell import Cell, transform
+from offline_prog.constants import MAX_SPEED_M_S
+
+MAX_OFFSET_MM = 10_000.0  # a tool stand or grasp farther than 10 m is a typo
+MAX_ANGLE_DEG = 360.0
+MAX_CLEARANCE_MM = 500.0
+ROUND_DEG = 9  # decimals kept of angles read from a rotation that is not an Rpy
+
+
+@dataclasses.dataclass(frozen=True)
+class SessionState:
+    """The editable parameters of a cell (one seam of it active).
+
+    Attributes:
+        p_IT: tool T's origin in I [m]; rpy_IT_deg: its roll, pitch, yaw [deg].
+        p_PE: flange E's origin in the part P [m]; rpy_PE_deg: its roll, pitch, yaw [deg].
+        motion_speed: motion.speed [m/s].
+        seam_speeds: each seam's own speed [m/s] (None: it runs at motion.speed).
+        free_rotation_deg: tool.free_rotation_deg [deg].
+        clearance: motion.clearance [m].
+        seam: the active seam's index.
+    """
+
+    p_IT: tuple[float, float, float]
+    rpy_IT_deg: tuple[float, float, float]
+    p_PE: tuple[float, float, float]
+    rpy_PE_deg: tuple[float, float, float]
+    motion_speed: float
+    seam_speeds: tuple[float | None, ...]
+    free_rotation_deg: float
+    clearance: float
+    seam: int = 0
+
+    @property
+    def speed(self) -> float:
+        """The active seam's process speed [m/s]."""
+        own = self.seam_speeds[self.seam]
+        return self.motion_speed if own is None else own
+
+
+@dataclasses.dataclass(frozen=True)
+class Control:
+    """One control of the panel: its key, label, unit and slider range (UI units)."""
+
+    key: str
+    group: str
+    label: str
+    unit: str
+    low: float
+    high: float
+    step: float
+
+
+def _rpy_deg(value: Transform) -> tuple[float, float, float]:
+    """Roll, pitch, yaw [deg] of a schema transform: an Rpy's own numbers."""
+    rotation = value.rotation.value
+    if isinstance(rotation, Rotation.Rpy):
+        return tuple(float(d) for d in rotation.deg)
+    rpy = RollPitchYaw(transform(value).rotation()).vector()
+    return tuple(round(float(np.rad2deg(a)), ROUND_DEG) + 0.0 for a in rpy)
+
+
+def initial_state(cell: Cell) -> SessionState:
+    """The state of a cell as loaded (seam 0 active)."""
+    seams = cell.seams or [None]
+    return SessionState(
+        tuple(float(v) for v in cell.tool.X_IT.translation),
+        _rpy_deg(cell.tool.X_IT),
+        tuple(float(v) for v in cell.part.X_PE.translation),
+        _rpy_deg(cell.part.X_PE),
+        float(cell.motion.speed),
+        tuple(None if s is None or s.speed is None else float(s.speed) for s in seams),
+        float(cell.tool.free_rotation_deg),
+        float(cell.motion.clearance),
+    )
+
+
+def schema_transform(p: tuple, rpy_deg: tuple) -> Transform:
+    """The cell file's ``{translation: p, rotation: !Rpy {deg: rpy_deg}}``."""
+    rpy = Rotation.Rpy()
+    rpy.deg = list(rpy_deg)
+    value = Transform()
+    value.translation = list(p)
+    value.rotation = Rotation()
+    value.rotation.value = rpy
+    return value
+
+
+def apply(cell: Cell, initial: SessionState, state: SessionState) -> Cell:
+    """The cell with the state's values where they differ from ``initial``."""
+    tool, part, motion, seams = cell.tool, cell.part, cell.motion, cell.seams
+    if (state.p_IT, state.rpy_IT_deg) != (initial.p_IT, initial.rpy_IT_deg):
+        tool = dataclasses.replace(tool, X_IT=schema_transform(state.p_IT, state.rpy_IT_deg))
+    if state.free_rotation_deg != initial.free_rotation_deg:
+        tool = dataclasses.replace(tool, free_rotation_deg=state.free_rotation_deg)
+    if (state.p_PE, state.rpy_PE_deg) != (initial.p_PE, initial.rpy_PE_deg):
+        part = dataclasses.replace(part, X_PE=schema_transform(state.p_PE, state.rpy_PE_deg))
+    if state.motion_speed != initial.motion_speed:
+        motion = dataclasses.replace(motion, speed=state.motion_speed)
+    if state.clearance != initial.clearance:
+        motion = dataclasses.replace(motion, clearance=state.clearance)
+    if state.seam_speeds != initial.seam_speeds:
+        seams = [
+            dataclasses.replace(seam, speed=speed) if speed != old else seam
+            for seam, speed, old in zip(seams, state.seam_speeds, initial.seam_speeds, strict=True)
+        ]
+    return dataclasses.replace(cell, tool=tool, part=part, motion=motion, seams=seams)
+
+
+def controls(state: SessionState, seam_names: list[str]) -> list[Control]:
+    """The panel's controls; slider ranges around the initial values (a typed value may
+    leave them, within the checks of :func:`with_value`)."""
+    out = []
+    for frame, group, p in (
+        ("X_IT", "tool pose X_IT", state.p_IT),
+        ("X_PE", "grasp X_PE", state.p_PE),
+    ):
+        for axis, value in zip("xyz", p, strict=True):
+            mm = value * 1e3
+            out.append(Control(f"{frame}.{axis}", group, axis, "mm", mm - 300, mm + 300, 1))
+        for name in ("roll", "pitch", "yaw"):
+            out.append(Control(f"{frame}.{name}", group, name, "°", -180, 180, 0.5))
+    top = max(4 * max([state.motion_speed, *filter(None, state.seam_speeds)]) * 1e3, 10.0)
+    out += [
+        Control("speed", "process", "speed", "mm/s", 0.5, round(top), 0.5),
+        Control("free_rotation", "process", "free tool rotation", "°", 0, 180, 1),
+        Control("clearance", "process", "clearance", "mm", 0, 50, 0.5),
+    ]
+    if len(seam_names) > 1:
+        out.append(Control("seam", "process", "active seam", "", 0, len(seam_names) - 1, 1))
+    return out
+
+
+def values(state: SessionState) -> dict[str, float]:
+    """Each control's value in its unit (mm, mm/s, deg, index)."""
+    out = {}
+    for frame, p, rpy in (
+        ("X_IT", state.p_IT, state.rpy_IT_deg),
+        ("X_PE", state.p_PE, state.rpy_PE_deg),
+    ):
+        out.update({f"{frame}.{a}": round(v * 1e3, 6) for a, v in zip("xyz", p, strict=True)})
+        names = ("roll", "pitch", "yaw")
+        out.update({f"{frame}.{n}": v for n, v in zip(names, rpy, strict=True)})
+    out.update(
+        speed=round(state.speed * 1e3, 6),
+        free_rotation=state.free_rotation_deg,
+        clearance=round(state.clearance * 1e3, 6),
+        seam=state.seam,
+    )
+    return out
+
+
+def _number(text) -> float:
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        raise ValueError(f"{str(text)[:40]!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{text!r} is not a finite number")
+    return value
+
+
+def _within(value: float, low: float, high: float, unit: str, *, open_low=False) -> None:
+    if (value <= low if open_low else value < low) or value > high:
+        bound = f"> {low:g}" if open_low else f"≥ {low:g}"
+        raise ValueError(f"must be {bound} and ≤ {high:g} {unit}")
+
+
+def with_value(state: SessionState, key: str, text) -> SessionState:
+    """The state with control ``key`` set to the typed ``text`` (in the control's unit).
+
+    Raises:
+        ValueError: an unknown key, or a value that is not a number or out of range
+            (one line: the session shows it and keeps the state).
+    """
+    value = _number(text)
+    frame, _, part = key.partition(".")
+    if frame in ("X_IT", "X_PE") and part in ("x", "y", "z"):
+        _within(value, -MAX_OFFSET_MM, MAX_OFFSET_MM, "mm")
+        name = "p_IT" if frame == "X_IT" else "p_PE"
+        p = list(getattr(state, name))
+        p["xyz".index(part)] = value * 1e-3
+        return dataclasses.replace(state, **{name: tuple(p)})
+    if frame in ("X_IT", "X_PE") and part in ("roll", "pitch", "yaw"):
+        _within(value, -MAX_ANGLE_DEG, MAX_ANGLE_DEG, "°")
+        name = "rpy_IT_deg" if frame == "X_IT" else "rpy_PE_deg"
+        rpy = list(getattr(state, name))
+        rpy[("roll", "pitch", "yaw").index(part)] = value
+        return dataclasses.replace(state, **{name: tuple(rpy)})
+    if key == "speed":
+        _within(value, 0.0, MAX_SPEED_M_S * 1e3, "mm/s", open_low=True)
+        if state.seam_speeds[state.seam] is None:
+            return dataclasses.replace(state, motion_speed=value * 1e-3)
+        speeds = list(state.seam_speeds)
+        speeds[state.seam] = value * 1e-3
+        return dataclasses.replace(state, seam_speeds=tuple(speeds))
+    if key == "free_rotation":
+        _within(value, 0.0, 180.0, "°")
+        return dataclasses.replace(state, free_rotation_deg=value)
+    if key == "clearance":
+        _within(value, 0.0, MAX_CLEARANCE_MM, "mm")
+        return dataclasses.replace(state, clearance=value * 1e-3)
+    if key == "seam":
+        if value != int(value) or not 0 <= value < len(state.seam_speeds):
+            raise ValueError(f"{value:g}: no such seam (0 to {len(state.seam_speeds) - 1})")
+        return dataclasses.replace(state, seam=int(value))
+    raise ValueError(f"{key!r} is not a control")

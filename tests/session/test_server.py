@@ -1,0 +1,101 @@
+"""The session loop without a browser: refused values keep the session and its state,
+a plan older than the controls is never shown as current, a plan still running when
+the controls move on stops at its next stage."""
+
+import time
+
+import pytest
+from pydrake.geometry import Meshcat
+
+from offline_prog.session.replan import SupersededError
+from offline_prog.session.server import Session
+
+from conftest import CELLS
+
+TIMEOUT_S = 30
+
+
+def run_until(session: Session, done) -> None:
+    deadline = time.monotonic() + TIMEOUT_S
+    while not done():
+        assert time.monotonic() < deadline, session.snapshot()["status"]
+        session.step()
+        time.sleep(0.01)
+
+
+@pytest.fixture(scope="module")
+def session():
+    session = Session(CELLS / "tape_cylinder_ur10e.yaml", Meshcat())
+    run_until(session, lambda: session.snapshot()["current"])
+    return session
+
+
+def test_the_first_plan_is_shown_with_its_figures(session):
+    snapshot = session.snapshot()
+    status = snapshot["status"]
+    assert status["kind"] == "feasible" and status["line"].startswith("feasible · cycle")
+    assert snapshot["duration"] > 0 and snapshot["length"] > 0
+    assert status["details"]["samples"]["colliding"] == 0
+
+
+def test_a_bad_value_is_refused_and_the_session_goes_on(session):
+    before = session.snapshot()
+    reply = session.set_value("speed", "-3")
+    after = session.snapshot()
+    assert reply["ok"] is False and after["message"]["kind"] == "refused"
+    assert "refused speed = '-3': must be > 0" in after["message"]["text"]
+    assert after["values"] == before["values"] and after["current"]
+    assert session.action("seek", "abc")["ok"] is False
+    session.step()  # nothing to re-plan
+    assert session.snapshot()["generation"] == before["generation"]
+
+
+def test_an_older_plan_is_never_shown_as_current(session):
+    old = session.view.shown
+    assert session.set_value("X_IT.y", 5)["ok"]
+    snapshot = session.snapshot()
+    assert not snapshot["current"] and snapshot["status"]["kind"] == "planning"
+    # A late answer for the previous values: dropped, not drawn.
+    session.answers.put(("plan", snapshot["generation"] - 1, old))
+    session.step()
+    assert session.view.shown is old and not session.snapshot()["current"]
+    run_until(session, lambda: session.snapshot()["current"])
+    shown = session.view.shown
+    assert shown is not old and shown.state.p_IT[1] == pytest.approx(0.005)
+
+
+def test_a_running_plan_stops_when_the_controls_move_on(session):
+    generation = session.snapshot()["generation"]
+    progress = session._progress(generation, supersede=True)
+    progress("fitting")  # still the newest: goes on
+    session.set_value("X_IT.y", 6)
+    with pytest.raises(SupersededError):
+        progress("joints")
+    run_until(session, lambda: session.snapshot()["current"])
+
+
+@pytest.mark.slow
+def test_a_job_plans_the_active_seam_and_exports_the_whole_job(tmp_path):
+    """seam picks the seam planned live; its own speed is the one edited; Export saves
+    the cell and writes the job's plan folder as `plan` does."""
+    import json
+    import shutil
+
+    cell = tmp_path / "job.yaml"
+    shutil.copyfile(CELLS / "seal_job_kr16.yaml", cell)
+    session = Session(cell, Meshcat(), out_root=tmp_path / "out")
+    run_until(session, lambda: session.snapshot()["current"])
+    assert session.snapshot()["status"]["line"].startswith("seam border: feasible")
+    session.set_value("seam", 3)
+    assert session.snapshot()["values"]["speed"] == 150.0  # the stripe's own speed
+    session.set_value("speed", 120)
+    run_until(session, lambda: session.snapshot()["current"])
+    assert session.snapshot()["status"]["line"].startswith("seam stripe: feasible")
+    session.action("export")
+    run_until(session, lambda: session.snapshot()["exported"] is not None)
+    saved = tmp_path / "job-1.yaml"
+    assert session.snapshot()["saved"] == str(saved)
+    assert "    speed: 0.12\n" in saved.read_text()
+    report = json.loads((tmp_path / "out" / "job-1" / "report.json").read_text())
+    assert [s["seam"] for s in report["seams"]].count("stripe") == 1
+    assert report["cell"] == str(saved)
