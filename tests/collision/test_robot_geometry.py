@@ -4,6 +4,7 @@ is checked only for the pairs the robot's matrix marks ``check``, each at its cl
 import dataclasses
 
 import numpy as np
+import pytest
 from pydrake.math import RigidTransform
 
 from offline_prog.collision.check import check_trajectory
@@ -72,6 +73,7 @@ def test_self_pairs_are_held_to_the_self_clearance():
     assert loose.collision_free
 
 
+@pytest.mark.slow  # a full plan on a changed cell (~8 s)
 def test_the_fixed_layout_is_checked_a_duct_through_the_base_fails(tmp_path):
     """Drake filters pairs of bodies welded together (robot base, tool, obstacles); a
     cable duct through the KR 16's base must still fail the plan, while the base
