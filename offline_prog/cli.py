@@ -109,6 +109,54 @@ def _serve_preview(plan, args, console: Console) -> None:
         pass
 
 
+def _run_place(args, console: Console, errors: Console) -> None:
+    """``place``: the search with a progress bar on stderr, then a short summary."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    from offline_prog.placement.run import place_cell
+
+    out = args.out or Path("out") / f"{args.cell.stem}_place"
+    labels = {"screen": "screening (path IK)", "plan": "planning candidates",
+              "outputs": "writing outputs"}  # fmt: skip
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
+    with Progress(*columns, console=errors, transient=True) as bar:
+        tasks = {}
+
+        def progress(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(labels[stage], total=total)
+            bar.update(tasks[stage], completed=done)
+
+        data = place_cell(
+            args.cell, out, budget=args.budget, seed=args.seed, workers=args.workers,
+            scheduler=args.scheduler, progress=progress,
+        )  # fmt: skip
+    best, cut, engine = data["best"], data["cycle_time_cut"], data["engine"]
+    verdict = "feasible" if best["feasible"] else f"infeasible ({best['reason']})"
+    console.print(f"best placement: {verdict}", highlight=False, markup=False)
+    if best["feasible"]:
+        p, rpy = best["X_IT"]["translation"], best["X_IT"]["rpy_deg"]
+        console.print(
+            f"  X_IT translation [mm] {', '.join(f'{1e3 * v:.1f}' for v in p)}, rpy [deg] "
+            f"{', '.join(f'{v:.2f}' for v in rpy)}; cycle {best['cycle_time_s']:.2f} s",
+            highlight=False,
+            markup=False,
+        )
+    if cut["percent"] is not None:
+        console.print(
+            f"  {cut['percent']:.1f} % faster than the cell as given", highlight=False, markup=False
+        )
+    if cut.get("why_not_more"):
+        console.print(f"  why not more: {cut['why_not_more']}", highlight=False, markup=False)
+    console.print(
+        f"{engine['candidates_evaluated']} candidates planned, {engine['screened']} screened, "
+        f"{engine['wall_time_s']:.1f} s on {engine['workers']} worker(s) "
+        f"({engine['scheduler']}); wrote {out}/placement.json, placed.yaml, placement.html",
+        highlight=False,
+        markup=False,
+    )
+
+
 def exit_code(error: BaseException, args) -> tuple[int, str]:
     """The exit code and the one stderr line for an error: the one place that maps
     errors to exit codes (README: "exit code")."""
@@ -164,6 +212,9 @@ def main(argv: list[str] | None = None) -> int:
 
             run_session(args.cell, host=args.host, port=args.port, seconds=args.seconds,
                         open_browser=not args.no_browser, say=console.print)  # fmt: skip
+            return 0
+        if args.command == "place":
+            _run_place(args, console, errors)
             return 0
         if args.command == "preview":
             args.preview, args.out = True, None

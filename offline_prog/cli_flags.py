@@ -81,6 +81,7 @@ def parser() -> argparse.ArgumentParser:
         help="keep the server this long (default: until Ctrl-C)",
     )
     _session_flags(commands)
+    _place_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
@@ -158,4 +159,32 @@ def _session_flags(commands) -> None:
     session.add_argument(
         "--seconds", type=_number(float, low=0.0, inclusive=True), default=None,
         help="stop after this long (default: until Ctrl-C)",
+    )  # fmt: skip
+
+
+def _place_flags(commands) -> None:
+    """``place CELL.yaml --out DIR [--budget N] [--seed S] [--workers N | --scheduler ADDR]``."""
+    place = commands.add_parser(
+        "place", help="search where the tool stands and how the part is held (place: block)"
+    )
+    place.add_argument("cell", type=Path, help="work-cell YAML file with a place: block")
+    place.add_argument(
+        "--out", type=Path, default=None, help="output folder (default: out/<cell name>_place)"
+    )
+    place.add_argument(
+        "--budget", type=_number(int, low=1, inclusive=True), default=None,
+        help="candidates through the planning pipeline (default: place.budget)",
+    )  # fmt: skip
+    place.add_argument(
+        "--seed", type=_number(int, low=0, inclusive=True), default=None,
+        help="search seed (default: place.seed)",
+    )  # fmt: skip
+    where = place.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers", type=_number(int, low=0, inclusive=True, high=1024), default=None,
+        help="Dask LocalCluster workers (default: one per core; 0: this process, no Dask)",
+    )  # fmt: skip
+    where.add_argument(
+        "--scheduler", default=None,
+        help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
     )  # fmt: skip

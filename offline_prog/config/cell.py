@@ -192,6 +192,54 @@ class MotionConfig:
 
 
 @dataclasses.dataclass
+class TranslationRanges:
+    """Search ranges of a translation [mm], per axis of the frame it is expressed in;
+    an axis not named keeps the cell's value."""
+
+    x: list[float] | None = None  # [low, high] mm
+    y: list[float] | None = None
+    z: list[float] | None = None
+
+
+@dataclasses.dataclass
+class RpyRanges:
+    """Search ranges of roll, pitch, yaw [deg]; an angle not named keeps the cell's."""
+
+    roll: list[float] | None = None  # [low, high] deg
+    pitch: list[float] | None = None
+    yaw: list[float] | None = None
+
+
+@dataclasses.dataclass
+class PoseRanges:
+    translation_mm: TranslationRanges = dataclasses.field(default_factory=TranslationRanges)
+    rpy_deg: RpyRanges = dataclasses.field(default_factory=RpyRanges)
+
+
+@dataclasses.dataclass
+class GraspRanges(PoseRanges):
+    """Grasps X_PE to choose from (default: part.X_PE alone), each searched within
+    the ranges (applied to every candidate)."""
+
+    candidates: list[Transform] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
+class PlaceConfig:
+    """``place:``, the search space of ``offline-prog place`` (issue 16's contract:
+    X_IT.translation_mm, X_IT.rpy_deg, X_PE.candidates, budget, seed)."""
+
+    X_IT: PoseRanges = dataclasses.field(default_factory=PoseRanges)
+    X_PE: GraspRanges | None = None
+    budget: int = 200  # full evaluations (the planning pipeline minus the exports)
+    seed: int = 0
+    screen_points: int = 1000  # grid points screened by the analytic path IK, per grasp
+    top_k: int = 10  # candidates listed in placement.json
+    # Obstacles that stand with the tool (its stand): moved with X_IT.
+    moves_with_tool: list[str] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
 class Cell:
     robot: RobotConfig = dataclasses.field(default_factory=RobotConfig, metadata=REQUIRED)
     tool: ToolConfig = dataclasses.field(default_factory=ToolConfig, metadata=REQUIRED)
@@ -208,6 +256,8 @@ class Cell:
     obstacles: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in I
     # Pairs of shape names whose contact is intended (the tool tip on the part).
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
+    # Where the tool and grasp may go (offline-prog place); plan ignores it.
+    place: PlaceConfig | None = None
 
 
 def load_cell(file: str | os.PathLike) -> Cell:

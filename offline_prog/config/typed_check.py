@@ -72,6 +72,7 @@ def _check_value(file, key, raw, schema):
             dataclasses.is_dataclass(args[0])
             or typing.get_origin(args[0]) is list
             or args[0] is str
+            or args[0] is Transform
         )
     ):
         if not isinstance(raw, list):

@@ -175,3 +175,37 @@ def singularity_distances(robot: RobotModel, q: np.ndarray, X_BE: np.ndarray) ->
         p_05 = X_BE[:, :3, 3] - p.d6 * X_BE[:, :3, 2]
         shoulder = np.abs(np.hypot(p_05[:, 0], p_05[:, 1]) - p.d4)
     return {"wrist": wrist, "elbow": elbow, "shoulder": shoulder}
+
+
+def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
+    """How far each flange pose is out of the arm's reach [m] (0 inside it): the wrist
+    centre's distance from the shoulder (axis 2) beyond the arm's longest stretch, or
+    inside its shortest. A measure that keeps growing where the closed form only says
+    "no solution", so a search can climb back into reach.
+
+    Args:
+        X_BE: (N, 4, 4) flange poses in the robot base.
+
+    Returns:
+        (N,) [m]; zeros for a robot without a closed form.
+    """
+    p, z = X_BE[:, :3, 3], X_BE[:, :3, 2]
+    params = robot.params
+    if robot.family == "opw":
+        c = p - params.c4 * z  # wrist centre
+        offset, height = params.a1, params.c1
+        longest = params.c2 + np.hypot(params.a2, params.c3)
+        shortest = abs(params.c2 - np.hypot(params.a2, params.c3))
+        lateral = params.b
+    elif robot.family == "ur":
+        c = p - params.d6 * z  # wrist 3 centre
+        offset, height = 0.0, params.d1
+        longest = abs(params.a2) + abs(params.a3) + abs(params.d5)
+        shortest = 0.0
+        lateral = params.d4
+    else:
+        return np.zeros(len(X_BE))
+    radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - lateral**2, 0.0))
+    h = c[:, 2] - height
+    d = np.minimum(np.hypot(radial - offset, h), np.hypot(radial + offset, h))  # front, back
+    return np.maximum(d - longest, 0.0) + np.maximum(shortest - d, 0.0)

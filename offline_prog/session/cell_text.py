@@ -10,6 +10,8 @@ result is loaded again and compared with the session's cell before it is written
 
 from __future__ import annotations
 
+import json
+
 import yaml
 
 from offline_prog.session.state import SessionState
@@ -140,4 +142,39 @@ def edited_text(text: str, initial: SessionState, state: SessionState) -> str:
     for k, (speed, speed0) in enumerate(zip(state.seam_speeds, initial.seam_speeds, strict=True)):
         if speed != speed0:  # a seam's own speed: given in the file (None is never edited)
             edits.scalar(_find(root, f"seams.{k}.speed"), speed)
+    return edits.result()
+
+
+def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> str:
+    """The cell file's ``text`` with transforms and text values replaced in place.
+
+    Args:
+        poses: {dotted key (``tool.X_IT``, ``obstacles.2.pose``): (p [m], rpy [deg])};
+            a key the file leaves out (an obstacle at the origin) is added.
+        strings: {dotted key: new text} (file names: written quoted).
+
+    Raises:
+        ValueError: a key of ``strings`` is not in the text, or a pose's mapping is not.
+    """
+    root = yaml.compose(text, Loader=yaml.SafeLoader)
+    edits = _Edits(text)
+    for key, (p, rpy_deg) in poses.items():
+        node = _find(root, key)
+        if node is None:
+            owner, _, name = key.rpartition(".")
+            mapping = _find(root, owner)
+            if mapping is None:
+                raise ValueError(f"{owner} not found in the cell file")
+            flat = (
+                f"{{translation: [{', '.join(map(number, p))}], "
+                f"rotation: !Rpy {{deg: [{', '.join(map(number, rpy_deg))}]}}}}"
+            )
+            edits.add(mapping, name, flat)
+        else:
+            _transform(edits, node, p, rpy_deg)
+    for key, value in strings.items():
+        node = _find(root, key)
+        if node is None:
+            raise ValueError(f"{key} not found in the cell file")
+        edits.replace(node, json.dumps(value))
     return edits.result()

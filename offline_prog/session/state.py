@@ -70,7 +70,7 @@ class Control:
     step: float
 
 
-def _rpy_deg(value: Transform) -> tuple[float, float, float]:
+def rpy_deg_of(value: Transform) -> tuple[float, float, float]:
     """Roll, pitch, yaw [deg] of a schema transform: an Rpy's own numbers."""
     rotation = value.rotation.value
     if isinstance(rotation, Rotation.Rpy):
@@ -84,9 +84,9 @@ def initial_state(cell: Cell) -> SessionState:
     seams = cell.seams or [None]
     return SessionState(
         tuple(float(v) for v in cell.tool.X_IT.translation),
-        _rpy_deg(cell.tool.X_IT),
+        rpy_deg_of(cell.tool.X_IT),
         tuple(float(v) for v in cell.part.X_PE.translation),
-        _rpy_deg(cell.part.X_PE),
+        rpy_deg_of(cell.part.X_PE),
         float(cell.motion.speed),
         tuple(None if s is None or s.speed is None else float(s.speed) for s in seams),
         float(cell.tool.free_rotation_deg),

@@ -1,0 +1,120 @@
+"""Where candidates are evaluated: in this process, or on Dask (``dask.distributed``).
+
+Both engines have one method, :meth:`map`: the evaluations of a batch of candidates,
+in the batch's order (so the search is the same whatever the number of workers).
+On Dask the cell (:class:`~offline_prog.placement.payload.CellPayload`) is scattered
+to every worker once; each task names it by its future, and each worker keeps the
+cell it loaded from it (``evaluate.context``).
+
+* default: a ``LocalCluster`` with one single-threaded worker process per core;
+* ``--scheduler tcp://host:8786``: an existing cluster (``dask scheduler`` on one
+  machine, ``dask worker tcp://host:8786`` on each; offline_prog installed on all).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import os
+from collections.abc import Callable, Sequence
+
+from offline_prog.errors import InputError
+from offline_prog.placement.evaluate import Evaluation, context, evaluate, screen
+from offline_prog.placement.payload import CellPayload
+from offline_prog.placement.space import Candidate
+
+CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds
+SCREEN_CHUNK = 32  # candidates per screen task (each ~10 ms)
+STAGES = {"screen": screen, "plan": evaluate}
+
+
+def run_chunk(
+    stage: str, candidates: Sequence[Candidate], payload: CellPayload
+) -> list[Evaluation]:
+    """Evaluate candidates with ``stage`` ("screen" | "plan") on this process's copy of
+    the cell (loaded once per payload)."""
+    ctx = context(payload)
+    judge = STAGES[stage]
+    return [judge(ctx, candidate) for candidate in candidates]
+
+
+class SerialEngine:
+    """Every candidate in this process, one after the other."""
+
+    scheduler = "in-process"
+    workers = 1
+
+    def __init__(self, payload: CellPayload):
+        self.payload = payload
+
+    def map(self, stage: str, candidates: Sequence[Candidate],
+            done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip
+        results = []
+        for candidate in candidates:
+            results += run_chunk(stage, [candidate], self.payload)
+            done(1)
+        return results
+
+    def close(self) -> None:
+        pass
+
+
+class DaskEngine:
+    """Candidates as tasks on a Dask cluster: a new LocalCluster, or the scheduler at
+    ``scheduler``.
+
+    Raises:
+        InputError: the scheduler cannot be reached within CONNECT_TIMEOUT_S.
+    """
+
+    def __init__(self, payload: CellPayload, *, workers: int | None = None,
+                 scheduler: str | None = None):  # fmt: skip
+        from dask.distributed import Client, LocalCluster
+
+        self.cluster = None
+        quiet = logging.ERROR
+        for name in ("distributed", "tornado", "bokeh"):
+            logging.getLogger(name).setLevel(quiet)
+        if scheduler:
+            try:
+                with contextlib.redirect_stderr(io.StringIO()):
+                    self.client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+            except (OSError, TimeoutError, ValueError) as error:
+                reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+                raise InputError(scheduler, "--scheduler", f"cannot reach it: {reason}") from None
+            self.scheduler = scheduler
+        else:
+            n = workers or os.cpu_count() or 1
+            self.cluster = LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=quiet,
+            )  # fmt: skip
+            self.client = Client(self.cluster)
+            self.scheduler = "LocalCluster"
+        self.workers = len(self.client.scheduler_info()["workers"])
+        self.payload = self.client.scatter(payload, broadcast=True, hash=False)
+
+    def map(self, stage: str, candidates: Sequence[Candidate],
+            done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip
+        from dask.distributed import as_completed
+
+        size = SCREEN_CHUNK if stage == "screen" else 1
+        chunks = [list(candidates[i : i + size]) for i in range(0, len(candidates), size)]
+        futures = self.client.map(
+            run_chunk, [stage] * len(chunks), chunks, payload=self.payload, pure=False
+        )
+        try:
+            for future in as_completed(futures):
+                future.result()  # a worker's exception is raised here
+                done(len(chunks[futures.index(future)]))
+        except BaseException:
+            self.client.cancel(futures)
+            raise
+        return [e for chunk in self.client.gather(futures) for e in chunk]
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception), contextlib.redirect_stderr(io.StringIO()):
+            self.client.close(timeout=CONNECT_TIMEOUT_S)
+            if self.cluster is not None:
+                self.cluster.close(timeout=CONNECT_TIMEOUT_S)

@@ -1,0 +1,173 @@
+"""The placement folder: placement.json, placed.yaml, placement.html, best_preview.html.
+
+* ``placement.json`` (the contract): ``best`` and ``candidates`` (top-k), each with
+  ``X_IT`` and ``X_PE`` as ``{translation [m], rpy_deg}``, ``feasible``,
+  ``cycle_time_s``, every objective term and the failure reason when infeasible;
+  ``baseline`` (the cell as given), ``cycle_time_cut`` (the cut and, when it is under
+  CUT_TARGET, why), ``search`` and ``engine`` (scheduler, workers, candidates
+  evaluated, wall time).
+* ``placed.yaml``: the cell file's text with the best X_IT and X_PE written in (and
+  the obstacles that stand with the tool moved), data files re-pointed from the new
+  folder: ``offline-prog plan placed.yaml`` plans it.
+* ``placement.html``: a top view of the search (screened grid, evaluated candidates
+  coloured by cycle time, failures by reason), the top-k table and the best plan.
+"""
+
+from __future__ import annotations
+
+import collections
+import json
+import math
+import os
+from pathlib import Path
+
+from offline_prog.config.cell import Cell, load_cell
+from offline_prog.placement.evaluate import Context, Evaluation, moved_obstacles
+from offline_prog.placement.search import Placement
+from offline_prog.placement.space import Pose, SearchSpace
+from offline_prog.session.cell_text import with_values
+
+CUT_TARGET = 0.15  # the cycle-time cut a placement search should find (issue 16)
+
+
+def _pose(pose: Pose) -> dict:
+    return {"translation": list(pose[0]), "rpy_deg": list(pose[1])}
+
+
+def _finite(value: float):
+    return value if math.isfinite(value) else None
+
+
+def terms(e: Evaluation) -> dict:
+    """One candidate in placement.json."""
+    return {
+        "X_IT": _pose(e.candidate.X_IT),
+        "X_PE": _pose(e.candidate.X_PE),
+        "grasp": e.candidate.grasp,
+        "feasible": e.feasible,
+        "cycle_time_s": _finite(e.cycle_time_s),
+        "joint_limit_margin_deg": _finite(e.joint_limit_margin_deg),
+        "singularity_margin_deg": _finite(e.singularity_margin_deg),
+        "clearance_mm": _finite(e.clearance_mm),
+        "tool_rotation_deg": e.tool_rotation_deg,
+        "slowed_share": e.slowed_share,
+        "limiting_axis": e.limiting_axis or None,
+        "process_bound_s": _finite(e.process_bound_s),
+        "tier": e.tier,
+        "violation": e.violation,
+        "reason": e.reason,
+        "evaluation_s": e.seconds,
+    }
+
+
+def _top(evaluated: list[Evaluation], k: int) -> list[Evaluation]:
+    """The k best distinct candidates (the baseline included when it ranks)."""
+    seen, top = set(), []
+    for e in sorted(evaluated, key=Evaluation.key):
+        key = (e.candidate.X_IT, e.candidate.X_PE)
+        if key not in seen:
+            seen.add(key)
+            top.append(e)
+        if len(top) == k:
+            break
+    return top
+
+
+def cycle_time_cut(result: Placement) -> dict:
+    """The cut of the cycle time against the cell as given, and why it is not larger
+    when it is under CUT_TARGET."""
+    base, best = result.baseline, result.best
+    if not best.feasible:
+        return {"percent": None, "why_not_more": "no feasible placement was found"}
+    if not base.feasible:
+        return {"percent": None, "why_not_more": "", "note": "the cell as given is infeasible"}
+    cut = 1.0 - best.cycle_time_s / base.cycle_time_s
+    out = {"percent": 100.0 * cut, "why_not_more": ""}
+    if cut >= CUT_TARGET:
+        return out
+    bound = best.process_bound_s
+    possible = 1.0 - bound / base.cycle_time_s
+    feasible = [e for e in result.evaluated if e.feasible]
+    axes = collections.Counter(e.limiting_axis for e in feasible if e.limiting_axis)
+    why = (
+        f"the process speed alone takes {bound:.2f} s (path length / speed with the time "
+        f"law's ramps), so no placement can cut more than {100 * possible:.1f} %"
+    )
+    if axes and possible >= CUT_TARGET:
+        axis, count = axes.most_common(1)[0]
+        least = min(e.slowed_share for e in feasible)
+        why += (
+            f"; every feasible placement evaluated ({len(feasible)}) still slows at least "
+            f"{100 * least:.0f} % of the path below the process speed, limited by axis "
+            f"{axis} in {count} of them: the seam's shape needs that joint motion wherever "
+            "the tool stands"
+        )
+    out["why_not_more"] = why
+    return out
+
+
+def placement_json(result: Placement, space: SearchSpace, place, engine: dict) -> dict:
+    return {
+        "best": terms(result.best),
+        "baseline": terms(result.baseline),
+        "cycle_time_cut": cycle_time_cut(result),
+        "candidates": [terms(e) for e in _top(result.evaluated, place.top_k)],
+        "search": {
+            "budget": place.budget,
+            "seed": place.seed,
+            "screen_points": len(result.screened),
+            "screen_feasible": sum(e.feasible for e in result.screened),
+            "axes": [
+                {
+                    "key": a.key,
+                    "low": a.low,
+                    "high": a.high,
+                    "unit": "m" if a.kind == "translation" else "deg",
+                }
+                for a in space.axes
+            ],  # fmt: skip
+            "grasps": [_pose(g) for g in space.grasps],
+            "failures": dict(
+                collections.Counter(
+                    e.reason.split(" at σ")[0].split(":")[0]
+                    for e in result.evaluated
+                    if not e.feasible
+                )
+            ),
+        },  # fmt: skip
+        "engine": engine,
+    }
+
+
+def _file_keys(cell: Cell) -> dict[str, str]:
+    """{dotted key: file name} of the data files a one-seam cell names."""
+    keys = {}
+    if cell.part.mesh:
+        keys["part.mesh"] = cell.part.mesh
+    for name in ("points", "dxf"):
+        if getattr(cell.path, name):
+            keys[f"path.{name}"] = getattr(cell.path, name)
+    for owner, shapes in (("obstacles", cell.obstacles), ("part.geometry", cell.part.geometry),
+                          ("tool.geometry", cell.tool.geometry)):  # fmt: skip
+        for i, shape in enumerate(shapes):
+            if shape.shape == "mesh" and shape.mesh:
+                keys[f"{owner}.{i}.mesh"] = shape.mesh
+    return keys
+
+
+def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) -> str:
+    """The cell file's text with the best placement, to be written into ``out_dir``."""
+    text = cell_file.read_text()
+    poses = {"tool.X_IT": best.candidate.X_IT, "part.X_PE": best.candidate.X_PE}
+    for i, pose in moved_obstacles(ctx, best.candidate).items():
+        poses[f"obstacles.{i}.pose"] = pose
+    source = cell_file.resolve().parent
+    strings = {
+        key: os.path.relpath(source / name, Path(out_dir).resolve())
+        for key, name in _file_keys(load_cell(cell_file)).items()
+    }
+    return with_values(text, poses, strings)
+
+
+def write_json(file: Path, data: dict) -> None:
+    file.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")

@@ -1,0 +1,107 @@
+"""A candidate is judged by plan's own pipeline: the cell as given evaluates to the plan
+of the cell; an infeasible candidate says how far it is from feasible, growing the
+farther it is; the tool's stand moves with the tool; the cell travels whole."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from offline_prog.config.cell import load_cell, transform
+from offline_prog.joints.path_ik import reach_excess
+from offline_prog.placement.evaluate import (
+    CANNOT_FOLLOW,
+    FEASIBLE,
+    context,
+    evaluate,
+    placed_cell,
+    screen,
+)
+from offline_prog.placement.payload import cell_payload, unpack
+from offline_prog.placement.space import Candidate, check_place
+from offline_prog.robot.model import load_robot
+
+from conftest import CELLS
+
+DEMO = CELLS / "placement" / "seal_out_of_reach_kr16.yaml"
+
+
+@pytest.fixture(scope="module")
+def seal():
+    file = CELLS / "seal_plate_kr16.yaml"
+    return context(cell_payload(file, load_cell(file)))
+
+
+def test_the_cell_as_given_evaluates_to_its_plan(seal, planned_folder):
+    plan, _ = planned_folder("seal_plate_kr16")
+    cell = plan.cell
+    X_IT = (tuple(cell.tool.X_IT.translation), (90.0, 0.0, 0.0))
+    X_PE = (tuple(cell.part.X_PE.translation), (180.0, 0.0, 0.0))
+    e = evaluate(seal, Candidate((), -1, X_IT, X_PE))
+    assert e.tier == FEASIBLE and e.reason == ""
+    assert e.cycle_time_s == pytest.approx(plan.trajectory.duration, abs=1e-9)
+    assert e.joint_limit_margin_deg == pytest.approx(np.rad2deg(plan.joints.margin_rad.min()))
+    assert e.clearance_mm == pytest.approx(plan.collisions.min_distance_m * 1e3)
+    assert e.process_bound_s == pytest.approx(plan.nominal_duration_s)
+    assert screen(seal, Candidate((), -1, X_IT, X_PE)).tier == FEASIBLE
+
+
+def test_out_of_reach_grows_with_the_distance(seal):
+    X_PE = ((0.0, 0.0, 0.1), (180.0, 0.0, 0.0))
+    screened = [
+        screen(seal, Candidate((), -1, ((x, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
+        for x in (1.75, 1.9, 2.2, 2.6)
+    ]
+    assert all(e.tier == CANNOT_FOLLOW and e.reason == "out of reach" for e in screened)
+    violations = [e.violation for e in screened]
+    assert violations == sorted(violations) and violations[0] < violations[-1], violations
+    far = evaluate(seal, Candidate((), -1, ((2.2, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
+    assert far.tier == CANNOT_FOLLOW and "out of reach" in far.reason and far.violation > 0
+
+
+def test_the_stand_moves_with_the_tool():
+    cell = load_cell(DEMO)
+    _, space = check_place(DEMO, cell)
+    ctx = context(cell_payload(DEMO, cell))
+    candidate = space.candidate([0.3, 0.7, 0.5, 0.4], 1)
+    moved = placed_cell(ctx, candidate)
+    X_IT, X_IT_new = transform(cell.tool.X_IT), transform(moved.tool.X_IT)
+    stand = [o for o in cell.obstacles if o.name == "nozzle_stand"][0]
+    stand_new = [o for o in moved.obstacles if o.name == "nozzle_stand"][0]
+    X_TO = X_IT.inverse() @ transform(stand.pose)
+    X_TO_new = X_IT_new.inverse() @ transform(stand_new.pose)
+    assert np.allclose(X_TO.GetAsMatrix4(), X_TO_new.GetAsMatrix4(), atol=2e-6)
+    others = [o.pose for o in moved.obstacles if o.name != "nozzle_stand"]
+    assert [transform(p).GetAsMatrix4().tolist() for p in others] == [
+        transform(o.pose).GetAsMatrix4().tolist()
+        for o in cell.obstacles if o.name != "nozzle_stand"
+    ]  # fmt: skip
+    assert moved.part.X_PE.rotation.value.deg.tolist() == [180.0, 0.0, 90.0]
+
+
+def test_the_payload_carries_the_cell_and_its_data_files():
+    file = CELLS / "weld_seam_irb2400.yaml"
+    payload = cell_payload(file, load_cell(file))
+    names = dict(payload.files)
+    assert set(names) == {"weld_seam_irb2400.yaml", "data/weld_seam.dxf"}
+    copy = unpack(payload)
+    assert copy.read_bytes() == file.read_bytes()
+    assert (copy.parent / "data/weld_seam.dxf").read_bytes() == (
+        CELLS / "data/weld_seam.dxf"
+    ).read_bytes()
+    again = cell_payload(file, dataclasses.replace(load_cell(file)))
+    assert again.digest == payload.digest
+
+
+@pytest.mark.parametrize("name", ["kuka_kr16_2", "abb_irb2400", "ur10e"])
+def test_reach_excess_is_zero_wherever_the_robot_reaches_and_grows_outside(name, rng):
+    robot = load_robot(name)
+    X_BE = robot.forward(rng.uniform(robot.q_lower, robot.q_upper, size=(1000, 6)))
+    assert reach_excess(robot, X_BE).max() == 0.0
+    out = X_BE.copy()
+    out[:, :3, 3] *= 3.0  # three times as far from the base: beyond reach
+    far = out.copy()
+    far[:, :3, 3] *= 2.0
+    beyond = reach_excess(robot, out) > 0  # most, not the poses near the base
+    assert beyond.mean() > 0.8
+    assert np.all(reach_excess(robot, far)[beyond] > reach_excess(robot, out)[beyond])

@@ -1,0 +1,99 @@
+"""``offline-prog place`` end to end: a placement out of reach becomes a feasible one
+that ``plan`` accepts with the cycle time placement.json promised; the same seed gives
+the same placement in one process and on a 2-worker LocalCluster; an unreachable
+scheduler and Ctrl-C end with one line."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from offline_prog.cli import main
+from offline_prog.plan import plan_cell
+
+from conftest import CELLS
+
+DEMO = CELLS / "placement" / "seal_out_of_reach_kr16.yaml"
+CONTRACT = {"X_IT", "X_PE", "feasible", "cycle_time_s", "joint_limit_margin_deg",
+            "singularity_margin_deg", "clearance_mm", "reason"}  # fmt: skip
+
+
+def small_search(tmp_path, screen_points: int = 100):
+    """The demo with a coarse screen (3 levels per axis), written next to a copy of it."""
+    file = tmp_path / "cells" / "out_of_reach.yaml"
+    file.parent.mkdir()
+    file.write_text(
+        DEMO.read_text().replace("seed: 0", f"seed: 0\n  screen_points: {screen_points}")
+    )
+    return file
+
+
+@pytest.mark.slow  # ~25 s: two searches of 10 candidates, a LocalCluster, one plan
+def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_path, capsys):
+    file = small_search(tmp_path)
+    serial, dask = tmp_path / "serial", tmp_path / "dask"
+    assert main(["place", str(file), "--out", str(serial), "--budget", "10", "--workers", "0"]) == 0
+    assert main(["place", str(file), "--out", str(dask), "--budget", "10", "--workers", "2"]) == 0
+    ours, theirs = (json.loads((d / "placement.json").read_text()) for d in (serial, dask))
+    assert ours["best"] == {**theirs["best"], "evaluation_s": ours["best"]["evaluation_s"]}
+    assert theirs["engine"]["workers"] == 2 and theirs["engine"]["scheduler"] == "LocalCluster"
+    assert ours["engine"]["candidates_evaluated"] == 10
+    best = ours["best"]
+    assert set(best) >= CONTRACT and best["feasible"] and best["reason"] == ""
+    assert not ours["baseline"]["feasible"] and "out of reach" in ours["baseline"]["reason"]
+    assert all(set(c) >= CONTRACT for c in ours["candidates"])
+    assert ours["candidates"][0]["X_IT"] == best["X_IT"]
+    # placed.yaml: the cell's text (comments kept) with the best placement; plan agrees.
+    placed = (serial / "placed.yaml").read_text()
+    assert "# Deliberately poor: 2.2 m from the robot base" in placed
+    plan = plan_cell(serial / "placed.yaml")
+    assert plan.feasible
+    assert plan.trajectory.duration == pytest.approx(best["cycle_time_s"], abs=1e-9)
+    assert list(plan.cell.tool.X_IT.translation) == best["X_IT"]["translation"]
+    page = (serial / "placement.html").read_text()
+    assert '<svg id="search-map"' in page and 'src="best_preview.html"' in page
+    assert (serial / "best_preview.html").stat().st_size > 10_000
+
+
+@pytest.mark.slow  # the scheduler's connect timeout: 5 s
+def test_an_unreachable_scheduler_is_one_line_exit_2_within_seconds(tmp_path, capsys):
+    start = time.monotonic()
+    code = main(["place", str(DEMO), "--out", str(tmp_path / "o"),
+                 "--scheduler", "tcp://127.0.0.1:9"])  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "tcp://127.0.0.1:9" in err[0] and "--scheduler" in err[0] and "cannot reach" in err[0]
+    assert time.monotonic() - start < 15
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow  # a LocalCluster started, then interrupted
+def test_ctrl_c_stops_the_workers_exit_130_one_line_no_folder(tmp_path):
+    file = small_search(tmp_path, screen_points=1000)
+    out = tmp_path / "o"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "offline_prog", "place", str(file), "--out", str(out),
+         "--workers", "2"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )  # fmt: skip
+    time.sleep(12)  # the cluster is up and screening
+    assert process.poll() is None
+    os.killpg(process.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
+    try:
+        _, err = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 130, err
+    assert err.strip().splitlines()[-1] == "interrupted", err
+    assert not out.exists() and not list(tmp_path.glob(".offline_prog*"))
+    deadline = time.monotonic() + 15  # the workers finish their task and exit
+    while time.monotonic() < deadline:
+        left = subprocess.run(["pgrep", "-g", str(process.pid)], capture_output=True, text=True)
+        if not left.stdout.strip():
+            break
+        time.sleep(0.5)
+    assert left.stdout.strip() == "", "worker processes outlived the interrupt"
