@@ -1,7 +1,8 @@
 """Benchmark: plan the demo cells stage by stage, and compare path IK with references.
 
 Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]
-[--only command|collision|session]``
+[--only command|collision|timing|session|place]``; ``--only place`` runs
+scripts/bench_place.py (the placement search, ~10 minutes)
 
 All figures come from the same process on the same machine, so the ratios
 hold even where the absolute numbers drift. Path IK is compared on one flange
@@ -277,7 +278,7 @@ def main() -> None:
     parser.add_argument("--drake-samples", type=int, default=300)
     parser.add_argument(
         "--only",
-        choices=["command", "collision", "timing", "session"],
+        choices=["command", "collision", "timing", "session", "place"],
         help="run one part of the benchmark",
     )
     args = parser.parse_args()
@@ -290,6 +291,12 @@ def main() -> None:
         return
     if args.only == "timing":
         bench_timing()
+        return
+    if args.only == "place":  # ~10 minutes: its own script (scripts/bench_place.py)
+        import bench_place
+
+        sys.argv = sys.argv[:1]
+        bench_place.main()
         return
     bench_command(CELLS / "seal_plate_kr16.yaml")
     if args.only == "command":

@@ -27,6 +27,16 @@ from offline_prog.placement.space import Candidate
 CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds
 SCREEN_CHUNK = 32  # candidates per screen task (each ~10 ms)
 STAGES = {"screen": screen, "plan": evaluate}
+# LocalCluster workers: a candidate is ~0.5 s of Python and Drake. The statistical
+# profiler (a stack sample every 10 ms), glibc trimming every free above 64 kB and the
+# frequent monitors cost 10–20 % of each worker's time on this machine
+# (scripts/bench_place.py: parallel efficiency 0.73 with them).
+WORKER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+}
 
 
 def run_chunk(
@@ -37,6 +47,10 @@ def run_chunk(
     ctx = context(payload)
     judge = STAGES[stage]
     return [judge(ctx, candidate) for candidate in candidates]
+
+
+def _load(payload: CellPayload) -> None:
+    context(payload)
 
 
 class SerialEngine:
@@ -70,6 +84,7 @@ class DaskEngine:
 
     def __init__(self, payload: CellPayload, *, workers: int | None = None,
                  scheduler: str | None = None):  # fmt: skip
+        import dask
         from dask.distributed import Client, LocalCluster
 
         self.cluster = None
@@ -86,14 +101,20 @@ class DaskEngine:
             self.scheduler = scheduler
         else:
             n = workers or os.cpu_count() or 1
-            self.cluster = LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=quiet,
-            )  # fmt: skip
+            with dask.config.set(WORKER_CONFIG):
+                self.cluster = LocalCluster(
+                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                    silence_logs=quiet,
+                )  # fmt: skip
             self.client = Client(self.cluster)
             self.scheduler = "LocalCluster"
-        self.workers = len(self.client.scheduler_info()["workers"])
+        addresses = list(self.client.scheduler_info()["workers"])
+        self.workers = len(addresses)
         self.payload = self.client.scatter(payload, broadcast=True, hash=False)
+        # Every worker loads the cell now, in parallel (not on its first candidate).
+        loads = [self.client.submit(_load, self.payload, workers=[a], pure=False)
+                 for a in addresses]  # fmt: skip
+        self.client.gather(loads)
 
     def map(self, stage: str, candidates: Sequence[Candidate],
             done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip
