@@ -11,7 +11,8 @@ jerk; where a sample is over, TOPP-RA is solved again with lower curves over the
 stretch of the profile that sample averages (``FilteredTimeLaw.span``):
 
 * the speed curve σ̇ ≤ v(σ) where a term of the speed alone dominates
-  (q′σ̇, q″σ̇², q‴σ̇³), by the excess (to the power 1, ½ or ⅓);
+  (q′σ̇, q″σ̇², q‴σ̇³), by the excess (to the power 1, ½ or ⅓; damped, see
+  EXCESS_DAMPING);
 * the path acceleration curve |σ̈| ≤ a(σ) where a term of the speed change
   dominates (q′σ̈, 3q″σ̇σ̈ + q′σ⃛, or σ⃛ over the path jerk): σ⃛ of the average is
   a difference of σ̈ across the window over T.
@@ -50,8 +51,9 @@ MAX_ROUNDS = 120
 STEP_SHARE = 0.99
 # ... taken to this power: a sample's excess is blamed on one curve (speed or
 # acceleration) though both terms add to it; small steps let the next round see what
-# the other curve's step did (seal demo: 13.38 s with 0.2 and 0.99, 13.43 s with 0.3
-# and 0.97, 13.76 s with 1 and 0.97; 20-60 rounds of ~10 ms).
+# the other curve's step did (seal demo, jerk planned to 98 %: 13.38 s with 0.2 and
+# 0.99, 13.43 s with 0.3 and 0.97, 13.76 s with 1 and 0.97; scripts/bench_timing.py
+# prints the solve time).
 EXCESS_DAMPING = 0.2
 # The acceleration curve never goes below this share of the path acceleration.
 MIN_ACCELERATION_SHARE = 1e-3
