@@ -3,7 +3,9 @@
 ``time_optimal``: TOPP-RA (``timing.time_optimal``) under the joint velocity and
 acceleration limits, the process speed cap and the path acceleration, with the
 steady-speed joint jerk limit as a speed limit curve; then the jerk stage
-(``timing.jerk_stage``). ``sin2``: the paper's law with plateaus lowered where the
+(``timing.jerk_stage``); for ``cycle_time`` also the time-averaged profile
+(``timing.filtered_stage``), keeping the faster of the two that holds every
+limit. ``sin2``: the paper's law with plateaus lowered where the
 joints need it (``timing.joint_timing``).
 """
 
@@ -13,6 +15,7 @@ import dataclasses
 
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.robot.model import RobotModel
+from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates, retime
 from offline_prog.timing.time_law import Sin2TimeLaw
@@ -37,13 +40,12 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
         rates, qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=nominal.v_max,
         a_path=nominal.a_max,
     )  # fmt: skip
-    timing = jerk_limited_law(
-        rates,
-        profile,
-        v_process=nominal.v_max,
-        a_max=nominal.a_max,
-        j_max=nominal.j_max,
-        limits=limits,
-        process=process,
-    )
+    path = dict(v_process=nominal.v_max, a_max=nominal.a_max, j_max=nominal.j_max)
+    timing = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
+    if process == "cycle_time":
+        filtered = filtered_timing(rates, profile, limits=limits, **path)
+        if filtered is not None and (
+            not timing.feasible or filtered.law.duration < timing.law.duration
+        ):
+            timing = filtered
     return dataclasses.replace(timing, topp_plain_s=plain.duration)

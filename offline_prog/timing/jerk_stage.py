@@ -8,7 +8,8 @@ bounded jerk) under it:
 * ``constant_speed``: the process speed, except on the stretches where the joints
   cannot hold it steadily; each of those holds one steady speed (the lowest the
   joints allow on it, ``static_limit``).
-* ``cycle_time``: a staircase under the TOPP-RA profile in steps of LEVEL_STEP.
+* ``cycle_time``: a staircase under the TOPP-RA profile in steps of LEVEL_STEP
+  (``path_timing`` keeps it where it beats ``filtered_stage``'s averaged profile).
 
 Along the path the joints move with (′ = d/dσ)
     q̇ = q′σ̇,   q̈ = q″σ̇² + q′σ̈,   q⃛ = q‴σ̇³ + 3q″σ̇σ̈ + q′σ⃛.
@@ -28,6 +29,7 @@ import numpy as np
 
 from offline_prog.arrays import true_runs
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ
+from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.joint_timing import JointRates
 from offline_prog.timing.limit_use import (
     HOLD_TOLERANCE,
@@ -37,6 +39,7 @@ from offline_prog.timing.limit_use import (
     joint_use,
     slowdowns,
     with_jerk,
+    worst_use,
 )
 from offline_prog.timing.time_law import Sin2TimeLaw, sin2_plateau_law
 from offline_prog.timing.time_optimal import ToppProfile
@@ -59,7 +62,8 @@ class JerkLimitedTiming:
     Attributes:
         law: the time law to use.
         reductions: ((σ_start, σ_end, speed), ...) plateaus below the process speed.
-        a_scale: the softest transition's factor on the path acceleration and jerk.
+        a_scale: the softest transition's factor on the path acceleration and jerk
+            (FilteredTimeLaw: the lowest path acceleration curve / a_max).
         feasible: every joint velocity, acceleration and jerk limit holds.
         worst: (joint index, σ, use) of the largest limit use on the final samples.
         slowdowns: every stretch below the process speed, with its limiting joint.
@@ -68,7 +72,7 @@ class JerkLimitedTiming:
         process: the intent ("constant_speed" | "cycle_time").
     """
 
-    law: Sin2TimeLaw
+    law: Sin2TimeLaw | FilteredTimeLaw
     reductions: tuple[tuple[float, float, float], ...]
     a_scale: float
     feasible: bool
@@ -214,15 +218,13 @@ def jerk_limited_law(
             soft[inside, side] = soft[inside, side].min() * STEP_SHARE / excess
     t = np.arange(0.0, law.duration, 1.0 / check_rate_hz)
     use = joint_use(rates, dddq, law, t, limits)
-    worst_kind = max(KINDS, key=lambda k: use[k].max())
-    i, j = np.unravel_index(np.argmax(use[worst_kind]), use[worst_kind].shape)
-    worst = (int(j), float(use["sigma"][i]), float(use[worst_kind][i, j]))
+    worst = worst_use(use)
     reductions = tuple((a, b, v) for v, a, b in law.plateaus if v < v_process * (1 - 1e-9))
     return JerkLimitedTiming(
         law,
         reductions,
         float(np.min(factors)),
-        bool(max(use[k].max() for k in KINDS) <= 1.0 + 1e-9),
+        worst[2] <= 1.0 + 1e-9,
         worst,
         slowdowns(law, t, use, v_process),
         profile,

@@ -76,6 +76,13 @@ def joint_use(rates: JointRates, dddq: np.ndarray, law, t: np.ndarray, limits) -
     }
 
 
+def worst_use(use: dict) -> tuple[int, float, float]:
+    """(joint index, σ, use) of the largest velocity, acceleration or jerk use."""
+    kind = max(KINDS, key=lambda k: use[k].max())
+    i, j = np.unravel_index(np.argmax(use[kind]), use[kind].shape)
+    return int(j), float(use["sigma"][i]), float(use[kind][i, j])
+
+
 def slowdowns(law, t: np.ndarray, use: dict, v_process: float) -> tuple[Slowdown, ...]:
     """Every stretch with σ̇ below the process speed (HOLD_TOLERANCE), with the joint
     limit used most on it; the runs touching the path's ends are the start and stop."""

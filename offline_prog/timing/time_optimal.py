@@ -78,8 +78,9 @@ class _GridPath:
         return None
 
 
-def _speed_curve(v_max: np.ndarray, dof: int):
-    """A toppra constraint σ̇ ≤ v_max (G,) at the grid points, vectorised (toppra's
+def _speed_curve(v_max: np.ndarray, dof: int, a_max: np.ndarray | None = None):
+    """A toppra constraint σ̇ ≤ v_max (G,) at the grid points, and |σ̈| ≤ a_max (G,)
+    on the step after each if given, vectorised (toppra's
     JointVelocityConstraintVarying calls Python once per grid point)."""
     from toppra.constraint import LinearConstraint
 
@@ -90,7 +91,8 @@ def _speed_curve(v_max: np.ndarray, dof: int):
 
         def compute_constraint_params(self, path, gridpoints):
             xbound = np.column_stack([np.zeros(len(v_max)), v_max**2])
-            return None, None, None, None, None, None, xbound
+            ubound = None if a_max is None else np.column_stack([-a_max, a_max])
+            return None, None, None, None, None, ubound, xbound
 
     return SpeedCurve()
 
@@ -110,6 +112,7 @@ def topp_profile(
     v_cap: float,
     a_path: float,
     v_steady: np.ndarray | None = None,
+    a_curve: np.ndarray | None = None,
     grid_points: int = TOPP_GRID_POINTS,
 ) -> ToppProfile:
     """The time-optimal σ̇(σ) under the module's constraints (see the module doc).
@@ -121,6 +124,8 @@ def topp_profile(
         a_path: the path acceleration limit on |σ̈| [m/s²].
         v_steady: (G,) optional further cap on σ̇ on the rates' grid [m/s] (the jerk
             stage's steady-speed jerk limit, |q‴σ̇³| ≤ q⃛_max: TOPP-RA knows no jerk).
+        a_curve: (G,) optional further cap on |σ̈| on the rates' grid [m/s²] (the
+            filtered stage lowers it where its window's speed changes are too hard).
         grid_points: most grid points of the solve.
     """
     import toppra.algorithm as algorithm  # 0.3 s (it imports matplotlib): only here
@@ -145,8 +150,10 @@ def topp_profile(
             discretization_scheme=constraint.DiscretizationType.Interpolation,
         ),
     ]
-    if v_steady is not None:
-        constraints.append(_speed_curve(np.minimum(v_steady[keep], v_cap), path.dof))
+    if v_steady is not None or a_curve is not None:
+        v_curve = np.full(len(sigma), v_cap) if v_steady is None else v_steady[keep]
+        a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)
+        constraints.append(_speed_curve(np.minimum(v_curve, v_cap), path.dof, a_step))
     start = time.perf_counter()
     solver = algorithm.TOPPRA(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
     _, sd, _ = solver.compute_parameterization(0.0, 0.0)

@@ -1,12 +1,16 @@
 """The time-optimal process law: TOPP-RA agrees with toppra's own use, the jerk
 stage keeps every joint limit (velocity, acceleration, jerk), a binding velocity
-limit is reported with the right joint and σ band, and a tight jerk limit holds."""
+limit is reported with the right joint and σ band, and a tight jerk limit holds;
+for cycle_time the averaged profile (filtered_stage) holds every limit too and is
+faster than the staircase, and on the tape demo within 5 % of TOPP-RA."""
 
 import io
 
 import numpy as np
 import pytest
 
+from offline_prog.timing.filtered_law import FilteredTimeLaw
+from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates
 from offline_prog.timing.time_optimal import topp_profile
@@ -124,6 +128,67 @@ def test_a_tight_jerk_limit_holds_and_costs_time():
         assert max(sampled_use(bump_rates_at(), timing.law, limits)) <= 1.01
         durations.append(timing.law.duration)
     assert durations[1] > durations[0]
+
+
+@pytest.mark.parametrize(("gain", "jerk_share"), [(3.0, 1.0), (3.0, 0.1), (8.0, 1.0)])
+def test_averaged_profile_holds_every_limit_and_beats_the_staircase(gain, jerk_share):
+    rates = bump_rates(gain=gain)
+    limits = (QD_MAX, QDD_MAX, QDDD_MAX * jerk_share)
+    profile = topp_profile(
+        rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+        v_steady=steady_jerk_limit(rates, limits),
+    )  # fmt: skip
+    path = dict(v_process=0.5, a_max=2.0, j_max=20.0, limits=limits)
+    staircase = jerk_limited_law(rates, profile, process="cycle_time", **path)
+    averaged = filtered_timing(rates, profile, **path)
+    assert averaged.feasible
+    assert max(sampled_use(bump_rates_at(gain=gain), averaged.law, limits)) <= 1.01
+    t = np.arange(0.0, averaged.law.duration, 1e-3)
+    _, sd, sdd, sddd = averaged.law(t)
+    assert sd.max() <= 0.5 * (1 + 1e-12)
+    assert np.abs(sdd).max() <= 2.0 * (1 + 1e-9)
+    assert np.abs(sddd).max() <= 20.0 * (1 + 1e-9)
+    assert averaged.law.duration < staircase.law.duration
+
+
+@pytest.mark.slow
+def test_tape_demo_cycle_time_within_5_percent_of_topp_ra():
+    """The tape demo's cycle_time plan: within 5 % of TOPP-RA without jerk limits,
+    with every joint's velocity, acceleration and jerk held on trajectory.csv."""
+    from offline_prog.plan import plan_cell
+
+    from conftest import CELLS
+
+    text = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
+    text = text.replace("  max_jerk: 10.0\n", "  max_jerk: 10.0\n  time_law: time_optimal\n"
+                        "  process: cycle_time\n")  # fmt: skip
+    cell = CELLS / "_test_time_optimal_tape.yaml"
+    cell.write_text(text)
+    try:
+        plan = plan_cell(cell)
+    finally:
+        cell.unlink()
+    assert isinstance(plan.trajectory.law, FilteredTimeLaw)
+    assert plan.trajectory.duration <= 1.05 * plan.joints.retiming.topp_plain_s
+    assert max(csv_limit_use(plan)) <= 1.01
+
+
+def csv_limit_use(plan) -> tuple[float, float, float]:
+    """Largest joint velocity, acceleration and jerk use on trajectory.csv, from its
+    qd columns by finite differences (controller axes)."""
+    from offline_prog.results.plan_folder import trajectory_csv
+
+    table = np.genfromtxt(io.StringIO(trajectory_csv(plan)), delimiter=",", names=True)
+    robot = plan.robot
+    t = table["t"]
+    qd = robot.controller_joints(np.column_stack([table[f"qd{k + 1}"] for k in range(6)]))
+    qdd = np.diff(qd, axis=0) / np.diff(t)[:, None]
+    qddd = np.diff(qdd, axis=0) / np.diff(0.5 * (t[1:] + t[:-1]))[:, None]
+    return (
+        float((np.abs(qd) / robot.qd_max).max()),
+        float((np.abs(qdd) / robot.qdd_max).max()),
+        float((np.abs(qddd) / robot.jerk_limits).max()),
+    )
 
 
 @pytest.mark.slow
