@@ -8,9 +8,11 @@ loads the cell from there. Robots come with the installed package.
 
 from __future__ import annotations
 
+import atexit
 import dataclasses
 import hashlib
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -54,8 +56,10 @@ def cell_payload(file: Path, cell: Cell) -> CellPayload:
 
 
 def unpack(payload: CellPayload) -> Path:
-    """Write the payload into a new temporary folder; the cell file's path there."""
+    """Write the payload into a new temporary folder (removed when this process
+    exits); the cell file's path there."""
     root = Path(tempfile.mkdtemp(prefix="offline_prog_place_"))
+    atexit.register(shutil.rmtree, root, ignore_errors=True)
     for name, content in payload.files:
         target = root / name
         target.parent.mkdir(parents=True, exist_ok=True)
