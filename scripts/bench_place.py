@@ -57,8 +57,12 @@ def search(file: Path, out: Path, budget: int, seed: int = 0, workers: int = 2) 
 
 def show(name: str, data: dict) -> None:
     best, base, cut = data["best"], data["baseline"], data["cycle_time_cut"]
-    given = f"{base['cycle_time_s']:.2f} s" if base["feasible"] else f"infeasible ({base['reason']})"
-    found = f"{best['cycle_time_s']:.2f} s" if best["feasible"] else f"infeasible ({best['reason']})"
+    given = (
+        f"{base['cycle_time_s']:.2f} s" if base["feasible"] else f"infeasible ({base['reason']})"
+    )
+    found = (
+        f"{best['cycle_time_s']:.2f} s" if best["feasible"] else f"infeasible ({best['reason']})"
+    )
     print(f"{name:<24} given {given:<28} best {found}", end="")
     if cut["percent"] is not None:
         print(f"  cut {cut['percent']:5.1f} %", end="")

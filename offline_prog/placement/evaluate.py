@@ -27,7 +27,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from offline_prog.config.cell import Cell, transform
-from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.errors import Failure, InputError, PlanFailedError
 from offline_prog.joints.path_ik import (
     base_poses,
     branch_results,
@@ -65,6 +65,9 @@ class Evaluation:
         tier: FEASIBLE, COLLIDES, CANNOT_FOLLOW or REFUSED; violation: how far from
             feasible within the tier (0 when feasible).
         reason: why it is infeasible, one line ("" when feasible).
+        failure: its kind: a :class:`~offline_prog.errors.Failure` value
+            ("out_of_reach", "joint_limit", "singularity", "collision", ...) or
+            "refused" (geometry the method refuses); "" when feasible.
         cycle_time_s: the seam's duration [s] (NaN without a plan).
         joint_limit_margin_deg: smallest distance of a joint to its limits [deg].
         singularity_margin_deg: smallest wrist or elbow angle from singular [deg].
@@ -82,6 +85,7 @@ class Evaluation:
     tier: int
     violation: float
     reason: str
+    failure: str = ""
     cycle_time_s: float = math.nan
     joint_limit_margin_deg: float = -math.inf
     singularity_margin_deg: float = 0.0
@@ -185,7 +189,7 @@ def screen(ctx: Context, candidate: Candidate) -> Evaluation:
                             X_PE=_rigid(candidate.X_PE))  # fmt: skip
         f = flange(ctx.screen_s)
     except NormalTangentError as error:
-        return Evaluation(candidate, "screen", REFUSED, 1.0, str(error))
+        return Evaluation(candidate, "screen", REFUSED, 1.0, str(error), "refused")
     X_BE = base_poses(inputs.X_IB, f.p_IE, f.R_IE)
     results = branch_results(inputs.robot, X_BE)
     reach = ~np.isnan(inputs.robot.inverse(X_BE)).any(axis=-1)  # (N, 8)
@@ -204,7 +208,9 @@ def screen(ctx: Context, candidate: Candidate) -> Evaluation:
     seconds = time.perf_counter() - start
     if not best.feasible:
         v = violation(best)
-        return Evaluation(candidate, "screen", CANNOT_FOLLOW, v, best.reason, seconds=seconds)
+        kind = Failure.of(best.reason).value
+        return Evaluation(candidate, "screen", CANNOT_FOLLOW, v, best.reason, kind,
+                          seconds=seconds)  # fmt: skip
     margin = float(np.rad2deg(best.margin_rad))
     d = singularity_distances(inputs.robot, best.q, X_BE)
     singular = float(np.rad2deg(np.arcsin(min(1.0, d["wrist"].min(), d["elbow"].min()))))
@@ -259,9 +265,10 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
         done = error.failure.sigma_m / ctx.fit.path.length
         screened = screen(ctx, candidate)
         return Evaluation(candidate, "plan", CANNOT_FOLLOW, screened.violation + 1.0 - done,
-                          str(error.failure), seconds=time.perf_counter() - start)  # fmt: skip
+                          str(error.failure), error.failure.kind.value,
+                          seconds=time.perf_counter() - start)  # fmt: skip
     except InputError as error:
-        return Evaluation(candidate, "plan", REFUSED, 1.0, error.reason,
+        return Evaluation(candidate, "plan", REFUSED, 1.0, error.reason, "refused",
                           seconds=time.perf_counter() - start)  # fmt: skip
     joints, collisions = plan.joints, plan.collisions
     singular = [joints.singularities[k]["distance"] for k in ("wrist", "elbow")
@@ -276,6 +283,7 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
         tier,
         violation,
         "" if plan.feasible else plan.failure,
+        "" if plan.feasible else Failure.COLLISION.value,
         cycle_time_s=float(plan.trajectory.duration),
         joint_limit_margin_deg=float(np.rad2deg(np.min(joints.margin_rad))),
         singularity_margin_deg=float(min(singular)) if singular else 90.0,

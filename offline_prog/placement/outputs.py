@@ -56,6 +56,7 @@ def terms(e: Evaluation) -> dict:
         "tier": e.tier,
         "violation": e.violation,
         "reason": e.reason,
+        "failure": e.failure,
         "evaluation_s": e.seconds,
     }
 

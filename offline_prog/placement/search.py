@@ -1,11 +1,11 @@
 """The placement search: a grid screened by the analytic path IK, then CMA-ES (the
 ``cma`` package) on the full planning pipeline, for ``place.budget`` evaluations.
 
-1. ``baseline``: the cell as given, through the pipeline (one evaluation).
-2. ``screen``: a regular grid over the ranges, every grasp, by the analytic path IK
+1. ``screen``: a regular grid over the ranges, every grasp, by the analytic path IK
    and a steady-speed cycle-time estimate (~10 ms each; no evaluation spent).
-3. ``survivors``: the best POPULATION screened candidates through the pipeline.
-4. ``cma``: CMA-ES over the unit box from the best candidate so far, its grasp fixed,
+2. ``first``: the cell as given and the best POPULATION − 1 screened candidates
+   through the pipeline (one batch).
+3. ``cma``: CMA-ES over the unit box from the best candidate so far, its grasp fixed,
    in generations of POPULATION; each generation is ranked by the lexicographic
    objective (``Evaluation.key``: CMA-ES uses ranks only). When it converges it
    restarts from the best screened candidate not yet used, until the budget is spent.
@@ -56,7 +56,7 @@ def _cma(space: SearchSpace, start: Evaluation, seed: int):
 
     options = {
         "bounds": [0.0, 1.0], "popsize": POPULATION, "seed": seed + 1,  # cma: 0 is random
-        "verbose": -9, "tolx": CMA_TOL_X, "CMA_stds": None,
+        "verbose": -9, "tolx": CMA_TOL_X,
     }  # fmt: skip
     x0 = np.clip(np.asarray(start.candidate.x, dtype=float), 0.05, 0.95)
     return cma.CMAEvolutionStrategy(x0, SIGMA0, options)
@@ -83,17 +83,16 @@ def search(
         run: evaluates a batch with a stage ("screen" | "plan"), results in order.
     """
     start = time.perf_counter()
-    evaluated = run("plan", [baseline])
     screened = run("screen", space.grid(place.screen_points))
     unused = sorted(screened, key=Evaluation.key)  # best first
-    budget = place.budget - 1
+    # The cell as given and the best screened points: one batch.
+    first = [e.candidate for e in unused[: min(POPULATION, place.budget) - 1]]
+    unused = unused[len(first) :]
+    evaluated = run("plan", [baseline, *first])
+    budget = place.budget - len(evaluated)
     if space.dimensions == 0 or budget <= 0:  # grasps only: each is one evaluation
         evaluated += run("plan", [e.candidate for e in unused[:budget]])
         return _result(evaluated, screened, start)
-    first = [e.candidate for e in unused[: min(POPULATION, budget)]]
-    unused = unused[len(first) :]
-    evaluated += run("plan", first)
-    budget -= len(first)
     origin, seed = min(evaluated[1:], key=Evaluation.key), place.seed
     while budget > 0:
         es = _cma(space, origin, seed)

@@ -18,6 +18,11 @@ from offline_prog.placement.search import Placement
 SIZE, PAD = 560, 50  # SVG size and margin [px]
 # Cycle-time colour scale: fastest to slowest feasible candidate (viridis ends).
 FAST, SLOW = (68, 1, 84), (253, 231, 37)
+# Infeasible candidates by failure kind (errors.Failure values, "refused").
+FAILURE_COLORS = {
+    "out_of_reach": "#d62728", "joint_limit": "#ff7f0e", "joint_rate_limit": "#bcbd22",
+    "singularity": "#9467bd", "collision": "#8c564b", "refused": "#7f7f7f",
+}  # fmt: skip
 
 
 def _colour(t: float, low: float, high: float) -> str:
@@ -51,7 +56,7 @@ def _map_svg(result: Placement) -> str:
             tip = f"{e.cycle_time_s:.2f} s, margin {e.joint_limit_margin_deg:.1f}°"
             fill = _colour(e.cycle_time_s, low, high)
         else:
-            tip, fill = e.reason, "#d62728"
+            tip, fill = e.reason, FAILURE_COLORS.get(e.failure, "#d62728")
         items.append(
             f'<circle cx="{x:.1f}" cy="{y:.1f}" r="5" fill="{fill}" stroke="#333" '
             f'stroke-width="0.5"><title>{html.escape(tip)}</title></circle>'
@@ -90,6 +95,10 @@ def render_placement_html(result: Placement, data: dict, preview: str | None) ->
     """The page, from the search result and placement.json's ``data``."""
     cut = data["cycle_time_cut"]
     best = data["best"]
+    legend = ", ".join(
+        f'<span style="color:{colour}">●</span> {kind.replace("_", " ")}'
+        for kind, colour in FAILURE_COLORS.items()
+    )
     summary = (
         f"best: {'feasible' if best['feasible'] else 'infeasible: ' + best['reason']}"
         + (f", cycle {best['cycle_time_s']:.2f} s" if best["cycle_time_s"] else "")
@@ -138,7 +147,8 @@ td,th{{border:1px solid #ccc;padding:2px 6px;font-size:13px}}</style></head><bod
 {engine["workers"]} worker(s) ({html.escape(engine["scheduler"])}).</p>
 <h2>Tool positions (top view)</h2>
 <p>Small dots: screened grid (grey: the path IK follows the path; red: it cannot).
-Circles: evaluated (dark = fast, yellow = slow; red: infeasible, hover for why).
+Circles: evaluated, feasible from dark (fast) to yellow (slow); infeasible by why
+({legend}; hover for the whole reason).
 Square: the cell as given. Star: best.</p>
 {_map_svg(result)}
 <h2>Best candidates</h2>

@@ -45,6 +45,7 @@ def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_p
     best = ours["best"]
     assert set(best) >= CONTRACT and best["feasible"] and best["reason"] == ""
     assert not ours["baseline"]["feasible"] and "out of reach" in ours["baseline"]["reason"]
+    assert ours["baseline"]["failure"] == "out_of_reach" and best["failure"] == ""
     assert all(set(c) >= CONTRACT for c in ours["candidates"])
     assert ours["candidates"][0]["X_IT"] == best["X_IT"]
     # placed.yaml: the cell's text (comments kept) with the best placement; plan agrees.
