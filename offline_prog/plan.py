@@ -267,9 +267,15 @@ def plan_job(
         InputError: bad input (one line; exit 2).
         PlanFailedError: a seam the robot cannot do, or a link not found (exit 1).
     """
-    file = Path(cell_file)
     stage = StageTimer(progress)
-    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
+    inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir)
+    return plan_loaded_job(inputs, stage)
+
+
+def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
+    """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory)."""
+    file = inputs.file
+    progress = stage.progress
     scene = stage("scene", "building the Drake cell", build_scene, inputs)
     q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
 

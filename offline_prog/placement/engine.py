@@ -20,8 +20,11 @@ import os
 from collections.abc import Callable, Sequence
 
 from offline_prog.errors import InputError
-from offline_prog.placement.evaluate import Evaluation, context, evaluate, screen
+from offline_prog.placement.context import context
+from offline_prog.placement.evaluate import evaluate
+from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import CellPayload
+from offline_prog.placement.screen import screen
 from offline_prog.placement.space import Candidate
 
 CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds

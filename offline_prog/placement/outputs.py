@@ -22,7 +22,8 @@ import os
 from pathlib import Path
 
 from offline_prog.config.cell import Cell, load_cell
-from offline_prog.placement.evaluate import Context, Evaluation, moved_obstacles
+from offline_prog.placement.context import Context, moved_obstacles
+from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.search import Placement
 from offline_prog.placement.space import Pose, SearchSpace
 from offline_prog.session.cell_text import with_values
@@ -53,6 +54,7 @@ def terms(e: Evaluation) -> dict:
         "slowed_share": e.slowed_share,
         "limiting_axis": e.limiting_axis or None,
         "process_bound_s": _finite(e.process_bound_s),
+        "air_time_s": e.air_time_s,
         "tier": e.tier,
         "violation": e.violation,
         "reason": e.reason,
@@ -88,12 +90,19 @@ def cycle_time_cut(result: Placement) -> dict:
         return out
     bound = best.process_bound_s
     possible = 1.0 - bound / base.cycle_time_s
-    feasible = [e for e in result.evaluated if e.feasible]
-    axes = collections.Counter(e.limiting_axis for e in feasible if e.limiting_axis)
     why = (
         f"the process speed alone takes {bound:.2f} s (path length / speed with the time "
         f"law's ramps), so no placement can cut more than {100 * possible:.1f} %"
     )
+    if best.air_time_s > 0:  # a job: approach, retract and links come on top
+        possible = 1.0 - (bound + best.air_time_s) / base.cycle_time_s
+        why = (
+            f"the seams at the process speed alone take {bound:.2f} s and the best job "
+            f"spends {best.air_time_s:.2f} s off them (approach, retract, links): with those "
+            f"moves no placement cuts more than {100 * possible:.1f} %"
+        )
+    feasible = [e for e in result.evaluated if e.feasible]
+    axes = collections.Counter(e.limiting_axis for e in feasible if e.limiting_axis)
     if axes and possible >= CUT_TARGET:
         axis, count = axes.most_common(1)[0]
         least = min(e.slowed_share for e in feasible)
@@ -141,13 +150,19 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict) -
 
 
 def _file_keys(cell: Cell) -> dict[str, str]:
-    """{dotted key: file name} of the data files a one-seam cell names."""
+    """{dotted key: file name} of the data files a cell names."""
     keys = {}
     if cell.part.mesh:
         keys["part.mesh"] = cell.part.mesh
-    for name in ("points", "dxf"):
-        if getattr(cell.path, name):
-            keys[f"path.{name}"] = getattr(cell.path, name)
+    paths = (
+        [("path", cell.path)]
+        if cell.path
+        else [(f"seams.{k}", s) for k, s in enumerate(cell.seams)]
+    )
+    for key, path in paths:
+        for name in ("points", "dxf"):
+            if getattr(path, name):
+                keys[f"{key}.{name}"] = getattr(path, name)
     for owner, shapes in (("obstacles", cell.obstacles), ("part.geometry", cell.part.geometry),
                           ("tool.geometry", cell.tool.geometry)):  # fmt: skip
         for i, shape in enumerate(shapes):

@@ -20,8 +20,9 @@ from offline_prog.atomic import staged_folder, write_manifest
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
 from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.placement.context import context
 from offline_prog.placement.engine import DaskEngine, SerialEngine
-from offline_prog.placement.evaluate import context, plan_candidate
+from offline_prog.placement.evaluate import plan_candidate
 from offline_prog.placement.outputs import placed_text, placement_json, write_json
 from offline_prog.placement.payload import cell_payload
 from offline_prog.placement.search import search
@@ -101,6 +102,8 @@ def place_cell(
         (folder / "placed.yaml").write_text(placed_text(cell_file, ctx, result.best, out_dir))
         preview = None
         if result.best.feasible:
+            from offline_prog.plan import JobPlan
+            from offline_prog.viz.job_preview import write_job_preview_html
             from offline_prog.viz.preview import write_preview_html
 
             try:
@@ -108,7 +111,8 @@ def place_cell(
             except (PlanFailedError, InputError):  # evaluated feasible: cannot happen
                 plan = None
             if plan is not None:
-                write_preview_html(plan, folder / "best_preview.html")
+                write = write_job_preview_html if isinstance(plan, JobPlan) else write_preview_html
+                write(plan, folder / "best_preview.html")
                 preview = "best_preview.html"
         write_json(folder / "placement.json", data)
         (folder / "placement.html").write_text(render_placement_html(result, data, preview))

@@ -24,7 +24,7 @@ from collections.abc import Callable
 import numpy as np
 
 from offline_prog.config.cell import PlaceConfig
-from offline_prog.placement.evaluate import Evaluation
+from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.space import Candidate, SearchSpace
 
 POPULATION = 8  # candidates per batch and per CMA-ES generation

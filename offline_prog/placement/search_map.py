@@ -12,7 +12,7 @@ from __future__ import annotations
 import html
 import math
 
-from offline_prog.placement.evaluate import Evaluation
+from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.search import Placement
 
 SIZE, PAD = 560, 50  # SVG size and margin [px]

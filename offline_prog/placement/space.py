@@ -190,10 +190,6 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
             raise InputError(
                 file, f"place.moves_with_tool[{i}]", f"{name!r} is not an obstacle of the cell"
             )
-    if cell.seams:
-        raise InputError(
-            file, "place", "a job (seams:) cannot be placed yet: place one seam (path:) at a time"
-        )
     axes = _axes(file, "X_IT", place.X_IT)
     grasps = (_pose(cell.part.X_PE),)
     if place.X_PE is not None:

@@ -9,15 +9,11 @@ import pytest
 
 from offline_prog.config.cell import load_cell, transform
 from offline_prog.joints.path_ik import reach_excess
-from offline_prog.placement.evaluate import (
-    CANNOT_FOLLOW,
-    FEASIBLE,
-    context,
-    evaluate,
-    placed_cell,
-    screen,
-)
+from offline_prog.placement.context import context, placed_cell
+from offline_prog.placement.evaluate import evaluate
+from offline_prog.placement.objective import CANNOT_FOLLOW, FEASIBLE
 from offline_prog.placement.payload import cell_payload, unpack
+from offline_prog.placement.screen import screen
 from offline_prog.placement.space import Candidate, check_place
 from offline_prog.robot.model import load_robot
 
@@ -105,3 +101,22 @@ def test_reach_excess_is_zero_wherever_the_robot_reaches_and_grows_outside(name,
     beyond = reach_excess(robot, out) > 0  # most, not the poses near the base
     assert beyond.mean() > 0.8
     assert np.all(reach_excess(robot, far)[beyond] > reach_excess(robot, out)[beyond])
+
+
+def test_a_job_is_screened_seam_by_seam():
+    file = CELLS / "seal_job_kr16.yaml"
+    ctx = context(cell_payload(file, load_cell(file)))
+    assert ctx.job and [s.inputs.cell.path.analytic.kind for s in ctx.seams] == [
+        "rounded_rectangle", "arc", "arc", "line",
+    ]  # fmt: skip
+    X_PE = ((0.0, 0.0, 0.1), (180.0, 0.0, 0.0))
+    given = screen(ctx, Candidate((), -1, ((1.0, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
+    assert given.tier == FEASIBLE
+    one = context(
+        cell_payload(CELLS / "seal_plate_kr16.yaml", load_cell(CELLS / "seal_plate_kr16.yaml"))
+    )
+    border = screen(one, Candidate((), -1, ((1.0, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
+    assert given.cycle_time_s > border.cycle_time_s  # the border and three more seams
+    far = screen(ctx, Candidate((), -1, ((2.4, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
+    assert far.tier == CANNOT_FOLLOW and far.failure == "out_of_reach"
+    assert far.violation > 3.0  # all four seams out of reach, each adding its share

@@ -98,3 +98,22 @@ def test_ctrl_c_stops_the_workers_exit_130_one_line_no_folder(tmp_path):
             break
         time.sleep(0.5)
     assert left.stdout.strip() == "", "worker processes outlived the interrupt"
+
+
+@pytest.mark.slow  # ~40 s: six whole-job plans and the plan of placed.yaml
+def test_a_whole_job_is_placed_and_plan_agrees(tmp_path):
+    source = CELLS / "placement" / "seal_job_far_kr16.yaml"
+    file = tmp_path / "job.yaml"
+    file.write_text(source.read_text().replace("seed: 0", "seed: 0\n  screen_points: 100"))
+    out = tmp_path / "out"
+    assert main(["place", str(file), "--out", str(out), "--budget", "6", "--workers", "0"]) == 0
+    data = json.loads((out / "placement.json").read_text())
+    best, base = data["best"], data["baseline"]
+    assert base["feasible"] and best["feasible"]
+    assert best["cycle_time_s"] <= base["cycle_time_s"]
+    assert best["air_time_s"] > 0  # approach, retract and links are part of the cycle
+    from offline_prog.plan import plan_job
+
+    job = plan_job(out / "placed.yaml")
+    assert job.feasible
+    assert job.samples.t[-1] - job.samples.t[0] == pytest.approx(best["cycle_time_s"], abs=1e-9)

@@ -1,0 +1,125 @@
+"""What a worker keeps of the cell between candidates, and the cell of one candidate.
+
+A worker unpacks the payload once (``payload.unpack``), loads it as ``plan`` does and
+fits each seam's path once: the seams do not move on the part, whatever the placement.
+A candidate's cell is the loaded one with its X_IT and X_PE (``session.state.apply``,
+which keeps every other value), and the obstacles that stand with the tool
+(``place.moves_with_tool``) moved with it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from pydrake.math import RigidTransform, RollPitchYaw
+
+from offline_prog.config.cell import Cell, transform
+from offline_prog.job.seams import is_job, job_seams, seam_inputs
+from offline_prog.placement.payload import CellPayload, unpack
+from offline_prog.placement.space import Candidate, Pose
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.session.state import SessionState, apply, initial_state, schema_transform
+from offline_prog.stages import FittedPath, Inputs, fit_path, load_inputs
+
+SCREEN_SAMPLES = 1000  # σ samples of a seam's path-IK screen (corners need ~10 each)
+
+
+@dataclasses.dataclass
+class SeamView:
+    """One seam as the screen sees it: its Inputs, its fitted path and σ samples."""
+
+    inputs: Inputs
+    fit: FittedPath
+    screen_s: np.ndarray  # (SCREEN_SAMPLES,) σ [m]
+
+
+@dataclasses.dataclass
+class Context:
+    """The loaded cell of a worker.
+
+    Attributes:
+        inputs: the cell as given (a job's, for a job).
+        seams: every seam (one for a one-seam cell).
+        job: the cell plans as a whole job (``plan_job``).
+        initial: the cell's own editable values; carried: indices of the obstacles
+            that stand with the tool.
+    """
+
+    inputs: Inputs
+    seams: list[SeamView]
+    job: bool
+    initial: SessionState
+    carried: tuple[int, ...]
+
+
+_CONTEXTS: dict[str, Context] = {}  # per worker process: one loaded cell per payload
+
+
+def _seam(inputs: Inputs) -> SeamView:
+    fit = fit_path(inputs)
+    return SeamView(inputs, fit, np.linspace(0.0, fit.path.length, SCREEN_SAMPLES))
+
+
+def context(payload: CellPayload) -> Context:
+    """The worker's Context for ``payload``, loaded on first use."""
+    kept = _CONTEXTS.get(payload.digest)
+    if kept is None:
+        _CONTEXTS.clear()
+        inputs = load_inputs(unpack(payload), ROBOTS_DIR)
+        cell = inputs.cell
+        job = is_job(cell)
+        if job:
+            seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
+        else:
+            seams = [_seam(inputs)]
+        names = set(cell.place.moves_with_tool) if cell.place else set()
+        carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
+        kept = Context(inputs, seams, job, initial_state(cell), carried)
+        _CONTEXTS[payload.digest] = kept
+    return kept
+
+
+def rigid(pose: Pose) -> RigidTransform:
+    """The RigidTransform of (p [m], rpy [deg])."""
+    p, rpy = pose
+    return RigidTransform(RollPitchYaw(np.deg2rad(rpy)), np.asarray(p, dtype=float))
+
+
+def pose_of(X: RigidTransform) -> Pose:
+    """(p [m], rpy [deg]) of a RigidTransform, rounded to 1 µm and 1e-6 deg."""
+    p = tuple(round(float(v), 6) + 0.0 for v in X.translation())
+    rpy = RollPitchYaw(X.rotation()).vector()
+    return p, tuple(round(float(np.rad2deg(a)), 6) + 0.0 for a in rpy)
+
+
+def moved_obstacles(ctx: Context, candidate: Candidate) -> dict[int, Pose]:
+    """{obstacle index: its pose in I} of the obstacles that stand with the tool, moved
+    with it: X_IO' = X_IT' · X_IT⁻¹ · X_IO."""
+    X_TT = rigid(candidate.X_IT) @ ctx.inputs.X_IT.inverse()  # old tool pose → new
+    return {i: pose_of(X_TT @ transform(ctx.inputs.cell.obstacles[i].pose)) for i in ctx.carried}
+
+
+def placed_cell(ctx: Context, candidate: Candidate) -> Cell:
+    """The cell with the candidate's X_IT and X_PE and the carried obstacles moved."""
+    state = dataclasses.replace(
+        ctx.initial,
+        p_IT=candidate.X_IT[0], rpy_IT_deg=candidate.X_IT[1],
+        p_PE=candidate.X_PE[0], rpy_PE_deg=candidate.X_PE[1],
+    )  # fmt: skip
+    cell = apply(ctx.inputs.cell, ctx.initial, state)
+    moved = moved_obstacles(ctx, candidate)
+    if not moved:
+        return cell
+    obstacles = list(cell.obstacles)
+    for i, pose in moved.items():
+        obstacles[i] = dataclasses.replace(obstacles[i], pose=schema_transform(*pose))
+    return dataclasses.replace(cell, obstacles=obstacles)
+
+
+def placed_inputs(ctx: Context, candidate: Candidate) -> Inputs:
+    """The loaded cell's Inputs with the candidate's cell and poses."""
+    cell = placed_cell(ctx, candidate)
+    return dataclasses.replace(
+        ctx.inputs, cell=cell, X_IT=transform(cell.tool.X_IT), X_PE=transform(cell.part.X_PE)
+    )

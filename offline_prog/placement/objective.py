@@ -1,0 +1,85 @@
+"""The placement objective (issue 16), lexicographic, :meth:`Evaluation.key`:
+
+1. feasible: reach, joint limits, one branch along the path, collision-free at the
+   cell's clearances. An infeasible candidate keeps its reason and how far it is from
+   feasible (``tier``, ``violation``), so a search can climb out of an infeasible
+   start: tier 1 collides (violation: depth below the clearance [m]), tier 2 cannot
+   follow the path (violation: share of the path out of reach plus the mean distance
+   beyond reach [m] (``path_ik.reach_excess``), share on a flipping branch, joint-limit
+   excess / π [rad], and the share of the path not done), tier 3 makes geometry the
+   method refuses (violation 1).
+2. cycle time [s], resolved to CYCLE_RESOLUTION_S, then
+3. the smallest joint-limit margin [deg] (larger is better),
+4. the distance to the wrist and elbow singularities [deg] (larger is better),
+5. the clearance [mm] (larger is better).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from offline_prog.placement.space import Candidate
+
+CYCLE_RESOLUTION_S = 0.01  # cycle times closer than this tie; the margins decide
+FEASIBLE, COLLIDES, CANNOT_FOLLOW, REFUSED = range(4)  # tiers
+
+
+@dataclasses.dataclass(frozen=True)
+class Evaluation:
+    """A candidate and every objective term.
+
+    Attributes:
+        candidate: what was evaluated.
+        stage: "screen" (analytic path IK only) or "plan" (the planning pipeline).
+        tier: FEASIBLE, COLLIDES, CANNOT_FOLLOW or REFUSED; violation: how far from
+            feasible within the tier (0 when feasible).
+        reason: why it is infeasible, one line ("" when feasible).
+        failure: its kind: a :class:`~offline_prog.errors.Failure` value
+            ("out_of_reach", "joint_limit", "singularity", "collision", ...) or
+            "refused" (geometry the method refuses); "" when feasible.
+        cycle_time_s: the seam's duration [s] (NaN without a plan).
+        joint_limit_margin_deg: smallest distance of a joint to its limits [deg].
+        singularity_margin_deg: smallest wrist or elbow angle from singular [deg].
+        clearance_mm: smallest distance of a checked pair [mm] (NaN without a plan).
+        tool_rotation_deg: the free tool rotation chosen [deg].
+        process_bound_s: the seam at the process speed with no joint slow-down (the
+            time law's nominal duration) [s]: no placement is faster.
+        slowed_share: share of the path the joints slowed below the process speed;
+            limiting_axis: the axis (1..6) closest to its limit there (0: none).
+        air_time_s: a job's time off the seams: approach, retract, links [s].
+        seconds: the evaluation's wall time [s].
+    """
+
+    candidate: Candidate
+    stage: str
+    tier: int
+    violation: float
+    reason: str
+    failure: str = ""
+    cycle_time_s: float = math.nan
+    joint_limit_margin_deg: float = -math.inf
+    singularity_margin_deg: float = 0.0
+    clearance_mm: float = math.nan
+    tool_rotation_deg: float = 0.0
+    process_bound_s: float = math.nan
+    slowed_share: float = 0.0
+    air_time_s: float = 0.0
+    limiting_axis: int = 0
+    seconds: float = 0.0
+
+    @property
+    def feasible(self) -> bool:
+        return self.tier == FEASIBLE
+
+    def key(self) -> tuple:
+        """The lexicographic objective: smaller is better."""
+        cycle = self.cycle_time_s if math.isfinite(self.cycle_time_s) else math.inf
+        return (
+            self.tier,
+            self.violation,
+            round(cycle / CYCLE_RESOLUTION_S) if cycle < math.inf else math.inf,
+            -self.joint_limit_margin_deg,
+            -self.singularity_margin_deg,
+            -(self.clearance_mm if math.isfinite(self.clearance_mm) else -math.inf),
+        )
