@@ -6,7 +6,8 @@ place``). In one process, on this machine:
 1. a poor X_IT (cells/placement/seal_out_of_reach_kr16.yaml: the nozzle beyond reach):
    ``place`` finds a feasible placement and ``plan`` on placed.yaml succeeds;
 2. feasible cells: the cut of the cycle time (≥ 15 %, or the report's reason why not)
-   on cells/placement/seal_far_kr16.yaml and on the seal demo with a place: block;
+   on cells/placement/seal_far_kr16.yaml, on the seal demo with a place: block and on
+   the whole job cells/placement/seal_job_far_kr16.yaml (budget ≤ 60);
 3. five seeds on seal_far: the best objectives' spread (≤ 2 %);
 4. candidates per second through the planning pipeline, in this process and on a
    2-worker LocalCluster (after each worker has loaded the cell), the parallel
@@ -30,12 +31,14 @@ from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.payload import cell_payload
 from offline_prog.placement.run import place_cell
 from offline_prog.placement.space import check_place
-from offline_prog.plan import plan_cell
+from offline_prog.plan import plan_cell, plan_job
 
 ROOT = Path(__file__).resolve().parents[1]
 CELLS = ROOT / "cells"
 OUT_OF_REACH = CELLS / "placement" / "seal_out_of_reach_kr16.yaml"
 FAR = CELLS / "placement" / "seal_far_kr16.yaml"
+JOB = CELLS / "placement" / "seal_job_far_kr16.yaml"
+JOB_BUDGET = 60  # a job's candidate is ~3 s
 SEEDS = range(5)
 THROUGHPUT_CANDIDATES = 32
 
@@ -140,6 +143,11 @@ def main() -> None:
         print(f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
               f"cycle {replan.trajectory.duration:.2f} s")  # fmt: skip
         show("seal_plate_kr16", search(seal_with_place(folder), folder / "seal", args.budget))
+        data = search(JOB, folder / "job", min(args.budget, JOB_BUDGET))
+        show("seal_job_far_kr16 (job)", data)
+        replan = plan_job(folder / "job" / "placed.yaml")
+        print(f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
+              f"cycle {replan.samples.t[-1]:.2f} s")  # fmt: skip
         bests = []
         for seed in range(args.seeds):
             data = search(FAR, folder / f"far{seed}", args.budget, seed=seed)

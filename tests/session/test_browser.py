@@ -169,11 +169,7 @@ def test_session_in_the_browser(session):
         )  # fmt: skip
         assert ours == theirs
         report = json.loads((exported / "report.json").read_text())
-        assert (
-            report["cell_file"].endswith("seal_plate_kr16-1.yaml")
-            if "cell_file" in report
-            else True
-        )
+        assert report["cell"].endswith("seal_plate_kr16-1.yaml")  # the saved cell
 
         # A bad typed value: refused in the status line, the session goes on.
         speed = page.locator('input.num[data-key="speed"]')
