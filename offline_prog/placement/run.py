@@ -19,19 +19,17 @@ from pathlib import Path
 from offline_prog.atomic import staged_folder, write_manifest
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
-from offline_prog.errors import InputError, PlanFailedError
-from offline_prog.placement.context import context
+from offline_prog.placement.context import Context, context
 from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.evaluate import plan_candidate
+from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.outputs import placed_text, placement_json, write_json
-from offline_prog.placement.payload import cell_payload
-from offline_prog.placement.search import search
+from offline_prog.placement.payload import CellPayload, cell_payload
+from offline_prog.placement.search import Placement, search
 from offline_prog.placement.search_map import render_placement_html
-from offline_prog.placement.space import Candidate, check_place
+from offline_prog.placement.space import Candidate, SearchSpace, check_place
 from offline_prog.results.plan_folder import check_out_dir
 from offline_prog.robot.model import ROBOTS_DIR
-
-NAMES = ("placement.json", "placed.yaml", "placement.html", "best_preview.html")
 
 
 def place_cell(
@@ -59,64 +57,88 @@ def place_cell(
         InputError: bad input, an unreachable scheduler, a bad --out (exit 2).
     """
     cell_file, out_dir = Path(cell_file), Path(out_dir)
+    place, space, payload = load(cell_file, out_dir, budget, seed)
+    started = time.perf_counter()
+    engine = start_engine(payload, workers, scheduler)
+    try:
+        result = search(space, place, space.baseline, _runner(engine, space, place, progress))
+    finally:
+        engine.close()
+    data = placement_json(result, space, place, engine_figures(engine, result, started))
+    progress("outputs", 0, 1)
+    write_folder(out_dir, cell_file, context(payload), result, data)
+    progress("outputs", 1, 1)
+    return data
+
+
+def load(cell_file: Path, out_dir: Path, budget: int | None, seed: int | None):
+    """Stage ``load``: --out, the cell and its ``place:`` block checked; the payload.
+
+    Returns:
+        (PlaceConfig, SearchSpace, CellPayload).
+    """
     check_out_dir(out_dir)
     cell = load_cell(cell_file)
     check_cell(cell_file, cell, ROBOTS_DIR)
     place, space = check_place(cell_file, cell, budget=budget, seed=seed)
-    payload = cell_payload(cell_file, cell)
-    started = time.perf_counter()
+    return place, space, cell_payload(cell_file, cell)
+
+
+def start_engine(payload: CellPayload, workers: int | None, scheduler: str | None):
+    """Stage ``engine``: this process (``--workers 0``) or Dask."""
     if workers == 0 and not scheduler:
-        engine = SerialEngine(payload)
-    else:
-        engine = DaskEngine(payload, workers=workers, scheduler=scheduler)
-    try:
-        totals = {"screen": len(space.grid(place.screen_points)), "plan": place.budget}
-        done = {"screen": 0, "plan": 0}
+        return SerialEngine(payload)
+    return DaskEngine(payload, workers=workers, scheduler=scheduler)
 
-        def run(stage: str, candidates: list[Candidate]):
-            def advance(n: int) -> None:
-                done[stage] += n
-                progress(stage, done[stage], totals[stage])
 
-            return engine.map(stage, candidates, advance)
+def _runner(engine, space: SearchSpace, place, progress):
+    """``search``'s ``run``: the engine's map, telling ``progress`` per stage."""
+    totals = {"screen": len(space.grid(place.screen_points)), "plan": place.budget}
+    done = {"screen": 0, "plan": 0}
 
-        result = search(space, place, space.baseline, run)
-    finally:
-        engine.close()
-    wall = time.perf_counter() - started
+    def run(stage: str, candidates: list[Candidate]):
+        def advance(n: int) -> None:
+            done[stage] += n
+            progress(stage, done[stage], totals[stage])
+
+        return engine.map(stage, candidates, advance)
+
+    return run
+
+
+def engine_figures(engine, result: Placement, started: float) -> dict:
+    """placement.json's ``engine``."""
     evaluated = len(result.evaluated)
-    engine_info = {
+    return {
         "scheduler": engine.scheduler,
         "workers": engine.workers,
         "candidates_evaluated": evaluated,
         "screened": len(result.screened),
-        "wall_time_s": wall,
+        "wall_time_s": time.perf_counter() - started,
         "search_s": result.wall_s,
         "candidates_per_s": evaluated / result.wall_s if result.wall_s > 0 else None,
         "evaluation_s_mean": sum(e.seconds for e in result.evaluated) / evaluated,
     }
-    data = placement_json(result, space, place, engine_info)
-    progress("outputs", 0, 1)
-    ctx = context(payload)
+
+
+def write_folder(out_dir: Path, cell_file: Path, ctx: Context, result: Placement, data: dict):
+    """Stage ``outputs``: the folder, written aside and swapped in when complete."""
     with staged_folder(out_dir) as folder:
         (folder / "placed.yaml").write_text(placed_text(cell_file, ctx, result.best, out_dir))
         preview = None
         if result.best.feasible:
-            from offline_prog.plan import JobPlan
-            from offline_prog.viz.job_preview import write_job_preview_html
-            from offline_prog.viz.preview import write_preview_html
-
-            try:
-                plan = plan_candidate(ctx, result.best.candidate)
-            except (PlanFailedError, InputError):  # evaluated feasible: cannot happen
-                plan = None
-            if plan is not None:
-                write = write_job_preview_html if isinstance(plan, JobPlan) else write_preview_html
-                write(plan, folder / "best_preview.html")
-                preview = "best_preview.html"
+            write_best_preview(ctx, result.best, folder / "best_preview.html")
+            preview = "best_preview.html"
         write_json(folder / "placement.json", data)
         (folder / "placement.html").write_text(render_placement_html(result, data, preview))
-        names = sorted(p.name for p in folder.iterdir())
-        write_manifest(folder, {"plan": names})
-    progress("outputs", 1, 1)
-    return data
+        write_manifest(folder, {"plan": sorted(p.name for p in folder.iterdir())})
+
+
+def write_best_preview(ctx: Context, best: Evaluation, file: Path) -> None:
+    """The best candidate planned again here, as an animated MeshCat page."""
+    from offline_prog.plan import JobPlan
+    from offline_prog.viz.job_preview import write_job_preview_html
+    from offline_prog.viz.preview import write_preview_html
+
+    plan = plan_candidate(ctx, best.candidate)  # evaluated feasible: plans again
+    (write_job_preview_html if isinstance(plan, JobPlan) else write_preview_html)(plan, file)
