@@ -124,12 +124,14 @@ def plot_specs(report: dict, data: ProgramData, columns: dict) -> list[dict]:
             _series("commanded (limit, reductions)", "command_mm_s", "#000000", dash=True),
             _series(measured, "speed_mm_s", XYZ_COLORS[0]),
         ],
+        "bands": slowdown_bands(report),
     }
     specs = [
         ("pose", "Flange trajectory in I (as the paper's fig. 5): position, Tait-Bryan angles "
          "R = Rx(α)Ry(β)Rz(γ), linear and angular velocity and acceleration.", 2, pose),
         ("speed", f"Speed at the {ref} against the command: the speed limit, lowered where "
-         "the joint limits forced a speed reduction.", 1, [speed]),
+         "the joint limits forced a speed reduction; time-optimal slowdowns are shaded, "
+         "each named by its limiting joint and constraint.", 1, [speed]),
         ("joints", "Joint positions with their limits (dashed).", 3, _joint_panels(data, False)),
         ("rates", "Joint velocities with their limits (dashed).", 3, _joint_panels(data, True)),
     ]  # fmt: skip
@@ -148,6 +150,17 @@ def plot_specs(report: dict, data: ProgramData, columns: dict) -> list[dict]:
              "obstacles), against the required clearance.", 1, [panel])
         )  # fmt: skip
     return [{"id": i, "caption": c, "columns": n, "panels": p} for i, c, n, p in specs]
+
+
+def slowdown_bands(report: dict) -> list[dict]:
+    """The time law's slowdowns (time_optimal) as shaded bands of the speed plot:
+    {t0, t1 [s], label: the limiting joint and constraint, e.g. "J3 acceleration"}."""
+    bands = []
+    for slow in report["robot_motion"].get("slowdowns", []):
+        joint = f"J{slow['joint']} " if slow["joint"] is not None else ""
+        bands.append({"t0": slow["t_start_s"], "t1": slow["t_end_s"],
+                      "label": joint + slow["constraint"]})  # fmt: skip
+    return bands
 
 
 def _rounded(values: np.ndarray) -> list[float]:
@@ -259,6 +272,20 @@ PLOT_SCRIPT = """
 (() => {
   const D = JSON.parse(document.getElementById("plot-data").textContent);
   const sync = uPlot.sync("t");
+  // Shaded time bands (the speed plot's slowdowns), each labelled at its top.
+  const drawBands = (u, bands) => {
+    const ctx = u.ctx, top = u.bbox.top, height = u.bbox.height;
+    ctx.save();
+    ctx.font = `${Math.round(10 * devicePixelRatio)}px sans-serif`;
+    for (const b of bands) {
+      const x0 = u.valToPos(b.t0, "x", true), x1 = u.valToPos(b.t1, "x", true);
+      ctx.fillStyle = "rgba(255, 160, 0, 0.15)";
+      ctx.fillRect(x0, top, Math.max(x1 - x0, 1), height);
+      ctx.fillStyle = "#b36b00";
+      ctx.fillText(b.label, x0 + 2, top + 12 * devicePixelRatio);
+    }
+    ctx.restore();
+  };
   for (const plot of D.plots) {
     const box = document.getElementById(plot.id);
     const width = Math.floor((box.clientWidth || 1100) / plot.columns) - 8;
@@ -275,6 +302,7 @@ PLOT_SCRIPT = """
         series: [{label: "t [s]"}].concat(panel.series.map(s => ({
           label: s.label, stroke: s.color, width: 1.3, dash: s.dash ? [6, 4] : undefined,
         }))),
+        hooks: {drawClear: [u => drawBands(u, panel.bands || [])]},
       }, [x].concat(ys), cell);
     }
   }

@@ -264,3 +264,35 @@ def test_browser_shows_the_plots(plan_dir, tmp_path_factory):
         colour = (region.max(axis=2) - region.min(axis=2) > 0.3).mean()  # coloured lines
         assert 0.005 < ink < 0.6 and colour > 0.001, (plot["id"], ink, colour)
     assert len(boxes["svgs"]) == 4 and all(s["w"] > 300 for s in boxes["svgs"])
+
+
+@pytest.mark.slow  # a time-optimal plan of the seal demo and a browser screenshot
+def test_speed_plot_shades_each_time_optimal_slowdown_with_its_joint(tmp_path):
+    cell = tmp_path / "seal_time_optimal.yaml"
+    text = (CELLS / "seal_plate_kr16.yaml").read_text()
+    cell.write_text(text.replace("  speed_reference: tcp\n",
+                                 "  speed_reference: tcp\n  time_law: time_optimal\n"))  # fmt: skip
+    plan_dir = make_plan_folder(cell, tmp_path / "plan")
+    slowdowns = json.loads((plan_dir / "report.json").read_text())["robot_motion"]["slowdowns"]
+    assert any(s["joint"] is not None for s in slowdowns), slowdowns  # the corners
+    file = write_report_html(plan_dir)
+    specs = {spec["id"]: spec for spec in plot_data(file.read_text())["plots"]}
+    bands = specs["speed"]["panels"][0]["bands"]
+    assert [(b["t0"], b["t1"]) for b in bands] == [
+        (s["t_start_s"], s["t_end_s"]) for s in slowdowns
+    ]
+    assert [b["label"] for b in bands] == [
+        (f"J{s['joint']} " if s["joint"] is not None else "") + s["constraint"] for s in slowdowns
+    ]
+    require_chromium()
+    png = screenshot(file, tmp_path / "speed.png")
+    keep_artifact(png, "report_speed_bands.png")
+    boxes = layout(file)
+    speed = next(p for p in boxes["plots"] if p["id"] == "speed")
+    assert speed["panels"] == 1
+    shot = matplotlib.image.imread(png)[..., :3]
+    x, y, w, h = (int(round(speed[k])) for k in "xywh")
+    region = shot[y : y + h, x : x + w]
+    # The band's tint over white: rgba(255, 160, 0, 0.15) → (1.0, 0.944, 0.85).
+    tint = (np.abs(region - [1.0, 0.944, 0.85]).max(axis=2) < 0.03).mean()
+    assert tint > 0.01, tint
