@@ -3,10 +3,11 @@
 ``time_optimal``: TOPP-RA (``timing.time_optimal``) under the joint velocity and
 acceleration limits, the process speed cap and the path acceleration, with the
 steady-speed joint jerk limit as a speed limit curve; then the jerk stage
-(``timing.jerk_stage``); for ``cycle_time`` also the time-averaged profile
-(``timing.filtered_stage``), keeping the faster of the two that holds every
-limit. ``sin2``: the paper's law with plateaus lowered where the
-joints need it (``timing.joint_timing``).
+(``timing.jerk_stage``), and the time-averaged profile (``timing.filtered_stage``),
+keeping for each intent the better of the two that holds every limit (the faster for
+``cycle_time``; for ``constant_speed`` the one holding the process speed longer).
+``sin2``: the paper's law with plateaus lowered where the joints need it
+(``timing.joint_timing``).
 """
 
 from __future__ import annotations
@@ -18,8 +19,11 @@ from offline_prog.robot.model import RobotModel
 from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates, retime
+from offline_prog.timing.speed_hold import speed_held
 from offline_prog.timing.time_law import Sin2TimeLaw
 from offline_prog.timing.time_optimal import topp_profile
+
+HELD_TIE = 1e-3  # held shares closer than this tie
 
 
 def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time_law: str,
@@ -41,11 +45,25 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
         a_path=nominal.a_max,
     )  # fmt: skip
     path = dict(v_process=nominal.v_max, a_max=nominal.a_max, j_max=nominal.j_max)
+
+    def held(law) -> tuple[float, float]:
+        return speed_held(rates, law, limits=limits, **path)
+
     timing = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
-    if process == "cycle_time":
-        filtered = filtered_timing(rates, profile, limits=limits, **path)
-        if filtered is not None and (
-            not timing.feasible or filtered.law.duration < timing.law.duration
-        ):
-            timing = filtered
-    return dataclasses.replace(timing, topp_plain_s=plain.duration)
+    filtered = filtered_timing(rates, profile, limits=limits, **path)
+    if filtered is not None and (not timing.feasible or _better(filtered, timing, process, held)):
+        timing = dataclasses.replace(filtered, process=process)
+    return dataclasses.replace(timing, topp_plain_s=plain.duration, speed_held=held(timing.law))
+
+
+def _better(filtered, staircase, process: str, held) -> bool:
+    """The averaged profile beats the staircase for the intent: shorter for
+    ``cycle_time``; for ``constant_speed`` it holds the process speed over more of the
+    feasible length (then: shorter). Its speed follows the joints' limit through a
+    slowdown where the staircase holds one steady lower speed; both ramp only where a
+    limit forces it."""
+    if process == "constant_speed":
+        ours, theirs = held(filtered.law)[0], held(staircase.law)[0]
+        if abs(ours - theirs) > HELD_TIE:
+            return ours > theirs
+    return filtered.law.duration < staircase.law.duration

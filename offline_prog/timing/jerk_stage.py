@@ -81,6 +81,9 @@ class JerkLimitedTiming:
     topp: ToppProfile | None = None
     process: str = "constant_speed"
     topp_plain_s: float = float("nan")  # TOPP-RA without the steady jerk limit [s]
+    # (share of the feasible length holding the process speed ±0.5 %, feasible share
+    # of the path): timing.speed_hold.speed_held.
+    speed_held: tuple[float, float] = (float("nan"), float("nan"))
 
 
 def envelope(profile: ToppProfile) -> np.ndarray:

@@ -223,3 +223,13 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
     assert plan.trajectory.duration <= sin2.trajectory.duration
     kinds = {s.constraint for s in plan.joints.retiming.slowdowns}
     assert "jerk" in kinds  # the wrist's jerk limit slows the corners
+    if process == "constant_speed":
+        # ±0.5 % of the process speed on ≥ 90 % of the length where it is feasible;
+        # trajectory.csv's TCP speed agrees (held length ≥ that share of the path).
+        share, room = plan.joints.retiming.speed_held
+        assert share >= 0.9 and 0.5 < room < 1.0, (share, room)
+        v = plan.cell.motion.speed
+        held = np.abs(table["tcp_speed"] - v) <= 0.005 * v
+        ds = np.abs(np.diff(table["sigma"]))
+        on_csv = np.sum(ds * (held[1:] & held[:-1])) / np.sum(ds)
+        assert on_csv >= share * room - 0.01, (on_csv, share, room)
