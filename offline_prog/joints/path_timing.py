@@ -19,7 +19,7 @@ from offline_prog.robot.model import RobotModel
 from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates, retime
-from offline_prog.timing.speed_hold import speed_held
+from offline_prog.timing.speed_hold import SpeedHold
 from offline_prog.timing.time_law import Sin2TimeLaw
 from offline_prog.timing.time_optimal import topp_profile
 
@@ -46,9 +46,7 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
     )  # fmt: skip
     path = dict(v_process=nominal.v_max, a_max=nominal.a_max, j_max=nominal.j_max)
 
-    def held(law) -> tuple[float, float]:
-        return speed_held(rates, law, limits=limits, **path)
-
+    held = SpeedHold(rates, limits=limits, **path)
     timing = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
     filtered = filtered_timing(rates, profile, limits=limits, **path)
     if filtered is not None and (not timing.feasible or _better(filtered, timing, process, held)):

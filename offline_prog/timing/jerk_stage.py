@@ -82,7 +82,7 @@ class JerkLimitedTiming:
     process: str = "constant_speed"
     topp_plain_s: float = float("nan")  # TOPP-RA without the steady jerk limit [s]
     # (share of the feasible length holding the process speed ±0.5 %, feasible share
-    # of the path): timing.speed_hold.speed_held.
+    # of the path): timing.speed_hold.SpeedHold.
     speed_held: tuple[float, float] = (float("nan"), float("nan"))
 
 

@@ -21,32 +21,38 @@ HOLD = 0.005  # ±0.5 % of the process speed
 RAMP_SAMPLES = 20001  # time samples of the nominal law that find its ramps
 
 
-def speed_held(
-    rates: JointRates, law, *, v_process: float, a_max: float, j_max: float, limits
-) -> tuple[float, float]:
-    """(share of the feasible length where ``law`` holds v_process within ±HOLD,
-    share of the path where v_process is feasible).
+class SpeedHold:
+    """The feasible set of a path, once; :meth:`__call__` measures a law on it.
 
     Args:
         rates: q, q′, q″ on a σ grid over [0, length] (controller axes).
-        law: a time law σ(t) (``law(t)`` → σ, σ̇, ...; ``law.duration``).
         v_process [m/s], a_max [m/s²], j_max [m/s³]: the process limits.
         limits: (qd_max, qdd_max, qddd_max), each (6,).
     """
-    length = float(rates.sigma[-1])
-    steady = static_limit(rates, with_jerk(rates), limits)  # (G,) [m/s]
-    nominal = sin2_time_law(length, v_max=v_process, a_max=a_max, j_max=j_max)
-    ramp_sigma, ramp_speed = nominal(np.linspace(0.0, nominal.duration, RAMP_SAMPLES))[:2]
-    cruise = ramp_sigma[ramp_speed >= (1.0 - HOLD) * v_process]
-    if not len(cruise):  # a path too short to reach the process speed
-        return float("nan"), 0.0
-    sigma, speed = law(np.arange(0.0, law.duration, 1.0 / LIMIT_CHECK_RATE_HZ))[:2]
-    feasible = (
-        (sigma >= cruise[0]) & (sigma <= cruise[-1])
-        & (np.interp(sigma, rates.sigma, steady) >= v_process)
-    )  # fmt: skip
-    held = feasible & (np.abs(speed - v_process) <= HOLD * v_process)
-    ds = np.diff(sigma)
-    room = float(np.sum(ds * (feasible[1:] & feasible[:-1])))
-    kept = float(np.sum(ds * (held[1:] & held[:-1])))
-    return (kept / room if room > 0 else float("nan")), room / length
+
+    def __init__(self, rates: JointRates, *, v_process: float, a_max: float, j_max: float,
+                 limits):  # fmt: skip
+        self.v, self.length = v_process, float(rates.sigma[-1])
+        self.sigma, self.steady = rates.sigma, static_limit(rates, with_jerk(rates), limits)
+        nominal = sin2_time_law(self.length, v_max=v_process, a_max=a_max, j_max=j_max)
+        ramp_sigma, ramp_speed = nominal(np.linspace(0.0, nominal.duration, RAMP_SAMPLES))[:2]
+        cruise = ramp_sigma[ramp_speed >= (1.0 - HOLD) * v_process]
+        self.cruise = (cruise[0], cruise[-1]) if len(cruise) else None
+
+    def __call__(self, law) -> tuple[float, float]:
+        """(share of the feasible length where ``law`` holds the process speed within
+        ±HOLD, share of the path where the process speed is feasible); ``law(t)`` →
+        σ, σ̇, ... on [0, law.duration]."""
+        if self.cruise is None:  # a path too short to reach the process speed
+            return float("nan"), 0.0
+        v = self.v
+        sigma, speed = law(np.arange(0.0, law.duration, 1.0 / LIMIT_CHECK_RATE_HZ))[:2]
+        feasible = (
+            (sigma >= self.cruise[0]) & (sigma <= self.cruise[1])
+            & (np.interp(sigma, self.sigma, self.steady) >= v)
+        )  # fmt: skip
+        held = feasible & (np.abs(speed - v) <= HOLD * v)
+        ds = np.diff(sigma)
+        room = float(np.sum(ds * (feasible[1:] & feasible[:-1])))
+        kept = float(np.sum(ds * (held[1:] & held[:-1])))
+        return (kept / room if room > 0 else float("nan")), room / self.length
