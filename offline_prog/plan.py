@@ -21,7 +21,6 @@ still written).
 from __future__ import annotations
 
 import dataclasses
-import logging
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -65,8 +64,6 @@ from offline_prog.stages import (
     with_normal_hint,
 )
 from offline_prog.timing.trajectory import WorkspaceTrajectory
-
-log = logging.getLogger(__name__)
 
 
 @dataclasses.dataclass
@@ -274,7 +271,6 @@ def plan_job(
 
 def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
     """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory)."""
-    file = inputs.file
     progress = stage.progress
     scene = stage("scene", "building the Drake cell", build_scene, inputs)
     q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
@@ -295,10 +291,10 @@ def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
     try:
         io = io_columns(samples, inputs.cell.tool.process_io, lengths, tcp_speed)
     except IoPlacementError as error:
-        raise InputError(file, error.key, error.reason) from None
+        raise InputError(inputs.file, error.key, error.reason) from None
     collisions = stage("check", "collision check of the whole job", check_job, inputs, scene,
                        samples)  # fmt: skip
     return JobPlan(
-        file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
+        inputs.file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
         tcp_speed, io, collisions, stage.timings_s,
     )  # fmt: skip
