@@ -211,15 +211,8 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
         sin2 = plan_cell(CELLS / "seal_plate_kr16.yaml")
     finally:
         cell.unlink()
+    assert max(csv_limit_use(plan)) <= 1.01  # velocity, acceleration and jerk
     table = np.genfromtxt(io.StringIO(trajectory_csv(plan)), delimiter=",", names=True)
-    robot = plan.robot
-    t = table["t"]
-    qd = robot.controller_joints(np.column_stack([table[f"qd{k + 1}"] for k in range(6)]))
-    qdd = np.diff(qd, axis=0) / np.diff(t)[:, None]
-    qddd = np.diff(qdd, axis=0) / np.diff(0.5 * (t[1:] + t[:-1]))[:, None]
-    assert (np.abs(qd) / robot.qd_max).max() <= 1.01
-    assert (np.abs(qdd) / robot.qdd_max).max() <= 1.01
-    assert (np.abs(qddd) / robot.jerk_limits).max() <= 1.01
     assert plan.trajectory.duration <= sin2.trajectory.duration
     kinds = {s.constraint for s in plan.joints.retiming.slowdowns}
     assert "jerk" in kinds  # the wrist's jerk limit slows the corners
