@@ -109,8 +109,9 @@ def _serve_preview(plan, args, console: Console) -> None:
         pass
 
 
-def _run_place(args, console: Console, errors: Console) -> None:
-    """``place``: the search with a progress bar on stderr, then a short summary."""
+def _run_place(args, console: Console, errors: Console) -> str:
+    """``place``: the search with a progress bar on stderr, then a short summary.
+    Returns "" or, when no candidate was feasible, the one line saying so."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
     from offline_prog.placement.run import place_cell
@@ -154,6 +155,12 @@ def _run_place(args, console: Console, errors: Console) -> None:
         f"({engine['scheduler']}); wrote {out}/placement.json, placed.yaml, placement.html",
         highlight=False,
         markup=False,
+    )
+    if best["feasible"]:
+        return ""
+    return (
+        f"error: {args.cell}: no feasible placement in {engine['candidates_evaluated']} "
+        f"candidates; the closest: {best['reason']} (see {out}/placement.html)"
     )
 
 
@@ -213,9 +220,9 @@ def main(argv: list[str] | None = None) -> int:
             run_session(args.cell, host=args.host, port=args.port, seconds=args.seconds,
                         open_browser=not args.no_browser, say=console.print)  # fmt: skip
             return 0
-        if args.command == "place":
-            _run_place(args, console, errors)
-            return 0
+        if args.command == "place":  # no feasible placement: outputs written, exit 1
+            failed = _run_place(args, console, errors)
+            return fail(failed, EXIT_PLAN_FAILED) if failed else 0
         if args.command == "preview":
             args.preview, args.out = True, None
         out = args.out or Path("out") / args.cell.stem

@@ -10,6 +10,7 @@ which keeps every other value), and the obstacles that stand with the tool
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 from pydrake.math import RigidTransform, RollPitchYaw
@@ -61,23 +62,38 @@ def _seam(inputs: Inputs) -> SeamView:
     return SeamView(inputs, fit, np.linspace(0.0, fit.path.length, SCREEN_SAMPLES))
 
 
+def load_context(cell_file: Path) -> Context:
+    """The cell loaded as ``plan`` loads it, each seam fitted once.
+
+    Raises:
+        InputError: naming ``cell_file`` and the key (bad data, a fit that fails).
+    """
+    inputs = load_inputs(cell_file, ROBOTS_DIR)
+    cell = inputs.cell
+    job = is_job(cell)
+    if job:
+        seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
+    else:
+        seams = [_seam(inputs)]
+    names = set(cell.place.moves_with_tool) if cell.place else set()
+    carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
+    return Context(inputs, seams, job, initial_state(cell), carried)
+
+
 def context(payload: CellPayload) -> Context:
-    """The worker's Context for ``payload``, loaded on first use."""
+    """This process's Context for ``payload``: kept, or loaded from its unpacked copy."""
     kept = _CONTEXTS.get(payload.digest)
     if kept is None:
         _CONTEXTS.clear()
-        inputs = load_inputs(unpack(payload), ROBOTS_DIR)
-        cell = inputs.cell
-        job = is_job(cell)
-        if job:
-            seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
-        else:
-            seams = [_seam(inputs)]
-        names = set(cell.place.moves_with_tool) if cell.place else set()
-        carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
-        kept = Context(inputs, seams, job, initial_state(cell), carried)
-        _CONTEXTS[payload.digest] = kept
+        kept = _CONTEXTS[payload.digest] = load_context(unpack(payload))
     return kept
+
+
+def keep(payload: CellPayload, ctx: Context) -> None:
+    """Use ``ctx`` (loaded from the user's own file) as this process's copy of
+    ``payload``: the in-process engine then loads nothing again."""
+    _CONTEXTS.clear()
+    _CONTEXTS[payload.digest] = ctx
 
 
 def rigid(pose: Pose) -> RigidTransform:

@@ -111,13 +111,17 @@ class DaskEngine:
                 )  # fmt: skip
             self.client = Client(self.cluster)
             self.scheduler = "LocalCluster"
-        addresses = list(self.client.scheduler_info()["workers"])
-        self.workers = len(addresses)
-        self.payload = self.client.scatter(payload, broadcast=True, hash=False)
-        # Every worker loads the cell now, in parallel (not on its first candidate).
-        loads = [self.client.submit(_load, self.payload, workers=[a], pure=False)
-                 for a in addresses]  # fmt: skip
-        self.client.gather(loads)
+        try:
+            addresses = list(self.client.scheduler_info()["workers"])
+            self.workers = len(addresses)
+            self.payload = self.client.scatter(payload, broadcast=True, hash=False)
+            # Every worker loads the cell now, in parallel (not on its first candidate).
+            loads = [self.client.submit(_load, self.payload, workers=[a], pure=False)
+                     for a in addresses]  # fmt: skip
+            self.client.gather(loads)
+        except BaseException:  # Ctrl-C or a worker's error: no cluster left running
+            self.close()
+            raise
 
     def map(self, stage: str, candidates: Sequence[Candidate],
             done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip

@@ -26,6 +26,8 @@ from offline_prog.placement.space import Candidate
 from offline_prog.plan import JobPlan, Plan, StageTimer, plan_flanges, plan_loaded_job
 from offline_prog.stages import build_scene, flange_paths
 
+MIN_VIOLATION = 1e-9  # [m]: a collision is never as good as none
+
 
 def plan_candidate(ctx: Context, candidate: Candidate) -> Plan | JobPlan:
     """The candidate's plan: a :class:`~offline_prog.plan.Plan` (one seam, no clearance
@@ -86,8 +88,11 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
     air = duration - sum(float(p.trajectory.duration) for p in seams)
     collisions = plan.collisions
     tier, violation = FEASIBLE, 0.0
-    if not plan.feasible:
-        tier, violation = COLLIDES, max(0.0, collisions.clearance_m - collisions.min_distance_m)
+    if not plan.feasible:  # the clearance missed, or the deepest pair's depth (a fixed pair
+        # may be the only one: min_distance_m covers the moving pairs)
+        depth = max((pair.depth_m for pair in collisions.pairs), default=0.0)
+        missed = collisions.clearance_m - collisions.min_distance_m
+        tier, violation = COLLIDES, max(missed, depth, MIN_VIOLATION)
     distance = collisions.min_distance_m
     return Evaluation(
         candidate,

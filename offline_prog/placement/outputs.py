@@ -21,9 +21,10 @@ import math
 import os
 from pathlib import Path
 
-from offline_prog.config.cell import Cell, load_cell
+from offline_prog.config.cell import load_cell
 from offline_prog.placement.context import Context, moved_obstacles
 from offline_prog.placement.objective import Evaluation
+from offline_prog.placement.payload import data_file_keys
 from offline_prog.placement.search import Placement
 from offline_prog.placement.space import Pose, SearchSpace
 from offline_prog.session.cell_text import with_values
@@ -137,38 +138,13 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict) -
                 for a in space.axes
             ],  # fmt: skip
             "grasps": [_pose(g) for g in space.grasps],
+            # Infeasible candidates by kind (errors.Failure values, or "refused").
             "failures": dict(
-                collections.Counter(
-                    e.reason.split(" at σ")[0].split(":")[0]
-                    for e in result.evaluated
-                    if not e.feasible
-                )
+                collections.Counter(e.failure for e in result.evaluated if not e.feasible)
             ),
         },  # fmt: skip
         "engine": engine,
     }
-
-
-def _file_keys(cell: Cell) -> dict[str, str]:
-    """{dotted key: file name} of the data files a cell names."""
-    keys = {}
-    if cell.part.mesh:
-        keys["part.mesh"] = cell.part.mesh
-    paths = (
-        [("path", cell.path)]
-        if cell.path
-        else [(f"seams.{k}", s) for k, s in enumerate(cell.seams)]
-    )
-    for key, path in paths:
-        for name in ("points", "dxf"):
-            if getattr(path, name):
-                keys[f"{key}.{name}"] = getattr(path, name)
-    for owner, shapes in (("obstacles", cell.obstacles), ("part.geometry", cell.part.geometry),
-                          ("tool.geometry", cell.tool.geometry)):  # fmt: skip
-        for i, shape in enumerate(shapes):
-            if shape.shape == "mesh" and shape.mesh:
-                keys[f"{owner}.{i}.mesh"] = shape.mesh
-    return keys
 
 
 def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) -> str:
@@ -180,7 +156,7 @@ def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) 
     source = cell_file.resolve().parent
     strings = {
         key: os.path.relpath(source / name, Path(out_dir).resolve())
-        for key, name in _file_keys(load_cell(cell_file)).items()
+        for key, name in data_file_keys(load_cell(cell_file)).items()
     }
     return with_values(text, poses, strings)
 

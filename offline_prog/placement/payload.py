@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from offline_prog.config.cell import Cell
-from offline_prog.config.checks import seam_keys
+from offline_prog.session.cell_text import with_values
 
 
 @dataclasses.dataclass(frozen=True)
@@ -35,24 +35,44 @@ class CellPayload:
     digest: str
 
 
-def data_files(file: Path, cell: Cell) -> list[Path]:
-    """The files a cell names (path points, DXF, meshes), resolved next to ``file``."""
-    names = [cell.part.mesh]
-    names += [getattr(path, k) for _, path in seam_keys(cell) for k in ("points", "dxf")]
-    shapes = list(cell.obstacles) + list(cell.part.geometry) + list(cell.tool.geometry)
-    names += [shape.mesh for shape in shapes if shape.shape == "mesh"]
-    return sorted({(file.parent / name).resolve() for name in names if name})
+def data_file_keys(cell: Cell) -> dict[str, str]:
+    """{dotted key of the cell file: file name as written} of every data file the cell
+    names (path points, DXF, meshes)."""
+    keys = {}
+    if cell.part.mesh:
+        keys["part.mesh"] = cell.part.mesh
+    paths = [("path", cell.path)] if cell.path else list(enumerate(cell.seams))
+    for key, path in paths:
+        key = key if isinstance(key, str) else f"seams.{key}"
+        for name in ("points", "dxf"):
+            if getattr(path, name):
+                keys[f"{key}.{name}"] = getattr(path, name)
+    for owner, shapes in (("obstacles", cell.obstacles), ("part.geometry", cell.part.geometry),
+                          ("tool.geometry", cell.tool.geometry)):  # fmt: skip
+        for i, shape in enumerate(shapes):
+            if shape.shape == "mesh" and shape.mesh:
+                keys[f"{owner}.{i}.mesh"] = shape.mesh
+    return keys
 
 
 def cell_payload(file: Path, cell: Cell) -> CellPayload:
-    """Read the cell file and its data files into a payload."""
-    paths = [Path(file).resolve(), *data_files(Path(file), cell)]
+    """Read the cell file and its data files into a payload. Paths are taken as
+    written (symlinks not followed, ``..`` folded); the payload's cell text names
+    each data file relative to itself, so an absolute path is carried too."""
+    cell_path = Path(os.path.abspath(file))
+    keys = data_file_keys(cell)
+    found = {key: Path(os.path.abspath(cell_path.parent / name)) for key, name in keys.items()}
+    paths = [cell_path, *sorted(set(found.values()))]
     root = Path(os.path.commonpath([p.parent for p in paths]))
-    files = tuple((p.relative_to(root).as_posix(), p.read_bytes()) for p in paths)
+    text = with_values(cell_path.read_text(), {}, {
+        key: os.path.relpath(path, cell_path.parent) for key, path in found.items()
+    })  # fmt: skip
+    files = [(cell_path.relative_to(root).as_posix(), text.encode())]
+    files += [(p.relative_to(root).as_posix(), p.read_bytes()) for p in paths[1:]]
     digest = hashlib.sha256()
     for name, content in files:
         digest.update(name.encode() + b"\0" + content + b"\0")
-    return CellPayload(files[0][0], files, digest.hexdigest())
+    return CellPayload(files[0][0], tuple(files), digest.hexdigest())
 
 
 def unpack(payload: CellPayload) -> Path:

@@ -19,7 +19,7 @@ from pathlib import Path
 from offline_prog.atomic import staged_folder, write_manifest
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
-from offline_prog.placement.context import Context, context
+from offline_prog.placement.context import Context, keep, load_context
 from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.evaluate import plan_candidate
 from offline_prog.placement.objective import Evaluation
@@ -57,7 +57,7 @@ def place_cell(
         InputError: bad input, an unreachable scheduler, a bad --out (exit 2).
     """
     cell_file, out_dir = Path(cell_file), Path(out_dir)
-    place, space, payload = load(cell_file, out_dir, budget, seed)
+    place, space, payload, ctx = load(cell_file, out_dir, budget, seed)
     started = time.perf_counter()
     engine = start_engine(payload, workers, scheduler)
     try:
@@ -66,22 +66,27 @@ def place_cell(
         engine.close()
     data = placement_json(result, space, place, engine_figures(engine, result, started))
     progress("outputs", 0, 1)
-    write_folder(out_dir, cell_file, context(payload), result, data)
+    write_folder(out_dir, cell_file, ctx, result, data)
     progress("outputs", 1, 1)
     return data
 
 
 def load(cell_file: Path, out_dir: Path, budget: int | None, seed: int | None):
-    """Stage ``load``: --out, the cell and its ``place:`` block checked; the payload.
+    """Stage ``load``: --out, the cell and its ``place:`` block checked; the cell loaded
+    and fitted here first (its errors name the user's file, not a worker's copy); the
+    payload for the workers.
 
     Returns:
-        (PlaceConfig, SearchSpace, CellPayload).
+        (PlaceConfig, SearchSpace, CellPayload, Context).
     """
     check_out_dir(out_dir)
     cell = load_cell(cell_file)
     check_cell(cell_file, cell, ROBOTS_DIR)
     place, space = check_place(cell_file, cell, budget=budget, seed=seed)
-    return place, space, cell_payload(cell_file, cell)
+    ctx = load_context(cell_file)
+    payload = cell_payload(cell_file, cell)
+    keep(payload, ctx)
+    return place, space, payload, ctx
 
 
 def start_engine(payload: CellPayload, workers: int | None, scheduler: str | None):

@@ -29,7 +29,7 @@ from offline_prog.placement.space import Candidate, SearchSpace
 
 POPULATION = 8  # candidates per batch and per CMA-ES generation
 SIGMA0 = 0.2  # CMA-ES initial step, a share of each range
-CMA_TOL_X = 1e-3  # converged when steps are below 0.1 % of each range
+CMA_TOL_X = 1e-3  # converged when steps are below 0.1 % of each range (its only stop)
 
 
 @dataclasses.dataclass
@@ -57,6 +57,9 @@ def _cma(space: SearchSpace, start: Evaluation, seed: int):
     options = {
         "bounds": [0.0, 1.0], "popsize": POPULATION, "seed": seed + 1,  # cma: 0 is random
         "verbose": -9, "tolx": CMA_TOL_X,
+        # Ranks are told (0 … 7 every generation): the best value never changes, so
+        # the tests on function values would stop the run after 10 generations.
+        "tolfun": 0, "tolfunhist": 0, "tolstagnation": 10**9, "tolflatfitness": 10**9,
     }  # fmt: skip
     x0 = np.clip(np.asarray(start.candidate.x, dtype=float), 0.05, 0.95)
     return cma.CMAEvolutionStrategy(x0, SIGMA0, options)

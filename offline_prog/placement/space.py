@@ -193,9 +193,16 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
     axes = _axes(file, "X_IT", place.X_IT)
     grasps = (_pose(cell.part.X_PE),)
     if place.X_PE is not None:
-        axes += _axes(file, "X_PE", place.X_PE)
         if place.X_PE.candidates:
             grasps = tuple(_pose(value) for value in place.X_PE.candidates)
+        for axis in _axes(file, "X_PE", place.X_PE):
+            part = 0 if axis.kind == "translation" else 1
+            if len({g[part][axis.index] for g in grasps}) > 1:  # a range sets the value
+                raise InputError(
+                    file, axis.key, "the grasps differ on this axis and a range would make "
+                    "them one: give the axis by range or by candidates, not both",
+                )  # fmt: skip
+            axes.append(axis)
     if not axes and len(grasps) == 1:
         raise InputError(file, "place", "nothing to search: name a range or several grasps")
     return place, SearchSpace(tuple(axes), grasps, _pose(cell.tool.X_IT), _pose(cell.part.X_PE))

@@ -176,5 +176,6 @@ def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> 
         node = _find(root, key)
         if node is None:
             raise ValueError(f"{key} not found in the cell file")
-        edits.replace(node, json.dumps(value))
+        if node.value != value:  # unchanged text stays as written
+            edits.replace(node, json.dumps(value))
     return edits.result()

@@ -120,3 +120,23 @@ def test_a_job_is_screened_seam_by_seam():
     far = screen(ctx, Candidate((), -1, ((2.4, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
     assert far.tier == CANNOT_FOLLOW and far.failure == "out_of_reach"
     assert far.violation > 3.0  # all four seams out of reach, each adding its share
+
+
+def test_the_payload_keeps_symlinked_and_absolute_data_files(tmp_path):
+    """A data file behind a symlink (the path as written, not its target) and one given
+    by an absolute path both travel: the unpacked cell names its own copies."""
+    shared, data, cells = (tmp_path / n for n in ("shared", "data", "cells"))
+    for folder in (shared, data, cells):
+        folder.mkdir()
+    dxf = CELLS / "data" / "weld_seam.dxf"
+    (shared / "weld_seam.dxf").write_bytes(dxf.read_bytes())
+    (data / "weld_seam.dxf").symlink_to(shared / "weld_seam.dxf")
+    text = (CELLS / "weld_seam_irb2400.yaml").read_text()
+    for name, source in (("linked", "../data/weld_seam.dxf"),
+                         ("absolute", str(shared / "weld_seam.dxf"))):  # fmt: skip
+        file = cells / f"{name}.yaml"
+        file.write_text(text.replace("dxf: data/weld_seam.dxf", f"dxf: {source}"))
+        copy = unpack(cell_payload(file, load_cell(file)))
+        named = load_cell(copy).path.dxf
+        assert not named.startswith("/") and (copy.parent / named).read_bytes() == dxf.read_bytes()
+        assert str(tmp_path) not in copy.read_text()  # nothing read from the user's disk

@@ -32,6 +32,20 @@ def small_search(tmp_path, screen_points: int = 100):
     return file
 
 
+def test_no_feasible_placement_is_exit_1_with_the_closest_reason_and_outputs(tmp_path, capsys):
+    file = small_search(tmp_path, screen_points=4).parent / "out_of_reach.yaml"
+    file.write_text(file.read_text().replace("x: [700, 1900]", "x: [2300, 2600]"))
+    out = tmp_path / "out"
+    code = main(["place", str(file), "--out", str(out), "--budget", "3", "--workers", "0"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and len(err) == 1 and "no feasible placement in 3 candidates" in err[0]
+    assert "out of reach" in err[0]
+    data = json.loads((out / "placement.json").read_text())
+    assert not data["best"]["feasible"] and data["best"]["failure"] == "out_of_reach"
+    assert data["search"]["failures"] == {"out_of_reach": 3}
+    assert not (out / "best_preview.html").exists()
+
+
 @pytest.mark.slow  # ~25 s: two searches of 10 candidates, a LocalCluster, one plan
 def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_path, capsys):
     file = small_search(tmp_path)

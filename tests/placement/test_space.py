@@ -32,6 +32,8 @@ def _variant(tmp_path, old: str, new: str):
         ("budget: 200", "budget: 0", "place.budget", "outside 1..100,000"),
         ("moves_with_tool: [nozzle_stand]", "moves_with_tool: [stand]",
          "place.moves_with_tool[0]", "'stand' is not an obstacle"),
+        ("  X_PE:   ", "  X_PE:\n    rpy_deg: {yaw: [-10, 10]}\n  ", "place.X_PE.rpy_deg.yaw",
+         "the grasps differ on this axis"),
     ],
 )  # fmt: skip
 def test_bad_place_input_is_one_line_exit_2_nothing_written(
