@@ -29,10 +29,9 @@ from offline_prog.plan import StageTimer, plan_seam
 from offline_prog.results.plan_folder import trajectory_csv
 from offline_prog.stages import build_scene, load_inputs
 from offline_prog.timing.filtered_stage import filtered_timing
-from offline_prog.timing.jerk_stage import jerk_limited_law, static_limit
+from offline_prog.timing.jerk_stage import jerk_limited_law
 from offline_prog.timing.joint_timing import JointRates
-from offline_prog.timing.limit_use import with_jerk
-from offline_prog.timing.time_law import sin2_time_law
+from offline_prog.timing.speed_hold import SpeedHold
 from offline_prog.timing.time_optimal import topp_profile
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -76,30 +75,15 @@ def held_share(plan) -> float:
 
 
 def held_where_feasible(plan) -> tuple[float, float]:
-    """(share of the feasible length held within ±HOLD, the feasible share of the
-    path): feasible where the process speed is, off the start and stop ramps of the
-    nominal sin² law, and where the joints allow it at steady speed (``static_limit``:
-    |q′v| ≤ q̇max, |q″v²| ≤ q̈max, |q‴v³| ≤ q⃛max)."""
+    """``timing.speed_hold`` measured on the plan's own samples (the TCP speed of
+    trajectory.csv's rows), not on its time law: (share of the feasible length held
+    within ±0.5 %, feasible share of the path)."""
     robot, tr, motion = plan.robot, plan.trajectory, plan.cell.motion
-    v = motion.speed
-    rates = path_rates(plan, 5000)
-    limits = (robot.qd_max, robot.qdd_max, robot.jerk_limits)
-    steady = static_limit(rates, with_jerk(rates), limits)
-    nominal = sin2_time_law(tr.law.length, v_max=v, a_max=motion.max_acceleration,
-                            j_max=motion.max_jerk)  # fmt: skip
-    law_sigma, law_speed = nominal(np.linspace(0.0, nominal.duration, 20001))[:2]
-    cruise = law_sigma[law_speed >= (1.0 - HOLD) * v]  # off the start and stop ramps
-    cruise_start, cruise_end = cruise[0], cruise[-1]
-    sigma = tr.law_position
-    feasible = (
-        (sigma >= cruise_start) & (sigma <= cruise_end)
-        & (np.interp(sigma, rates.sigma, steady) >= v)
+    hold = SpeedHold(
+        path_rates(plan, 5000), v_process=motion.speed, a_max=motion.max_acceleration,
+        j_max=motion.max_jerk, limits=(robot.qd_max, robot.qdd_max, robot.jerk_limits),
     )  # fmt: skip
-    held = feasible & (np.abs(tr.tcp_speed - v) <= HOLD * v)
-    ds = np.abs(np.diff(tr.s))
-    both = ds * (held[1:] & held[:-1])
-    room = ds * (feasible[1:] & feasible[:-1])
-    return float(both.sum() / room.sum()), float(room.sum() / ds.sum())
+    return hold.on_samples(tr.law_position, tr.tcp_speed)
 
 
 def path_rates(plan, n: int) -> JointRates:

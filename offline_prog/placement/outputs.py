@@ -21,7 +21,6 @@ import math
 import os
 from pathlib import Path
 
-from offline_prog.config.cell import load_cell
 from offline_prog.placement.context import Context, moved_obstacles
 from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import data_file_keys
@@ -156,7 +155,7 @@ def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) 
     source = cell_file.resolve().parent
     strings = {
         key: os.path.relpath(source / name, Path(out_dir).resolve())
-        for key, name in data_file_keys(load_cell(cell_file)).items()
+        for key, name in data_file_keys(ctx.inputs.cell).items()
     }
     return with_values(text, poses, strings)
 

@@ -40,19 +40,28 @@ class SpeedHold:
         self.cruise = (cruise[0], cruise[-1]) if len(cruise) else None
 
     def __call__(self, law) -> tuple[float, float]:
-        """(share of the feasible length where ``law`` holds the process speed within
-        ±HOLD, share of the path where the process speed is feasible); ``law(t)`` →
-        σ, σ̇, ... on [0, law.duration]."""
+        """:meth:`on_samples` of ``law`` (``law(t)`` → σ, σ̇, ...) at
+        LIMIT_CHECK_RATE_HZ."""
+        sigma, speed = law(np.arange(0.0, law.duration, 1.0 / LIMIT_CHECK_RATE_HZ))[:2]
+        return self.on_samples(sigma, speed)
+
+    def on_samples(self, sigma: np.ndarray, speed: np.ndarray) -> tuple[float, float]:
+        """(share of the feasible length where the speed holds the process speed within
+        ±HOLD, share of the path where the process speed is feasible).
+
+        Args:
+            sigma: (N,) the law's position along the path [m], in time order.
+            speed: (N,) the speed there [m/s].
+        """
         if self.cruise is None:  # a path too short to reach the process speed
             return float("nan"), 0.0
         v = self.v
-        sigma, speed = law(np.arange(0.0, law.duration, 1.0 / LIMIT_CHECK_RATE_HZ))[:2]
         feasible = (
             (sigma >= self.cruise[0]) & (sigma <= self.cruise[1])
             & (np.interp(sigma, self.sigma, self.steady) >= v)
         )  # fmt: skip
         held = feasible & (np.abs(speed - v) <= HOLD * v)
-        ds = np.diff(sigma)
+        ds = np.abs(np.diff(sigma))
         room = float(np.sum(ds * (feasible[1:] & feasible[:-1])))
         kept = float(np.sum(ds * (held[1:] & held[:-1])))
         return (kept / room if room > 0 else float("nan")), room / self.length
