@@ -29,6 +29,7 @@ from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
 from offline_prog.path.process_frames import NormalTangentError
 from offline_prog.path.sources import PathPoints
+from offline_prog.path.tool_turn import SmoothTurn
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
@@ -154,6 +155,7 @@ def flange_paths(inputs: Inputs, fit: FittedPath) -> FlangePaths:
                 X_PE=inputs.X_PE,
                 bound_rad=np.deg2rad(cell.tool.free_rotation_deg),
                 axis=cell.tool.symmetry_axis,
+                smooth_turn=smooth_turn(inputs, fit),
             )
         cusps = find_cusps(rotations[0][1])
     except NormalTangentError as error:
@@ -167,6 +169,16 @@ def flange_paths(inputs: Inputs, fit: FittedPath) -> FlangePaths:
             f"cusp at σ = {first.sigma_m:.4f} m; use tcp or motion.cusp_smoothing_mm",
         )
     return FlangePaths(rotations, cusps)
+
+
+def smooth_turn(inputs: Inputs, fit: FittedPath) -> SmoothTurn | None:
+    """The tool turn that spreads the path's bends over tool.turn_smoothing_mm, if set."""
+    tool = inputs.cell.tool
+    if tool.turn_smoothing_mm == 0.0:
+        return None
+    return SmoothTurn(
+        fit.path, fit.normal, axis=tool.symmetry_axis, width_m=tool.turn_smoothing_mm * 1e-3
+    )
 
 
 def build_scene(inputs: Inputs) -> DrakeCell:

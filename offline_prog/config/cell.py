@@ -83,6 +83,9 @@ class ToolConfig:
     # this angle to keep the robot inside its limits; y is the pressing direction n.
     free_rotation_deg: float = 0.0
     symmetry_axis: str = "y"
+    # With a free rotation: the tool turns along the path so that the part turns
+    # through bends smoothly, over about 4x this length (path.tool_turn); 0: fixed.
+    turn_smoothing_mm: float = 0.0
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in T
     process_io: ProcessIoConfig | None = None  # the process output (glue gun, torch)
 

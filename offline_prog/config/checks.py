@@ -87,6 +87,11 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "tool.free_rotation_deg", "must be within [0, 180]")
     if cell.tool.symmetry_axis not in ("x", "y", "z"):
         raise _error(file, "tool.symmetry_axis", f"{cell.tool.symmetry_axis!r} (use x, y or z)")
+    smoothing = cell.tool.turn_smoothing_mm
+    if not (np.isfinite(smoothing) and smoothing >= 0.0):
+        raise _error(file, "tool.turn_smoothing_mm", f"must be ≥ 0 mm, got {smoothing}")
+    if smoothing > 0.0 and cell.tool.free_rotation_deg == 0.0:
+        raise _error(file, "tool.turn_smoothing_mm", "needs tool.free_rotation_deg > 0")
     if motion.cusp_smoothing_mm is not None and not motion.cusp_smoothing_mm > 0:
         raise _error(file, "motion.cusp_smoothing_mm", "must be > 0")
     for key in ("clearance", "self_clearance"):

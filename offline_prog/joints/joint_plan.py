@@ -131,17 +131,21 @@ ROTATION_STEP_RAD = np.deg2rad(5.0)
 ROTATION_TRIAL_POINTS = 400
 
 
-def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y"):
-    """Fixed turns φ ∈ [−bound, bound] of a symmetric tool about its axis, best first.
+def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y",
+                   smooth_turn=None):  # fmt: skip
+    """Turns φ₀ ∈ [−bound, bound] of a symmetric tool about its axis, best first.
 
-    The process frame is laid onto T·R_axis(φ) instead of T, which a tool
-    symmetric about that axis cannot tell apart. A constant φ keeps the flange
-    path exactly as smooth as with φ = 0. Ranked by the joint-limit margin of each
-    φ's best branch (the smaller |φ| on ties); the collision check may move on to
-    the next.
+    The process frame is laid onto T·R_axis(φ₀) instead of T, which a tool
+    symmetric about that axis cannot tell apart. A constant φ₀ keeps the flange
+    path exactly as smooth as with φ₀ = 0; with ``smooth_turn`` (a
+    ``path.tool_turn.SmoothTurn``) the tool turns by φ₀ + θ − θ̄ along the path, and
+    φ₀ keeps the whole turn within ±bound (if θ − θ̄ spans more than 2·bound, a
+    share of it is taken up, about the middle φ₀). Ranked by the joint-limit margin
+    of each φ₀'s best branch (the smaller |φ₀| on ties); the collision check may
+    move on to the next.
 
     Returns:
-        [(φ [rad], the FlangePath built with it), ...], best first.
+        [(φ₀ [rad], the FlangePath built with it), ...], best first.
     """
     from pydrake.common.eigen_geometry import AngleAxis
     from pydrake.math import RigidTransform, RotationMatrix
@@ -149,13 +153,24 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
     from offline_prog.path.fixed_tcp import FlangePath
 
     unit = np.eye(3)["xyz".index(axis)]
-    count = int(np.ceil(bound_rad / ROTATION_STEP_RAD))
-    angles = np.linspace(-bound_rad, bound_rad, 2 * count + 1) if count else np.zeros(1)
+    lo, hi, scale = -bound_rad, bound_rad, 1.0
+    if smooth_turn is not None:
+        low, high = smooth_turn.span_rad
+        scale = min(1.0, 2.0 * bound_rad / max(high - low, 1e-12))
+        lo, hi = -bound_rad - scale * low, bound_rad - scale * high
+        if scale < 1.0:  # the whole free rotation is taken up: one φ₀
+            lo = hi = 0.5 * (lo + hi)
+    count = int(np.ceil((hi - lo) / (2.0 * ROTATION_STEP_RAD)))
+    angles = np.linspace(lo, hi, 2 * count + 1) if count else np.array([lo])
     s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
     ranked = []
     for phi in sorted(angles, key=abs):
-        X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
-        flange = FlangePath(path, normal, X_IT=X_IT_phi, X_PE=X_PE)
+        if smooth_turn is None:
+            X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
+            flange = FlangePath(path, normal, X_IT=X_IT_phi, X_PE=X_PE)
+        else:
+            turn = smooth_turn.with_offset(float(phi), scale)
+            flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=unit)
         f = flange(s)
         result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)

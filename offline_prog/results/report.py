@@ -55,6 +55,18 @@ def _merged(stretches):
     return out
 
 
+def tool_turn_range_deg(plan: Plan) -> list[float]:
+    """[lowest, highest] turn of a symmetric tool about its axis along the path [deg]:
+    tool_rotation_deg twice unless the tool turns along the path (tool.turn_smoothing_mm
+    or collision avoidance)."""
+    flange = getattr(plan.flange, "exact", plan.flange)  # under cusp smoothing
+    turn = getattr(flange, "tool_turn", None)
+    if turn is None:
+        return [float(np.rad2deg(plan.tool_rotation_rad))] * 2
+    phi = np.rad2deg(turn(plan.trajectory.s)[0])
+    return [float(phi.min()), float(phi.max())]
+
+
 def robot_report(plan: Plan) -> dict:
     """Branch, joint-limit margins, joint steps, singularities and speed reductions."""
     robot, joints = plan.robot, plan.joints
@@ -68,6 +80,7 @@ def robot_report(plan: Plan) -> dict:
         "branch": joints.branch,
         "feasible_branches": [b.branch for b in joints.branches if b.feasible],
         "tool_rotation_deg": float(np.rad2deg(plan.tool_rotation_rad)),
+        "tool_turn_deg": tool_turn_range_deg(plan),
         "joint_limit_margin_deg": np.rad2deg(joints.margin_rad).round(3).tolist(),
         "min_joint_limit_margin_deg": float(np.rad2deg(joints.margin_rad.min())),
         "largest_joint_step": {
@@ -115,7 +128,7 @@ def timing_report(plan: Plan) -> dict:
         # acceleration; then with the steady jerk limit as a speed limit curve too.
         "time_optimal_without_jerk_stage_s": retiming.topp_plain_s,
         "time_optimal_steady_jerk_s": retiming.topp.duration,
-        "time_optimal_solve_s": retiming.topp.solve_s,
+        "time_optimal_solve_s": retiming.solve_s,
         # Where the process speed is feasible (off the start/stop ramps, within the
         # joints' steady limits), the share of that length held within ±0.5 %.
         "process_speed_held": {

@@ -84,6 +84,7 @@ class JerkLimitedTiming:
     # (share of the feasible length holding the process speed ±0.5 %, feasible share
     # of the path): timing.speed_hold.SpeedHold.
     speed_held: tuple[float, float] = (float("nan"), float("nan"))
+    solve_s: float = float("nan")  # wall time of the whole time-optimal law [s]
 
 
 def envelope(profile: ToppProfile) -> np.ndarray:

@@ -100,7 +100,9 @@ _RM, _STEP, _RED = (
 ROWS = (
     ("Cell", "{name} ({cell})"),
     ("Robot", "{robot}, IK branch {robot_motion.branch:d}"),
-    ("Tool", "{tool}, turned {robot_motion.tool_rotation_deg:.1f °} about its axis"),
+    ("Tool", "{tool}, turned {robot_motion.tool_rotation_deg:.1f °} about its axis "
+     "({robot_motion.tool_turn_deg.0:.1f °} to {robot_motion.tool_turn_deg.1:.1f °} along "
+     "the path)"),
     ("Part", "{part}"),
     ("Path length", "{path.length_m:.4f m} ({path.source}, {path.n_points:d} points)"),
     ("Fit error", "max {fit.max_error_mm:.4f mm}, RMS {fit.rms_error_mm:.4f mm} (tolerance "

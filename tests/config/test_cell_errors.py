@@ -92,6 +92,13 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ),
     ("max_jerk: 10.0", "max_jerk: 10.0\n  clearance: -1.0", "motion.clearance", "must be ≥ 0"),
     ("X_IT: {", "free_rotation_deg: 270\n  X_IT: {", "tool.free_rotation_deg", "within"),
+    (
+        "X_IT: {",
+        "free_rotation_deg: 90\n  turn_smoothing_mm: -5\n  X_IT: {",
+        "tool.turn_smoothing_mm",
+        "must be ≥ 0 mm",
+    ),
+    ("X_IT: {", "turn_smoothing_mm: 30\n  X_IT: {", "tool.turn_smoothing_mm", "needs tool.free"),
     ("X_IT: {", "symmetry_axis: w\n  X_IT: {", "tool.symmetry_axis", "use x, y or z"),
     ("model: kuka_kr16_2", "model: no_such_robot", "robot.model", "not a robot folder"),
     ("closed: false", "closed: maybe", "path.closed", "expected bool"),

@@ -33,6 +33,23 @@ def data(planned_folder):
 
 
 @pytest.fixture(scope="module")
+def slowed(tmp_path_factory):
+    """The seal demo with its nozzle's turn fixed (no tool.turn_smoothing_mm): the
+    wrist's jerk slows the plate at each corner."""
+    from offline_prog.plan import plan_cell
+    from offline_prog.results.plan_folder import write_outputs
+
+    from conftest import CELLS
+
+    folder = tmp_path_factory.mktemp("seal_fixed_turn")
+    text = (CELLS / "seal_plate_kr16.yaml").read_text()
+    cell = folder / "seal_fixed_turn.yaml"
+    cell.write_text(re.sub(r"\n  turn_smoothing_mm: .*", "", text))
+    write_outputs(plan_cell(cell), folder / "plan")
+    return ProgramData.load(folder / "plan")
+
+
+@pytest.fixture(scope="module")
 def plant():
     """The KR 16-2 URDF in Drake, base_link welded to the world."""
     from pydrake.multibody.parsing import Parser
@@ -279,7 +296,8 @@ def test_exported_points_follow_the_dense_plan(data, tmp_path, style):
     assert result.max_chord_m <= chord and result.max_angle_rad <= angle
 
 
-def test_vel_cp_follows_the_planned_speed(data, tmp_path):
+def test_vel_cp_follows_the_planned_speed(slowed, tmp_path):
+    data = slowed
     result = write_krl(data, tmp_path)
     motions, _ = read_program(tmp_path, "offline_prog")
     lin = [m for m in motions if m["kind"] == "LIN"]
