@@ -13,3 +13,15 @@ def at_index(values: np.ndarray, x: float):
     """values (N, ...) linearly interpolated at the fractional sample index x."""
     i = min(int(x), len(values) - 2) if len(values) > 1 else 0
     return values[i] + (x - i) * (values[i + 1] - values[i]) if x != i else values[i]
+
+
+def interp_rows(x: np.ndarray, xp: np.ndarray, *tables: np.ndarray) -> list[np.ndarray]:
+    """Each table (G, K) linearly interpolated at x (N,) over the increasing grid xp
+    (G,), held at its ends like ``np.interp``; one index search for all columns.
+
+    Returns:
+        [(N, K), ...], one per table.
+    """
+    i = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
+    w = np.clip((x - xp[i]) / (xp[i + 1] - xp[i]), 0.0, 1.0)[:, None]
+    return [t[i] + w * (t[i + 1] - t[i]) for t in tables]

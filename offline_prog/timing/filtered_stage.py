@@ -38,7 +38,7 @@ from offline_prog.timing.limit_use import (
     with_jerk,
     worst_use,
 )
-from offline_prog.timing.time_optimal import ToppProfile, topp_profile
+from offline_prog.timing.time_optimal import ToppProfile, resolve_locally, topp_profile
 
 # Share of each joint limit (velocity, acceleration, jerk) the law is planned to. The
 # jerk's is lower: q‴ is the σ-difference of q″ on the rates' 0.5 mm grid, up to 8 %
@@ -131,11 +131,17 @@ def filtered_timing(
     steady = steady_jerk_limit(rates, limits) * np.cbrt(SHARES[2] / LIMIT_SHARE)
     v_curve = np.minimum(steady, v_process)
     a_curve = np.full(len(rates.sigma), a_max)
-    for _ in range(MAX_ROUNDS):
-        profile = topp_profile(
+
+    def solve(span=None, ends=(0.0, 0.0)):
+        return topp_profile(
             rates, qd_max=shared[0], qdd_max=shared[1], v_cap=v_process, a_path=a_max,
-            v_steady=v_curve, a_curve=a_curve,
+            v_steady=v_curve, a_curve=a_curve, span=span, ends=ends,
         )  # fmt: skip
+
+    profile, lowered = solve(), []
+    for _ in range(MAX_ROUNDS):
+        if lowered:  # only around the stretches the last round lowered
+            profile = resolve_locally(profile, lowered, solve, v_process**2 / (2.0 * a_max))
         if not profile.ok:
             return None
         law = FilteredTimeLaw(length, v_process, a_max, j_max, profile.sigma, profile.speed, window)
@@ -163,11 +169,13 @@ def filtered_timing(
         over = np.flatnonzero(speed_over > 1.0)
         cap = STEP_SHARE * use["speed"][over] / speed_over[over]
         _lower(v_curve, rates.sigma, grid[first[over]], grid[end[over]], cap)
+        lowered = list(zip(grid[first[over]], grid[end[over]], strict=True))
         over = np.flatnonzero(change_over > 1.0)
         steps = np.abs(law.profile_acceleration())
         hardest = np.array([steps[i:j].max() for i, j in zip(first[over], end[over], strict=True)])
         cap = np.maximum(STEP_SHARE * hardest / change_over[over], MIN_ACCELERATION_SHARE * a_max)
         _lower(a_curve, rates.sigma, grid[first[over]], grid[end[over]], cap)
+        lowered += list(zip(grid[first[over]], grid[end[over]], strict=True))
     return None
 
 

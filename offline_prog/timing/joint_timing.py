@@ -17,7 +17,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
+from offline_prog.arrays import interp_rows, true_runs
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ
 from offline_prog.timing.time_law import Sin2TimeLaw, sin2_plateau_law
 
@@ -49,10 +49,7 @@ class JointRates:
 
     def at(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(q′, q″) linearly interpolated at σ (N,), each (N, 6)."""
-        return tuple(
-            np.column_stack([np.interp(sigma, self.sigma, d[:, j]) for j in range(d.shape[1])])
-            for d in (self.dq, self.ddq)
-        )
+        return tuple(interp_rows(sigma, self.sigma, self.dq, self.ddq))
 
 
 def speed_cap(rates: JointRates, qd_max: np.ndarray, qdd_max: np.ndarray) -> np.ndarray:

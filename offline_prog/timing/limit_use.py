@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
+from offline_prog.arrays import interp_rows, true_runs
 from offline_prog.timing.joint_timing import JointRates
 
 # A speed this close below the process speed counts as holding it.
@@ -55,8 +55,7 @@ def joint_use(rates: JointRates, dddq: np.ndarray, law, t: np.ndarray, limits) -
         limits: (qd_max, qdd_max, qddd_max), each (6,) [rad/s, rad/s², rad/s³].
     """
     sigma, sd, sdd, sddd = law(t)
-    dq, ddq = rates.at(sigma)
-    d3q = np.column_stack([np.interp(sigma, rates.sigma, dddq[:, k]) for k in range(6)])
+    dq, ddq, d3q = interp_rows(sigma, rates.sigma, rates.dq, rates.ddq, dddq)
     qd_max, qdd_max, qddd_max = limits
     sd, sdd, sddd = sd[:, None], sdd[:, None], sddd[:, None]
     centripetal, tangential = ddq * sd**2, dq * sdd

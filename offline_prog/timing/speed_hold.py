@@ -10,6 +10,7 @@ length, ``motion.process: constant_speed``).
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d
 
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ
 from offline_prog.timing.jerk_stage import static_limit
@@ -19,6 +20,7 @@ from offline_prog.timing.time_law import sin2_time_law
 
 HOLD = 0.005  # ±0.5 % of the process speed
 RAMP_SAMPLES = 20001  # time samples of the nominal law that find its ramps
+BOUND_SPACING_M = 2.5e-4  # grid of upper_bound [m]
 
 
 class SpeedHold:
@@ -44,6 +46,21 @@ class SpeedHold:
         LIMIT_CHECK_RATE_HZ."""
         sigma, speed = law(np.arange(0.0, law.duration, 1.0 / LIMIT_CHECK_RATE_HZ))[:2]
         return self.on_samples(sigma, speed)
+
+    def upper_bound(self, sigma: np.ndarray, speed: np.ndarray, reach: float) -> float:
+        """The most of the feasible length a law can hold whose speed at each σ is an
+        average of ``speed`` within ``reach`` of it (the averaged profile's): where the
+        highest speed within reach is below the hold band, no average reaches it.
+
+        Args:
+            sigma: (G,) increasing grid [m]; speed: (G,) a profile on it [m/s].
+            reach: how far along the path the average looks each way [m].
+        """
+        grid = np.arange(0.0, self.length + BOUND_SPACING_M, BOUND_SPACING_M)
+        grid[-1] = min(grid[-1], self.length)
+        size = 2 * int(np.ceil(reach / BOUND_SPACING_M)) + 1
+        highest = maximum_filter1d(np.interp(grid, sigma, speed), size, mode="nearest")
+        return self.on_samples(grid, np.minimum(highest, self.v))[0]
 
     def on_samples(self, sigma: np.ndarray, speed: np.ndarray) -> tuple[float, float]:
         """(share of the feasible length where the speed holds the process speed within

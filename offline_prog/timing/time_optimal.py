@@ -18,15 +18,20 @@ return value with a reason (``ToppProfile.ok``), as in toppra itself.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 import numpy as np
 
 from offline_prog.timing.joint_timing import JointRates
 
-# Most grid points TOPP-RA solves on (the joint rates' grid is thinned to this): the
-# solve time grows linearly with them; ~1 mm spacing on the demo seams.
+# TOPP-RA's grid: the joint rates' grid thinned to about this spacing [m], within
+# these many points. The solve time grows linearly with them (~18 µs a point here);
+# 1.5 mm costs the demo laws ≤ 0.1 % of cycle time against 0.5-1.2 mm (1,000 points).
+TOPP_GRID_SPACING_M = 1.5e-3
+TOPP_MIN_GRID_POINTS = 300
 TOPP_GRID_POINTS = 1000
+RAMP_POINTS = 16
 
 
 @dataclasses.dataclass(frozen=True)
@@ -97,6 +102,39 @@ def _speed_curve(v_max: np.ndarray, dof: int, a_max: np.ndarray | None = None):
     return SpeedCurve()
 
 
+def topp_grid(sigma: np.ndarray, ramp: float, most: int) -> np.ndarray:
+    """Indices into ``sigma`` (G,) of TOPP-RA's grid: TOPP_GRID_SPACING_M apart (at least
+    TOPP_MIN_GRID_POINTS, at most ``most``), plus RAMP_POINTS spaced quadratically over
+    the first and last ``ramp`` metres (the rest-to-rest ramps at the path
+    acceleration, σ̇ ∝ √σ: else a slow process's ramp takes a whole grid step).
+    """
+    last = len(sigma) - 1
+    count = min(max(int(np.ceil(sigma[-1] / TOPP_GRID_SPACING_M)) + 1, TOPP_MIN_GRID_POINTS),
+                most, len(sigma))  # fmt: skip
+    ends = min(ramp, 0.5 * sigma[-1]) * np.linspace(0.0, 1.0, RAMP_POINTS) ** 2
+    near = np.concatenate([np.searchsorted(sigma, ends, "left"),  # nearest the ends
+                           np.searchsorted(sigma, sigma[-1] - ends, "right") - 1])  # fmt: skip
+    uniform = np.linspace(0, last, count).round().astype(int)
+    return np.unique(np.concatenate([uniform, np.clip(near, 0, last)]))
+
+
+@functools.lru_cache(maxsize=32)
+def _joint_constraints(v: tuple[float, ...], a: tuple[float, ...]):
+    """toppra's joint velocity and acceleration constraints for limits v, a (7,),
+    made once per limits: their constructors format every limit into a string (~4 ms
+    a solve on this machine, a fifth of it)."""
+    import toppra.constraint as constraint
+
+    v, a = np.array(v), np.array(a)
+    return (
+        constraint.JointVelocityConstraint(np.column_stack([-v, v])),
+        constraint.JointAccelerationConstraint(
+            np.column_stack([-a, a]),
+            discretization_scheme=constraint.DiscretizationType.Interpolation,
+        ),
+    )
+
+
 def profile_duration(sigma: np.ndarray, speed: np.ndarray) -> float:
     """Time to run the profile [s]: constant σ̈ between grid points, so each step
     takes 2 Δσ / (σ̇_i + σ̇_i+1)."""
@@ -114,6 +152,8 @@ def topp_profile(
     v_steady: np.ndarray | None = None,
     a_curve: np.ndarray | None = None,
     grid_points: int = TOPP_GRID_POINTS,
+    span: tuple[int, int] | None = None,
+    ends: tuple[float, float] = (0.0, 0.0),
 ) -> ToppProfile:
     """The time-optimal σ̇(σ) under the module's constraints (see the module doc).
 
@@ -126,13 +166,17 @@ def topp_profile(
             stage's steady-speed jerk limit, |q‴σ̇³| ≤ q⃛_max: TOPP-RA knows no jerk).
         a_curve: (G,) optional further cap on |σ̈| on the rates' grid [m/s²] (the
             filtered stage lowers it where its window's speed changes are too hard).
-        grid_points: most grid points of the solve.
+        grid_points: most grid points of the solve (TOPP_GRID_SPACING_M apart, at least
+            TOPP_MIN_GRID_POINTS).
+        span: (i, j): solve on the grid points i..j only (of the whole path's grid, the
+            returned ``sigma``), from σ̇ = ends[0] at i to σ̇ = ends[1] at j [m/s]; the
+            whole path, rest to rest, if None (``resolve_locally``).
     """
     import toppra.algorithm as algorithm  # 0.3 s (it imports matplotlib): only here
-    import toppra.constraint as constraint
 
-    keep = np.unique(np.linspace(0, len(rates.sigma) - 1, min(grid_points, len(rates.sigma))))
-    keep = keep.round().astype(int)
+    keep = topp_grid(rates.sigma, v_cap**2 / (2.0 * a_path), grid_points)
+    if span is not None:
+        keep = keep[span[0] : span[1] + 1]
     sigma = rates.sigma[keep]
     ones = np.ones((len(sigma), 1))
     path = _GridPath(
@@ -141,25 +185,62 @@ def topp_profile(
         np.hstack([rates.dq[keep], ones]),
         np.hstack([rates.ddq[keep], 0 * ones]),
     )
-    v = np.append(qd_max, v_cap)
-    a = np.append(qdd_max, a_path)
-    constraints = [
-        constraint.JointVelocityConstraint(np.column_stack([-v, v])),
-        constraint.JointAccelerationConstraint(
-            np.column_stack([-a, a]),
-            discretization_scheme=constraint.DiscretizationType.Interpolation,
-        ),
-    ]
+    constraints = list(_joint_constraints(tuple(np.append(qd_max, v_cap)),
+                                          tuple(np.append(qdd_max, a_path))))  # fmt: skip
     if v_steady is not None or a_curve is not None:
         v_curve = np.full(len(sigma), v_cap) if v_steady is None else v_steady[keep]
         a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)
         constraints.append(_speed_curve(np.minimum(v_curve, v_cap), path.dof, a_step))
     start = time.perf_counter()
     solver = algorithm.TOPPRA(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
-    _, sd, _ = solver.compute_parameterization(0.0, 0.0)
+    _, sd, _ = solver.compute_parameterization(*ends)
     solve_s = time.perf_counter() - start
     code = solver.problem_data.return_code
     if sd is None or str(code.name) != "Ok":
         return ToppProfile(sigma, np.zeros_like(sigma), np.inf, solve_s, False, str(code))
     speed = np.clip(np.asarray(sd, dtype=float), 0.0, v_cap)
+    return ToppProfile(sigma, speed, profile_duration(sigma, speed), solve_s, True)
+
+
+def resolve_locally(profile: ToppProfile, lowered: list[tuple[float, float]], solve,
+                    reach: float) -> ToppProfile:  # fmt: skip
+    """TOPP-RA again after its limit curves were lowered on the σ stretches
+    ``lowered``, re-solving only around them; exact.
+
+    The new profile is nowhere above the old one (its limits are tighter). Where a
+    stretch widened by ``reach`` each way can be solved from the old profile's speed
+    at its start to the old speed at its end, the old profile outside it and that
+    solution inside make a feasible profile, and no feasible profile is higher
+    (TOPP-RA's profile is the highest): it is the new optimum. Where not, the stretch
+    widens (×2) until it can, or becomes the whole path.
+
+    Args:
+        profile: TOPP-RA's answer before the curves were lowered (``ok``).
+        lowered: [(σ_start, σ_end), ...] where a limit curve was lowered [m].
+        solve: (span, ends) ↦ ToppProfile: ``topp_profile`` with the new curves.
+        reach: the first widening [m] (the longest stop at the path acceleration).
+    """
+    sigma, speed = profile.sigma, profile.speed.copy()
+    last, solve_s = len(sigma) - 1, profile.solve_s
+    lo = np.searchsorted(sigma, [a - reach for a, _ in lowered], "right") - 1
+    hi = np.searchsorted(sigma, [b + reach for _, b in lowered])
+    spans = sorted(zip(lo.tolist(), hi.tolist(), strict=True))
+    merged: list[list[int]] = []
+    for i, j in spans:
+        i, j = max(i, 0), min(j, last)
+        if merged and i <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], j)
+        else:
+            merged.append([i, j])
+    for i, j in merged:
+        while True:
+            part = solve((i, j), (float(speed[i]), float(speed[j])))
+            solve_s += part.solve_s
+            if part.ok:
+                speed[i : j + 1] = np.minimum(part.speed, speed[i : j + 1])
+                break
+            if i == 0 and j == last:
+                return part
+            width = j - i
+            i, j = max(i - width // 2 - 1, 0), min(j + width // 2 + 1, last)
     return ToppProfile(sigma, speed, profile_duration(sigma, speed), solve_s, True)

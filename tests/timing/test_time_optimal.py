@@ -58,6 +58,34 @@ def sampled_use(rates, law, limits=(QD_MAX, QDD_MAX, QDDD_MAX), rate_hz=1000.0):
     )
 
 
+def test_local_resolve_equals_a_whole_new_solve():
+    """Lowering the speed limit curve on a stretch and re-solving only around it gives
+    TOPP-RA's whole-path answer (time_optimal.resolve_locally)."""
+    from offline_prog.timing.time_optimal import resolve_locally
+
+    rates = bump_rates(gain=1.0)
+    curve = np.full(len(rates.sigma), 0.8)
+    common = dict(qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.8, a_path=2.0)
+
+    def solve(span=None, ends=(0.0, 0.0)):
+        return topp_profile(rates, v_steady=curve, span=span, ends=ends, **common)
+
+    before = solve()
+    lowered = [(0.2, 0.25), (0.8, 0.85)]
+    for a, b in lowered:  # a stretch the old profile is over, near each end
+        curve[(rates.sigma >= a) & (rates.sigma <= b)] = 0.3
+    local = resolve_locally(before, lowered, solve, reach=0.8**2 / (2 * 2.0))
+    whole = solve()
+    assert local.ok and whole.ok
+    np.testing.assert_allclose(local.sigma, whole.sigma)
+    np.testing.assert_allclose(local.speed, whole.speed, atol=1e-6)
+    assert local.duration > before.duration + 0.1  # the lowered stretches cost time
+    # A reach too short to hold the new slowdown widens until it does.
+    curve[(rates.sigma >= 0.5) & (rates.sigma <= 0.52)] = 0.05
+    tight = resolve_locally(whole, [(0.5, 0.52)], solve, reach=1e-3)
+    np.testing.assert_allclose(tight.speed, solve().speed, atol=1e-6)
+
+
 def test_topp_ra_agrees_with_toppra_used_directly():
     import toppra
     import toppra.algorithm as algo
@@ -230,3 +258,31 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
         ds = np.abs(np.diff(table["sigma"]))
         on_csv = np.sum(ds * (held[1:] & held[:-1])) / np.sum(ds)
         assert on_csv >= share * room - 0.01, (on_csv, share, room)
+
+
+@pytest.mark.parametrize(("speed", "gain"), [(0.05, 0.0), (0.5, 3.0)])
+@pytest.mark.parametrize("process", ["constant_speed", "cycle_time"])
+def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, process):
+    """Where path_timing skips the averaged profile by its bounds, running it would not
+    have given a shorter law (cycle_time) nor one holding the speed longer."""
+    from offline_prog.joints.path_timing import HELD_TIE, SKIP_SHARE, _cannot_win
+    from offline_prog.timing.speed_hold import SpeedHold
+    from offline_prog.timing.time_law import sin2_time_law
+
+    rates = bump_rates(gain=gain)
+    limits = (QD_MAX, QDD_MAX, QDDD_MAX)
+    path = dict(v_process=speed, a_max=2.0, j_max=20.0)
+    nominal = sin2_time_law(LENGTH, v_max=speed, a_max=2.0, j_max=20.0)
+    profile = topp_profile(rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=speed, a_path=2.0,
+                           v_steady=steady_jerk_limit(rates, limits))  # fmt: skip
+    staircase = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
+    averaged = filtered_timing(rates, profile, limits=limits, **path)
+    held = SpeedHold(rates, limits=limits, **path)
+    skipped = _cannot_win(staircase, profile, nominal, process, held)
+    # A slow process on a smooth path skips it; a fast one on a steep path cannot.
+    assert skipped == (gain == 0.0)
+    if skipped:
+        assert averaged.law.duration >= staircase.law.duration / (1 + SKIP_SHARE) - 1e-9
+        assert held(averaged.law)[0] <= held(staircase.law)[0] + HELD_TIE
+    else:
+        assert averaged.law.duration < staircase.law.duration
