@@ -39,8 +39,8 @@ MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this pa
 MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin
 # A cell's mesh larger than this across is a unit slip (a mm file read as m: 1000×).
 MAX_MESH_EXTENT_M = 20.0
-# motion.time_law: TOPP-RA + jerk stage, or the paper's sin² law (the default,
-# config/cell.py).
+# motion.time_law: TOPP-RA + jerk stage (the default, config/cell.py), or the paper's
+# sin² law.
 TIME_LAWS = ("time_optimal", "sin2")
 # motion.process, the time-optimal law's intent: hold the process speed wherever the
 # robot can (sealing, gluing), or anything up to it for the shortest cycle.

@@ -186,7 +186,7 @@ class MotionConfig:
     max_jerk: float = required()  # m/s³
     speed_reference: str = "tcp"  # tcp | flange
     # sin2 (the paper's law, the default) | time_optimal (TOPP-RA + jerk stage)
-    time_law: str = "sin2"
+    time_law: str = "time_optimal"  # time_optimal (TOPP-RA + jerk stage) | sin2 (the paper)
     process: str = "constant_speed"  # constant_speed | cycle_time (time_optimal only)
     sample_rate_hz: float = 250.0
     cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation

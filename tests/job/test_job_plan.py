@@ -190,6 +190,7 @@ def test_the_demo_needs_the_sampling_planner_and_its_links_are_clear(job):
     assert plan.collisions.collision_free and plan.feasible
 
 
+@pytest.mark.slow  # a whole job planned through the CLI
 def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp_path, capsys):
     import json
 
