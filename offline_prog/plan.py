@@ -43,6 +43,7 @@ from offline_prog.job.stages import (
     tool_speed,
 )
 from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.joints.path_timing import duration_without_joint_limits
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
@@ -178,7 +179,6 @@ def plan_flanges(
         profile = stage(
             "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
         )
-    timings = stage.timings_s
     return Plan(
         file,
         inputs.cell,
@@ -188,10 +188,10 @@ def plan_flanges(
         chosen.flange,
         traj,
         flanges.cusps,
-        timings,
+        stage.timings_s,
         inputs.robot,
         chosen.joints,
-        chosen.nominal.duration,
+        duration_without_joint_limits(chosen.nominal, inputs.cell.motion.time_law),
         chosen.rotation,
         chosen.collisions,
         avoidance,

@@ -71,6 +71,24 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
     )  # fmt: skip
 
 
+def duration_without_joint_limits(nominal: Sin2TimeLaw, time_law: str) -> float:
+    """The cycle time the law would take with no joint limit [s]: the sin² law's own
+    (``nominal``); for time_optimal the fastest rest-to-rest motion over the path
+    under its speed, acceleration and jerk limits (ruckig), which the averaged
+    profile reaches where no joint limit binds (L/v + v/a + a/j on a long path)."""
+    if time_law == "sin2":
+        return nominal.duration
+    from ruckig import InputParameter, Result, Ruckig, Trajectory
+
+    inp, trajectory = InputParameter(1), Trajectory(1)
+    inp.current_position, inp.target_position = [0.0], [nominal.length]
+    inp.max_velocity, inp.max_acceleration = [nominal.v_max], [nominal.a_max]
+    inp.max_jerk = [nominal.j_max]
+    result = Ruckig(1).calculate(inp, trajectory)
+    assert result in (Result.Working, Result.Finished), result
+    return float(trajectory.duration)
+
+
 def _cannot_win(staircase, profile, nominal, process: str, held: SpeedHold) -> bool:
     """The averaged profile (``filtered_stage``) cannot beat the staircase, by bounds:
     its profile is TOPP-RA's under tighter limits, so never above ``profile``, and it

@@ -17,7 +17,9 @@ stretch of the profile that sample averages (``FilteredTimeLaw.span``):
   dominates (q′σ̈, 3q″σ̇σ̈ + q′σ⃛, or σ⃛ over the path jerk): σ⃛ of the average is
   a difference of σ̈ across the window over T.
 
-An expected failure (no round holds every limit) is a return value: ``None``.
+After the first round, TOPP-RA is re-solved only around the stretches the last round
+lowered (``time_optimal.resolve_locally``: exact, a few ms a round). An expected
+failure (no round holds every limit) is a return value: ``None``.
 """
 
 from __future__ import annotations

@@ -286,3 +286,19 @@ def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, pro
         assert held(averaged.law)[0] <= held(staircase.law)[0] + HELD_TIE
     else:
         assert averaged.law.duration < staircase.law.duration
+
+
+def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_folder):
+    """time_optimal's cycle time without joint limits is the constant-jerk rest-to-rest
+    motion under the path's v, a, j (L/v + v/a + a/j on a long path), below sin²'s;
+    the demo seal's law (no joint limit binds) reaches it within 0.1 %."""
+    from offline_prog.joints.path_timing import duration_without_joint_limits
+    from offline_prog.timing.time_law import sin2_time_law
+
+    nominal = sin2_time_law(1.2, v_max=0.1, a_max=1.0, j_max=10.0)
+    fastest = duration_without_joint_limits(nominal, "time_optimal")
+    assert fastest == pytest.approx(1.2 / 0.1 + 0.1 / 1.0 + 1.0 / 10.0, rel=1e-9)
+    assert fastest < duration_without_joint_limits(nominal, "sin2") == nominal.duration
+    plan = planned_folder("seal_plate_kr16")[0]
+    assert plan.cell.motion.time_law == "time_optimal"  # the default
+    assert plan.nominal_duration_s <= plan.trajectory.duration <= 1.001 * plan.nominal_duration_s
