@@ -76,9 +76,10 @@ def _top(evaluated: list[Evaluation], k: int) -> list[Evaluation]:
     return top
 
 
-def cycle_time_cut(result: Placement) -> dict:
+def cycle_time_cut(result: Placement, tool=None) -> dict:
     """The cut of the cycle time against the cell as given, and why it is not larger
-    when it is under CUT_TARGET."""
+    when it is under CUT_TARGET (``tool``: the cell's ToolConfig, for the hint that a
+    round tool fixed about its axis could turn along the path)."""
     base, best = result.baseline, result.best
     if not best.feasible:
         return {"percent": None, "why_not_more": "no feasible placement was found"}
@@ -112,15 +113,21 @@ def cycle_time_cut(result: Placement) -> dict:
             f"{axis} in {count} of them: the seam's shape needs that joint motion wherever "
             "the tool stands"
         )
+        if tool is not None and tool.free_rotation_deg > 0 and tool.turn_smoothing_mm == 0:
+            why += (
+                " with the tool's turn fixed: tool.turn_smoothing_mm would let the tool "
+                "take up the part's turns"
+            )
     out["why_not_more"] = why
     return out
 
 
-def placement_json(result: Placement, space: SearchSpace, place, engine: dict) -> dict:
+def placement_json(result: Placement, space: SearchSpace, place, engine: dict,
+                   tool=None) -> dict:  # fmt: skip
     return {
         "best": terms(result.best),
         "baseline": terms(result.baseline),
-        "cycle_time_cut": cycle_time_cut(result),
+        "cycle_time_cut": cycle_time_cut(result, tool),
         "candidates": [terms(e) for e in _top(result.evaluated, place.top_k)],
         "search": {
             "budget": place.budget,

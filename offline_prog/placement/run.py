@@ -64,7 +64,8 @@ def place_cell(
         result = search(space, place, space.baseline, _runner(engine, space, place, progress))
     finally:
         engine.close()
-    data = placement_json(result, space, place, engine_figures(engine, result, started))
+    figures = engine_figures(engine, result, started)
+    data = placement_json(result, space, place, figures, ctx.inputs.cell.tool)
     progress("outputs", 0, 1)
     write_folder(out_dir, cell_file, ctx, result, data)
     progress("outputs", 1, 1)

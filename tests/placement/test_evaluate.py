@@ -140,3 +140,27 @@ def test_the_payload_keeps_symlinked_and_absolute_data_files(tmp_path):
         named = load_cell(copy).path.dxf
         assert not named.startswith("/") and (copy.parent / named).read_bytes() == dxf.read_bytes()
         assert str(tmp_path) not in copy.read_text()  # nothing read from the user's disk
+
+
+def test_why_not_more_names_the_fixed_tool_turn():
+    """A small cut whose cause is the wrist's turn at the corners says so, and names
+    tool.turn_smoothing_mm when the round tool's turn is fixed."""
+    import dataclasses
+
+    from offline_prog.config.cell import ToolConfig
+    from offline_prog.placement.objective import FEASIBLE, Evaluation
+    from offline_prog.placement.outputs import cycle_time_cut
+    from offline_prog.placement.search import Placement
+    from offline_prog.placement.space import Candidate
+
+    pose = ((1.0, 0.0, 0.5), (90.0, 0.0, 0.0))
+    run = Evaluation(Candidate((), -1, pose, pose), "plan", FEASIBLE, 0.0, "",
+                     cycle_time_s=14.0, process_bound_s=12.0, slowed_share=0.2,
+                     limiting_axis=6)  # fmt: skip
+    base = dataclasses.replace(run, cycle_time_s=14.5)
+    result = Placement(run, base, [base, run], [], 1.0)
+    fixed = ToolConfig(free_rotation_deg=90.0)
+    why = cycle_time_cut(result, fixed)["why_not_more"]
+    assert "limited by axis 6" in why and "tool.turn_smoothing_mm" in why
+    turning = dataclasses.replace(fixed, turn_smoothing_mm=30.0)
+    assert "tool.turn_smoothing_mm" not in cycle_time_cut(result, turning)["why_not_more"]
