@@ -43,7 +43,7 @@ from offline_prog.job.stages import (
     tool_speed,
 )
 from offline_prog.joints.joint_plan import JointTrajectory
-from offline_prog.joints.path_timing import duration_without_joint_limits
+from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
@@ -191,7 +191,7 @@ def plan_flanges(
         stage.timings_s,
         inputs.robot,
         chosen.joints,
-        duration_without_joint_limits(chosen.nominal, inputs.cell.motion.time_law),
+        without_joint_limits(chosen.nominal, inputs.cell.motion.time_law)[0],
         chosen.rotation,
         chosen.collisions,
         avoidance,

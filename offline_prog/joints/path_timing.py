@@ -26,7 +26,7 @@ from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates, retime
 from offline_prog.timing.speed_hold import SpeedHold
-from offline_prog.timing.time_law import Sin2TimeLaw
+from offline_prog.timing.time_law import Sin2TimeLaw, sin2_time_law
 from offline_prog.timing.time_optimal import topp_profile
 
 HELD_TIE = 1e-3  # held shares closer than this tie
@@ -71,22 +71,25 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
     )  # fmt: skip
 
 
-def duration_without_joint_limits(nominal: Sin2TimeLaw, time_law: str) -> float:
-    """The cycle time the law would take with no joint limit [s]: the sin² law's own
-    (``nominal``); for time_optimal the fastest rest-to-rest motion over the path
-    under its speed, acceleration and jerk limits (ruckig), which the averaged
-    profile reaches where no joint limit binds (L/v + v/a + a/j on a long path)."""
+def without_joint_limits(law, time_law: str) -> tuple[float, bool]:
+    """(cycle time [s], whether the process speed is reached) of the law with no joint
+    limit, from the path's limits alone (``law``: any time law over the path, its
+    length, v_max, a_max, j_max): the sin² law's for sin2; for time_optimal the fastest
+    rest-to-rest motion under those limits (ruckig), which the averaged profile
+    reaches where no joint limit binds (L/v + v/a + a/j on a long path)."""
     if time_law == "sin2":
-        return nominal.duration
+        nominal = sin2_time_law(law.length, v_max=law.v_max, a_max=law.a_max, j_max=law.j_max)
+        return nominal.duration, not nominal.reduced
     from ruckig import InputParameter, Result, Ruckig, Trajectory
 
     inp, trajectory = InputParameter(1), Trajectory(1)
-    inp.current_position, inp.target_position = [0.0], [nominal.length]
-    inp.max_velocity, inp.max_acceleration = [nominal.v_max], [nominal.a_max]
-    inp.max_jerk = [nominal.j_max]
+    inp.current_position, inp.target_position = [0.0], [law.length]
+    inp.max_velocity, inp.max_acceleration = [law.v_max], [law.a_max]
+    inp.max_jerk = [law.j_max]
     result = Ruckig(1).calculate(inp, trajectory)
     assert result in (Result.Working, Result.Finished), result
-    return float(trajectory.duration)
+    top = trajectory.at_time(0.5 * trajectory.duration)[1][0]  # rest to rest: the middle
+    return float(trajectory.duration), bool(top >= law.v_max * (1.0 - 1e-9))
 
 
 def _cannot_win(staircase, profile, nominal, process: str, held: SpeedHold) -> bool:

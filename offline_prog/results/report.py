@@ -13,6 +13,7 @@ import numpy as np
 
 from offline_prog import __version__
 from offline_prog.export.payload import payload, payload_note, payload_record
+from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.plan import Plan
 from offline_prog.timing.speed_hold import HOLD
 
@@ -252,7 +253,8 @@ def report(plan: Plan) -> dict:
                 "max_jerk_m_s3": law.j_max,
             },
             "top_speed_m_s": law.v_peak,
-            "top_speed_reduced": law.reduced,
+            # The path is too short to reach the speed (with no joint limit).
+            "top_speed_reduced": not without_joint_limits(law, cell.motion.time_law)[1],
             "sample_rate_hz": cell.motion.sample_rate_hz,
         },
         "trajectory": {

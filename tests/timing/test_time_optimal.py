@@ -5,6 +5,7 @@ for cycle_time the averaged profile (filtered_stage) holds every limit too and i
 faster than the staircase, and on the tape demo within 5 % of TOPP-RA."""
 
 import io
+import json
 import re
 
 import numpy as np
@@ -292,13 +293,19 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
     """time_optimal's cycle time without joint limits is the constant-jerk rest-to-rest
     motion under the path's v, a, j (L/v + v/a + a/j on a long path), below sin²'s;
     the demo seal's law (no joint limit binds) reaches it within 0.1 %."""
-    from offline_prog.joints.path_timing import duration_without_joint_limits
+    from offline_prog.joints.path_timing import without_joint_limits
     from offline_prog.timing.time_law import sin2_time_law
 
     nominal = sin2_time_law(1.2, v_max=0.1, a_max=1.0, j_max=10.0)
-    fastest = duration_without_joint_limits(nominal, "time_optimal")
-    assert fastest == pytest.approx(1.2 / 0.1 + 0.1 / 1.0 + 1.0 / 10.0, rel=1e-9)
-    assert fastest < duration_without_joint_limits(nominal, "sin2") == nominal.duration
-    plan = planned_folder("seal_plate_kr16")[0]
+    fastest, reached = without_joint_limits(nominal, "time_optimal")
+    assert fastest == pytest.approx(1.2 / 0.1 + 0.1 / 1.0 + 1.0 / 10.0, rel=1e-9) and reached
+    assert fastest < without_joint_limits(nominal, "sin2")[0] == nominal.duration
+    # 5 mm cannot reach 0.1 m/s at 1 m/s², 10 m/s³ (that takes ≥ 10 mm): "reduced".
+    short = sin2_time_law(0.005, v_max=0.1, a_max=1.0, j_max=10.0)
+    assert not without_joint_limits(short, "time_optimal")[1]
+    assert not without_joint_limits(short, "sin2")[1]
+    plan, folder = planned_folder("seal_plate_kr16")
     assert plan.cell.motion.time_law == "time_optimal"  # the default
     assert plan.nominal_duration_s <= plan.trajectory.duration <= 1.001 * plan.nominal_duration_s
+    # The seal demo reaches its speed: report.json does not call its path short.
+    assert json.loads((folder / "report.json").read_text())["motion"]["top_speed_reduced"] is False
