@@ -16,8 +16,9 @@ def at_index(values: np.ndarray, x: float):
 
 
 def interp_rows(x: np.ndarray, xp: np.ndarray, *tables: np.ndarray) -> list[np.ndarray]:
-    """Each table (G, K) linearly interpolated at x (N,) over the increasing grid xp
-    (G,), held at its ends like ``np.interp``; one index search for all columns.
+    """Each table (G, K) linearly interpolated at x (N,) over the strictly increasing
+    grid xp (G ≥ 2), held at its ends like ``np.interp``; one index search for all
+    columns.
 
     Returns:
         [(N, K), ...], one per table.

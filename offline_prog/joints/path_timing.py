@@ -6,9 +6,10 @@ steady-speed joint jerk limit as a speed limit curve; then the jerk stage
 (``timing.jerk_stage``), and the time-averaged profile (``timing.filtered_stage``),
 keeping for each intent the better of the two that holds every limit (the faster for
 ``cycle_time``; for ``constant_speed`` the one holding the process speed longer). Two
-exact shortcuts keep the solve short: TOPP-RA is solved once when its profile already
-keeps the steady jerk limit, and the averaged profile's rounds (each a TOPP-RA solve)
-are skipped when bounds show it cannot beat the staircase.
+shortcuts keep the solve short: TOPP-RA is solved once when its profile already keeps
+the steady jerk limit (exact), and the averaged profile's rounds are skipped when
+bounds show it cannot beat the staircase by more than SKIP_SHARE of the cycle or
+HELD_TIE of the held length.
 ``sin2``: the paper's law with plateaus lowered where the joints need it
 (``timing.joint_timing``).
 """

@@ -35,7 +35,8 @@ from offline_prog.path.fixed_tcp import vee
 from offline_prog.path.process_frames import NormalField, process_frames
 
 GRID_SPACING_M = 5e-4  # θ and θ̄ sampled every 0.5 mm
-SPAN_MARGIN_RAD = 1e-5
+SPAN_REFINE = 16
+SPAN_MARGIN_RAD = 1e-7
 
 
 def turn_rates(path: ArcLengthPath, normal: NormalField, s: np.ndarray, axis: int):
@@ -80,9 +81,11 @@ class SmoothTurn:
         else:
             smooth = gaussian_filter1d(theta, width_m / step, mode="nearest")
         self._smooth = make_interp_spline(s, smooth, k=5)
-        # The span of θ − θ̄ [rad]: φ₀ + scale · span must stay within the free rotation
-        # (widened by SPAN_MARGIN_RAD for the splines between their grid points).
-        residual = theta - smooth
+        # The span of θ − θ̄ [rad]: φ₀ + scale · span must stay within the free rotation;
+        # taken on a SPAN_REFINE× finer grid than the splines' (they overshoot their
+        # nodes by up to ~1e-5 rad on a 5 mm width) and widened by SPAN_MARGIN_RAD.
+        fine = np.linspace(0.0, length, SPAN_REFINE * (len(s) - 1) + 1)
+        residual = self._theta(fine) - self._smooth(fine)
         self.span_rad = (residual.min() - SPAN_MARGIN_RAD, residual.max() + SPAN_MARGIN_RAD)
 
     def with_offset(self, offset_rad: float, scale: float = 1.0) -> SmoothTurn:

@@ -76,6 +76,9 @@ def _top(evaluated: list[Evaluation], k: int) -> list[Evaluation]:
     return top
 
 
+WRIST_AXES = (4, 5, 6)
+
+
 def cycle_time_cut(result: Placement, tool=None) -> dict:
     """The cut of the cycle time against the cell as given, and why it is not larger
     when it is under CUT_TARGET (``tool``: the cell's ToolConfig, for the hint that a
@@ -113,7 +116,8 @@ def cycle_time_cut(result: Placement, tool=None) -> dict:
             f"{axis} in {count} of them: the seam's shape needs that joint motion wherever "
             "the tool stands"
         )
-        if tool is not None and tool.free_rotation_deg > 0 and tool.turn_smoothing_mm == 0:
+        fixed = tool is not None and tool.free_rotation_deg > 0 and tool.turn_smoothing_mm == 0
+        if fixed and axis in WRIST_AXES:  # the part's turns land on the wrist
             why += (
                 " with the tool's turn fixed: tool.turn_smoothing_mm would let the tool "
                 "take up the part's turns"

@@ -32,6 +32,7 @@ TOPP_GRID_SPACING_M = 1.5e-3
 TOPP_MIN_GRID_POINTS = 300
 TOPP_GRID_POINTS = 1000
 RAMP_POINTS = 16
+START_TOL = 1e-6  # resolve_locally: a local solve starts at the old speed within this share
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,7 +105,7 @@ def _speed_curve(v_max: np.ndarray, dof: int, a_max: np.ndarray | None = None):
 
 def topp_grid(sigma: np.ndarray, ramp: float, most: int) -> np.ndarray:
     """Indices into ``sigma`` (G,) of TOPP-RA's grid: TOPP_GRID_SPACING_M apart (at least
-    TOPP_MIN_GRID_POINTS, at most ``most``), plus RAMP_POINTS spaced quadratically over
+    TOPP_MIN_GRID_POINTS, at most ``most`` of these), plus RAMP_POINTS spaced quadratically over
     the first and last ``ramp`` metres (the rest-to-rest ramps at the path
     acceleration, σ̇ ∝ √σ: else a slow process's ramp takes a whole grid step).
     """
@@ -218,7 +219,8 @@ def resolve_locally(profile: ToppProfile, lowered: list[tuple[float, float]], so
         profile: TOPP-RA's answer before the curves were lowered (``ok``).
         lowered: [(σ_start, σ_end), ...] where a limit curve was lowered [m].
         solve: (span, ends) ↦ ToppProfile: ``topp_profile`` with the new curves.
-        reach: the first widening [m] (the longest stop at the path acceleration).
+        reach: the first widening [m] (the shortest stop from the process speed,
+            v²/2a: a longer one needs a wider stretch, which the widening finds).
     """
     sigma, speed = profile.sigma, profile.speed.copy()
     last, solve_s = len(sigma) - 1, profile.solve_s
@@ -236,11 +238,14 @@ def resolve_locally(profile: ToppProfile, lowered: list[tuple[float, float]], so
         while True:
             part = solve((i, j), (float(speed[i]), float(speed[j])))
             solve_s += part.solve_s
-            if part.ok:
+            # toppra may start a little below the speed asked (its forward pass lowers
+            # σ̇₀² on a numerical failure): then the step into i would be too hard.
+            kept = part.ok and abs(part.speed[0] - speed[i]) <= START_TOL * max(speed[i], 1e-3)
+            if kept:
                 speed[i : j + 1] = np.minimum(part.speed, speed[i : j + 1])
                 break
             if i == 0 and j == last:
-                return part
+                return dataclasses.replace(part, solve_s=solve_s)
             width = j - i
             i, j = max(i - width // 2 - 1, 0), min(j + width // 2 + 1, last)
     return ToppProfile(sigma, speed, profile_duration(sigma, speed), solve_s, True)

@@ -79,25 +79,29 @@ def test_corner_turn_is_spread_and_the_seam_joins():
     np.testing.assert_allclose(ends[:, 0], ends[:, 1], atol=1e-6 * (1 + np.abs(ends).max()))
 
 
-@pytest.mark.parametrize("bound_deg", [90.0, 10.0])
-def test_every_turn_tried_stays_within_the_free_rotation(bound_deg):
+@pytest.mark.parametrize(("bound_deg", "width_mm"), [(90.0, 30.0), (10.0, 30.0), (10.0, 5.0)])
+def test_every_turn_tried_stays_within_the_free_rotation(bound_deg, width_mm):
     inputs = load_inputs(CELLS / "seal_plate_kr16.yaml", ROBOTS_DIR)
     fit = fit_path(inputs)
-    turn = SmoothTurn(fit.path, fit.normal, axis="y", width_m=0.03)
+    turn = SmoothTurn(fit.path, fit.normal, axis="y", width_m=width_mm * 1e-3)
     bound = np.deg2rad(bound_deg)
     rotations = tool_rotations(inputs.robot, inputs.X_IB, fit.path, fit.normal,
                                X_IT=inputs.X_IT, X_PE=inputs.X_PE, bound_rad=bound,
                                smooth_turn=turn)  # fmt: skip
-    s = np.linspace(0.0, fit.path.length, 2001)
+    # The outermost φ₀ each way, every 12 µm (between the splines' 0.5 mm nodes).
+    fine = np.linspace(0.0, fit.path.length, 100_001)
+    for _, flange in (min(rotations, key=lambda r: r[0]), max(rotations, key=lambda r: r[0])):
+        assert np.abs(flange.tool_turn(fine)[0]).max() <= bound
+    s = fine[::50]
     for _, flange in rotations:
-        phi = flange.tool_turn(s)[0]
-        assert np.abs(phi).max() <= bound + 1e-9
         # The part's turn is the same everywhere up to a constant: θ̄ less φ₀.
         rate = flange_turn_rate(flange, s)
         np.testing.assert_allclose(rate, flange_turn_rate(rotations[0][1], s), atol=1e-9)
-    # θ − θ̄ spans ~55° on this border: within ±90° φ₀ moves, within ±10° one φ₀ with
-    # a share of it.
-    assert (len(rotations) > 1) == (bound_deg == 90.0)
+    # θ − θ̄ spans ~55° on this border at 30 mm, ~18° at 5 mm: where the free
+    # rotation is wider φ₀ moves within it, else one φ₀ takes up a share of the turn.
+    low, high = turn.span_rad
+    assert (len(rotations) > 1) == (high - low < 2 * bound)
+    assert (bound_deg, width_mm) != (10.0, 30.0) or len(rotations) == 1
 
 
 def test_open_path_turn_holds_its_ends(rng):

@@ -164,3 +164,8 @@ def test_why_not_more_names_the_fixed_tool_turn():
     assert "limited by axis 6" in why and "tool.turn_smoothing_mm" in why
     turning = dataclasses.replace(fixed, turn_smoothing_mm=30.0)
     assert "tool.turn_smoothing_mm" not in cycle_time_cut(result, turning)["why_not_more"]
+    # A slowdown at the shoulder is not the part's turn: no hint.
+    shoulder = [dataclasses.replace(e, limiting_axis=2) for e in (run, base)]
+    result = Placement(shoulder[0], shoulder[1], shoulder[::-1], [], 1.0)
+    why = cycle_time_cut(result, fixed)["why_not_more"]
+    assert "limited by axis 2" in why and "tool.turn_smoothing_mm" not in why
