@@ -130,6 +130,7 @@ def edited_text(text: str, initial: SessionState, state: SessionState) -> str:
             _transform(edits, node, p, rpy)
     for owner, key, value, value0 in (
         ("tool", "free_rotation_deg", state.free_rotation_deg, initial.free_rotation_deg),
+        ("tool", "turn_smoothing_mm", state.turn_smoothing_mm, initial.turn_smoothing_mm),
         ("motion", "speed", state.motion_speed, initial.motion_speed),
         ("motion", "clearance", state.clearance, initial.clearance),
     ):

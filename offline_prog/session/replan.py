@@ -165,7 +165,7 @@ class Replanner:
             self._fits[k] = stage("fit", "fitting the B-spline", fit_path, inputs)
         fit = self._fits[k]
         poses = (state.p_IT, state.rpy_IT_deg, state.p_PE, state.rpy_PE_deg)
-        frames_key = (k, *poses, state.free_rotation_deg)
+        frames_key = (k, *poses, state.free_rotation_deg, state.turn_smoothing_mm)
         flanges = self._cached("frames", frames_key, lambda: stage(
             "frames", "process frames and flange path", flange_paths, inputs, fit))  # fmt: skip
         scene = self._cached("scene", poses, lambda: stage(

@@ -23,6 +23,7 @@ from offline_prog.constants import MAX_SPEED_M_S
 MAX_OFFSET_MM = 10_000.0  # a tool stand or grasp farther than 10 m is a typo
 MAX_ANGLE_DEG = 360.0
 MAX_CLEARANCE_MM = 500.0
+MAX_TURN_SMOOTHING_MM = 1000.0  # a Gaussian wider than a metre smooths any seam flat
 ROUND_DEG = 9  # decimals kept of angles read from a rotation that is not an Rpy
 
 
@@ -36,6 +37,7 @@ class SessionState:
         motion_speed: motion.speed [m/s].
         seam_speeds: each seam's own speed [m/s] (None: it runs at motion.speed).
         free_rotation_deg: tool.free_rotation_deg [deg].
+        turn_smoothing_mm: tool.turn_smoothing_mm [mm].
         clearance: motion.clearance [m].
         seam: the active seam's index.
     """
@@ -47,6 +49,7 @@ class SessionState:
     motion_speed: float
     seam_speeds: tuple[float | None, ...]
     free_rotation_deg: float
+    turn_smoothing_mm: float
     clearance: float
     seam: int = 0
 
@@ -90,6 +93,7 @@ def initial_state(cell: Cell) -> SessionState:
         float(cell.motion.speed),
         tuple(None if s is None or s.speed is None else float(s.speed) for s in seams),
         float(cell.tool.free_rotation_deg),
+        float(cell.tool.turn_smoothing_mm),
         float(cell.motion.clearance),
     )
 
@@ -112,6 +116,8 @@ def apply(cell: Cell, initial: SessionState, state: SessionState) -> Cell:
         tool = dataclasses.replace(tool, X_IT=schema_transform(state.p_IT, state.rpy_IT_deg))
     if state.free_rotation_deg != initial.free_rotation_deg:
         tool = dataclasses.replace(tool, free_rotation_deg=state.free_rotation_deg)
+    if state.turn_smoothing_mm != initial.turn_smoothing_mm:
+        tool = dataclasses.replace(tool, turn_smoothing_mm=state.turn_smoothing_mm)
     if (state.p_PE, state.rpy_PE_deg) != (initial.p_PE, initial.rpy_PE_deg):
         part = dataclasses.replace(part, X_PE=schema_transform(state.p_PE, state.rpy_PE_deg))
     if state.motion_speed != initial.motion_speed:
@@ -143,6 +149,7 @@ def controls(state: SessionState, seam_names: list[str]) -> list[Control]:
     out += [
         Control("speed", "process", "speed", "mm/s", 0.5, round(top), 0.5),
         Control("free_rotation", "process", "free tool rotation", "°", 0, 180, 1),
+        Control("turn_smoothing", "process", "tool turn smoothing", "mm", 0, 100, 1),
         Control("clearance", "process", "clearance", "mm", 0, 50, 0.5),
     ]
     if len(seam_names) > 1:
@@ -163,6 +170,7 @@ def values(state: SessionState) -> dict[str, float]:
     out.update(
         speed=round(state.speed * 1e3, 6),
         free_rotation=state.free_rotation_deg,
+        turn_smoothing=state.turn_smoothing_mm,
         clearance=round(state.clearance * 1e3, 6),
         seam=state.seam,
     )
@@ -216,6 +224,9 @@ def with_value(state: SessionState, key: str, text) -> SessionState:
     if key == "free_rotation":
         _within(value, 0.0, 180.0, "°")
         return dataclasses.replace(state, free_rotation_deg=value)
+    if key == "turn_smoothing":
+        _within(value, 0.0, MAX_TURN_SMOOTHING_MM, "mm")
+        return dataclasses.replace(state, turn_smoothing_mm=value)
     if key == "clearance":
         _within(value, 0.0, MAX_CLEARANCE_MM, "mm")
         return dataclasses.replace(state, clearance=value * 1e-3)

@@ -72,3 +72,17 @@ def test_out_of_reach_is_a_status_with_sigma_t_and_why(replanner):
     assert "σ = " in status["line"] and "t = " in status["line"]
     # The failure is kept: only the clearance changed, nothing is planned again.
     assert replanner.plan(with_value(far, "clearance", 6)).ran == []
+
+
+def test_a_tool_turn_smoothing_change_re_runs_the_frames_and_joints(replanner):
+    """tool.turn_smoothing_mm from the panel: the flange paths and the joints are planned
+    again with the tool turning along the path; without a free rotation it is refused."""
+    free = with_value(replanner.initial, "free_rotation", 90)
+    replanner.plan(free)
+    turning = with_value(free, "turn_smoothing", 20)
+    result = replanner.plan(turning)
+    assert result.ran == ["frames", "joints"] and result.plan.feasible
+    phi = result.plan.flange.tool_turn(np.linspace(0.0, result.plan.path.length, 200))[0]
+    assert np.ptp(phi) > np.deg2rad(1.0)  # it turns along the path
+    refused = replanner.plan(with_value(replanner.initial, "turn_smoothing", 20))
+    assert refused.plan is None and "tool.turn_smoothing_mm" in refused.error

@@ -49,6 +49,7 @@ def test_values_in_mm_and_degrees_make_the_cell(seal):
         ("X_IT.x", "1e9", "must be ≥ -10000"),
         ("X_PE.roll", "inf", "not a finite number"),
         ("free_rotation", "200", "≤ 180"),
+        ("turn_smoothing", "-1", "must be ≥ 0"),
         ("seam", "1", "no such seam"),
         ("nozzle", "1", "not a control"),
     ],
