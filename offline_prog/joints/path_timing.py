@@ -60,14 +60,18 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
 
     held = SpeedHold(rates, limits=limits, **path)
     timing = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
-    if not (timing.feasible and _cannot_win(timing, profile, nominal, process, held)):
+    speed_held = held(timing.law)  # measured once per law: the choice and the report
+    if not (timing.feasible and _cannot_win(timing, speed_held, profile, nominal, process,
+                                            held)):  # fmt: skip
         filtered = filtered_timing(rates, profile, limits=limits, **path)
-        if filtered is not None and (
-            not timing.feasible or _better(filtered, timing, process, held)
-        ):
-            timing = dataclasses.replace(filtered, process=process, topp=profile)
+        if filtered is not None:
+            filtered_held = held(filtered.law)
+            if not timing.feasible or _better(filtered, filtered_held, timing, speed_held,
+                                              process):  # fmt: skip
+                timing = dataclasses.replace(filtered, process=process, topp=profile)
+                speed_held = filtered_held
     return dataclasses.replace(
-        timing, topp_plain_s=plain.duration, speed_held=held(timing.law),
+        timing, topp_plain_s=plain.duration, speed_held=speed_held,
         solve_s=time.perf_counter() - start,
     )  # fmt: skip
 
@@ -93,29 +97,30 @@ def without_joint_limits(law, time_law: str) -> tuple[float, bool]:
     return float(trajectory.duration), bool(top >= law.v_max * (1.0 - 1e-9))
 
 
-def _cannot_win(staircase, profile, nominal, process: str, held: SpeedHold) -> bool:
+def _cannot_win(staircase, staircase_held, profile, nominal, process: str,
+                held: SpeedHold) -> bool:  # fmt: skip
     """The averaged profile (``filtered_stage``) cannot beat the staircase, by bounds:
     its profile is TOPP-RA's under tighter limits, so never above ``profile``, and it
     runs the profile's duration plus its window T = a/j. Its speed is an average of
     the profile's over T, so it can hold the process speed only within v·T of where
-    the profile does (``held.upper_bound``)."""
+    the profile does (``held.upper_bound``; staircase_held: ``held`` of the staircase)."""
     window = nominal.a_max / nominal.j_max
     if staircase.law.duration > (profile.duration + window) * (1.0 + SKIP_SHARE):
         return False
     if process == "cycle_time":
         return True
     bound = held.upper_bound(profile.sigma, profile.speed, reach=nominal.v_max * window)
-    return held(staircase.law)[0] >= bound - HELD_TIE
+    return staircase_held[0] >= bound - HELD_TIE
 
 
-def _better(filtered, staircase, process: str, held) -> bool:
+def _better(filtered, filtered_held, staircase, staircase_held, process: str) -> bool:
     """The averaged profile beats the staircase for the intent: shorter for
     ``cycle_time``; for ``constant_speed`` it holds the process speed over more of the
     feasible length (then: shorter). Its speed follows the joints' limit through a
     slowdown where the staircase holds one steady lower speed; both ramp only where a
-    limit forces it."""
+    limit forces it (``*_held``: SpeedHold of each law)."""
     if process == "constant_speed":
-        ours, theirs = held(filtered.law)[0], held(staircase.law)[0]
+        ours, theirs = filtered_held[0], staircase_held[0]
         if abs(ours - theirs) > HELD_TIE:
             return ours > theirs
     return filtered.law.duration < staircase.law.duration

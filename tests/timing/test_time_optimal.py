@@ -279,7 +279,7 @@ def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, pro
     staircase = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
     averaged = filtered_timing(rates, profile, limits=limits, **path)
     held = SpeedHold(rates, limits=limits, **path)
-    skipped = _cannot_win(staircase, profile, nominal, process, held)
+    skipped = _cannot_win(staircase, held(staircase.law), profile, nominal, process, held)
     # A slow process on a smooth path skips it; a fast one on a steep path cannot.
     assert skipped == (gain == 0.0)
     if skipped:
