@@ -36,3 +36,42 @@ def test_installed_package_plans_a_demo_cell_from_another_directory(tmp_path):
     for name in ("report.json", "preview.html", "report.html", "programs/offline_prog.src"):
         assert (work / "out" / name).is_file(), name
     assert "uPlot" in (work / "out" / "report.html").read_text()
+
+
+def _requirements():
+    """Every requirement pyproject.toml declares: the package's and the test extra's."""
+    import tomllib
+
+    from packaging.requirements import Requirement
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    declared = project["dependencies"] + project["optional-dependencies"]["test"]
+    return [Requirement(text) for text in declared]
+
+
+def _pins():
+    """constraints.txt as {normalized name: version}."""
+    from packaging.utils import canonicalize_name
+
+    pins = {}
+    for line in (REPO / "constraints.txt").read_text().splitlines():
+        line = line.split("#")[0].strip()
+        if line:
+            name, version = line.split("==")
+            pins[canonicalize_name(name)] = version
+    return pins
+
+
+def test_constraints_pin_every_declared_requirement_inside_its_range():
+    """The README's installs use constraints.txt: a requirement added to pyproject.toml
+    without a tested pin, or a pin outside the declared range, would give a fresh
+    machine versions the suite never ran with."""
+    from packaging.utils import canonicalize_name
+
+    pins = _pins()
+    for requirement in _requirements():
+        name = canonicalize_name(requirement.name)
+        assert name in pins, f"{requirement.name} has no pin in constraints.txt"
+        assert requirement.specifier.contains(pins[name], prereleases=True), (
+            f"constraints.txt pins {requirement.name}=={pins[name]}, outside {requirement}"
+        )
