@@ -6,6 +6,9 @@ import numpy as np
 DEFAULT_SPLINE_DEGREE = 5
 MIN_SPLINE_DEGREE = 5
 DEFAULT_FIT_TOLERANCE_M = 1e-4  # max distance from a given point to the curve [m]
+# A closed contour's points may stop short of their start by up to this many times the
+# larger of the first and last point spacing (path/closing.py); more is a missing stretch.
+CLOSING_GAP_STEP_RATIO = 2.0
 
 # Arc-length re-parameterization: Newton on s(u) stops below this [m].
 ARC_LENGTH_TOLERANCE_M = 1e-12
