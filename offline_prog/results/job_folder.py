@@ -32,7 +32,7 @@ from offline_prog.results.plan_folder import (
     program_names,
     time_law_name,
 )
-from offline_prog.results.report import collision_summary, report
+from offline_prog.results.report import collision_summary, payload_summary, report
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
 from offline_prog.viz.job_report_html import write_job_report_html
@@ -131,6 +131,7 @@ def job_report(job: JobPlan) -> dict:
         "robot": job.cell.robot.model,
         "tool": job.cell.tool.name,
         "part": job.cell.part.name,
+        "payload": payload_summary(job.cell),
         "job": {
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
             "order_mode": job_config(job.cell).order,
