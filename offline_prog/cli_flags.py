@@ -104,7 +104,7 @@ def parser() -> argparse.ArgumentParser:
     robot_commands.add_parser("list", help="the robots in offline_prog/robots")
     matrix = robot_commands.add_parser(
         "self-collision",
-        help="sample configurations and write robots/<robot>/self_collision.yaml",
+        help="sample configurations and write the robot's self-collision matrix",
     )
     matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
     matrix.add_argument(
@@ -112,6 +112,11 @@ def parser() -> argparse.ArgumentParser:
         default=10_000, help="configurations (10000)",
     )  # fmt: skip
     matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    matrix.add_argument(
+        "--out", type=Path, default=Path("."),
+        help="file, or folder for self_collision.yaml (default: the current folder); "
+        "the planner reads the one in the robot's folder",
+    )  # fmt: skip
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(

@@ -165,3 +165,24 @@ def test_debug_before_or_after_the_subcommand_shows_the_traceback(capsys, monkey
     argv = ["--debug", "robots", "list"] if where == "before" else ["robots", "list", "--debug"]
     with pytest.raises(RuntimeError, match="a bug of ours"):
         main(argv)
+
+
+def test_self_collision_writes_where_the_user_says_not_into_the_package(
+    capsys, tmp_path, monkeypatch
+):
+    """The robot file shipped in the package stays as it is; the matrix goes to the
+    current folder (or --out), and the command says how to plan with it."""
+    from offline_prog.robot.model import ROBOTS_DIR
+    from offline_prog.scene.self_collision import MATRIX_FILE, read_matrix
+
+    shipped = ROBOTS_DIR / "ur10e" / MATRIX_FILE
+    before = shipped.read_bytes(), shipped.stat().st_mtime_ns
+    monkeypatch.chdir(tmp_path)
+    assert main(["robots", "self-collision", "ur10e", "--samples", "20"]) == 0
+    said = capsys.readouterr().out.splitlines()[-1]
+    assert said.startswith("wrote self_collision.yaml (20 samples, seed 0)")
+    assert said.endswith(f"copy it there: cp self_collision.yaml {shipped}")
+    assert len(read_matrix(tmp_path)) == len(read_matrix(shipped.parent))
+    assert main(["robots", "self-collision", "ur10e", "--samples", "20", "--out", "m.yaml"]) == 0
+    assert (tmp_path / "m.yaml").read_text() == (tmp_path / MATRIX_FILE).read_text()
+    assert (shipped.read_bytes(), shipped.stat().st_mtime_ns) == before
