@@ -201,7 +201,8 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
             for fmt in job_formats(data.language):
                 for file in export(data, fmt, folder / PROGRAMS_DIR):
                     files[f"{fmt}:{file.name}"] = file
-        files["report_html"] = write_job_report_html(folder)  # after the programs
+        # After the programs; it names the folder the user gets, not the staged one.
+        files["report_html"] = write_job_report_html(folder, folder_name=out_dir.name)
         preview.wait()
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
