@@ -39,6 +39,8 @@ def _export_options(args) -> dict:
         options["angle_tol_rad"] = float(np.deg2rad(args.angle_tol_deg))
     if args.style is not None and args.format == "krl":
         options["style"] = args.style
+    if args.tcp_pose_convention is not None and args.format == "krl":
+        options["tcp_pose_convention"] = args.tcp_pose_convention
     if args.mode is not None and args.format == "urscript":
         options["mode"] = args.mode
     if args.line_limit is not None and args.format in ("krl", "rapid"):

@@ -135,6 +135,12 @@ def parser() -> argparse.ArgumentParser:
         help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
     )
     export.add_argument(
+        "--tcp-pose-convention",
+        choices=["X_TP", "X_PF"],
+        default=None,
+        help="KRL external_tcp points: the part P in the tool T (X_TP, default) or T in P (X_PF)",
+    )
+    export.add_argument(
         "--mode",
         choices=["servoj", "movel"],
         default=None,
