@@ -143,7 +143,10 @@ def _run_place(args, console: Console, errors: Console) -> str:
             args.cell, out, budget=args.budget, seed=args.seed, workers=args.workers,
             scheduler=args.scheduler, progress=progress,
         )  # fmt: skip
+    from offline_prog.atomic import read_manifest
+
     best, cut, engine = data["best"], data["cycle_time_cut"], data["engine"]
+    wrote = ", ".join(sorted((read_manifest(out) or {}).get("files", {}).get("plan", [])))
     verdict = "feasible" if best["feasible"] else f"infeasible ({best['reason']})"
     console.print(f"best placement: {verdict}", highlight=False, markup=False)
     if best["feasible"]:
@@ -163,7 +166,7 @@ def _run_place(args, console: Console, errors: Console) -> str:
     console.print(
         f"{engine['candidates_evaluated']} candidates planned, {engine['screened']} screened, "
         f"{engine['wall_time_s']:.1f} s on {engine['workers']} worker(s) "
-        f"({engine['scheduler']}); wrote {out}/placement.json, placed.yaml, placement.html",
+        f"({engine['scheduler']}); wrote into {out}: {wrote}",
         highlight=False,
         markup=False,
     )
