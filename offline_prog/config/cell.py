@@ -128,7 +128,7 @@ class AnalyticPath:
 @dataclasses.dataclass
 class PathConfig:
     units: str = required()  # m | mm
-    closed: bool = False  # a closed contour (periodic spline): the ends must meet
+    closed: bool = False  # a closed contour (periodic spline); its ends: path.closing
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
