@@ -39,6 +39,8 @@ def _export_options(args) -> dict:
         options["angle_tol_rad"] = float(np.deg2rad(args.angle_tol_deg))
     if args.style is not None and args.format == "krl":
         options["style"] = args.style
+    if args.tcp_pose_convention is not None and args.format == "krl":
+        options["tcp_pose_convention"] = args.tcp_pose_convention
     if args.mode is not None and args.format == "urscript":
         options["mode"] = args.mode
     if args.line_limit is not None and args.format in ("krl", "rapid"):
@@ -55,17 +57,26 @@ def _run_robots(args, console: Console) -> None:
         for name in list_robots():
             console.print(name)
         return
-    from offline_prog.scene.self_collision import write_matrix
+    from offline_prog.scene.self_collision import MATRIX_FILE, write_matrix
 
     try:
         robot = load_robot(args.robot)
     except ValueError as error:
         raise InputError(ROBOTS_DIR, "", str(error)) from None
-    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed)
+    file = args.out / MATRIX_FILE if args.out.is_dir() else args.out
+    if file.exists() and not file.is_file():
+        raise InputError(file, "--out", "exists and is not a file")
+    pairs = write_matrix(robot, file, samples=args.samples, seed=args.seed)
     for kind in ("adjacent", "always", "constant", "never", "check"):
         names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
         console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
-    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
+    used = robot.urdf_path.parent / MATRIX_FILE
+    console.print(
+        f"wrote {file} ({args.samples} samples, seed {args.seed}). The planner reads "
+        f"{used}" + ("" if file.resolve() == used.resolve() else
+                     f"; to plan with this matrix, copy it there: cp {file} {used}"),
+        highlight=False, markup=False,
+    )  # fmt: skip
 
 
 def _run_export(args, console: Console) -> None:
@@ -132,7 +143,10 @@ def _run_place(args, console: Console, errors: Console) -> str:
             args.cell, out, budget=args.budget, seed=args.seed, workers=args.workers,
             scheduler=args.scheduler, progress=progress,
         )  # fmt: skip
+    from offline_prog.atomic import read_manifest
+
     best, cut, engine = data["best"], data["cycle_time_cut"], data["engine"]
+    wrote = ", ".join(sorted((read_manifest(out) or {}).get("files", {}).get("plan", [])))
     verdict = "feasible" if best["feasible"] else f"infeasible ({best['reason']})"
     console.print(f"best placement: {verdict}", highlight=False, markup=False)
     if best["feasible"]:
@@ -152,7 +166,7 @@ def _run_place(args, console: Console, errors: Console) -> str:
     console.print(
         f"{engine['candidates_evaluated']} candidates planned, {engine['screened']} screened, "
         f"{engine['wall_time_s']:.1f} s on {engine['workers']} worker(s) "
-        f"({engine['scheduler']}); wrote {out}/placement.json, placed.yaml, placement.html",
+        f"({engine['scheduler']}); wrote into {out}: {wrote}",
         highlight=False,
         markup=False,
     )

@@ -11,13 +11,23 @@ import argparse
 import math
 from pathlib import Path
 
+from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
+
 EXIT_BAD_INPUT = 2
 MAX_MESSAGE_CHARS = 500  # one stderr line, however long the cause's text
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``error: <message> (see offline-prog <cmd> --help)``
-    and exit code 2, instead of the usage block."""
+    and exit code 2, instead of the usage block; ``--debug`` is taken before or after
+    any (sub)command (every internal error says "rerun with --debug")."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # SUPPRESS: a subcommand without the flag leaves the value parsed before it.
+        self.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks"
+        )
 
     def error(self, message: str):
         self.exit(EXIT_BAD_INPUT, f"error: {one_line(message)} (see {self.prog} --help)\n")
@@ -32,17 +42,20 @@ def one_line(message: str) -> str:
 def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
     """An argparse type: a finite ``kind`` (float or int) above ``low`` (or equal to it
     when inclusive), at most ``high``; ArgumentTypeError otherwise."""
+    noun = "an integer" if kind is int else "a number"
+    show = (lambda v: f"{int(v)}") if kind is int else (lambda v: f"{v:g}")
 
     def parse(text: str):
         try:
             value = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a {kind.__name__}") from None
+            raise argparse.ArgumentTypeError(f"{text!r} is not {noun}") from None
         if not (math.isfinite(value) and low <= value <= high) or (value == low and not inclusive):
-            bound = (f">= {low:g}" if inclusive else f"> {low:g}") + (
-                f" and <= {high:g}" if high < math.inf else ""
+            bound = (f">= {show(low)}" if inclusive else f"> {show(low)}") + (
+                f" and <= {show(high)}" if high < math.inf else ""
             )
-            raise argparse.ArgumentTypeError(f"{text!r}: need a finite number {bound}")
+            finite = noun if kind is int else "a finite number"
+            raise argparse.ArgumentTypeError(f"{text!r}: need {finite} {bound}")
         return value
 
     parse.__name__ = kind.__name__  # argparse names the type in its messages
@@ -60,13 +73,15 @@ def parser() -> argparse.ArgumentParser:
         prog="offline-prog",
         description="Plan robot motions that carry a part past a spatially fixed tool.",
     )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    parser.set_defaults(debug=False)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     plan = commands.add_parser("plan", help="plan a cell and write the outputs")
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
     plan.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
-    )
+        "--out", type=Path, default=None,
+        help="output folder (default: out/<file stem>, e.g. out/seal_plate_kr16 for "
+        "cells/seal_plate_kr16.yaml)",
+    )  # fmt: skip
     plan.add_argument(
         "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
     )
@@ -89,7 +104,7 @@ def parser() -> argparse.ArgumentParser:
     robot_commands.add_parser("list", help="the robots in offline_prog/robots")
     matrix = robot_commands.add_parser(
         "self-collision",
-        help="sample configurations and write robots/<robot>/self_collision.yaml",
+        help="sample configurations and write the robot's self-collision matrix",
     )
     matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
     matrix.add_argument(
@@ -97,6 +112,11 @@ def parser() -> argparse.ArgumentParser:
         default=10_000, help="configurations (10000)",
     )  # fmt: skip
     matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    matrix.add_argument(
+        "--out", type=Path, default=Path("."),
+        help="file, or folder for self_collision.yaml (default: the current folder); "
+        "the planner reads the one in the robot's folder",
+    )  # fmt: skip
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
@@ -113,6 +133,12 @@ def parser() -> argparse.ArgumentParser:
         choices=["external_tcp", "flange"],
         default=None,
         help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
+    )
+    export.add_argument(
+        "--tcp-pose-convention",
+        choices=["X_TP", "X_PF"],
+        default=None,
+        help="KRL external_tcp points: the part P in the tool T (X_TP, default) or T in P (X_PF)",
     )
     export.add_argument(
         "--mode",
@@ -169,14 +195,15 @@ def _place_flags(commands) -> None:
     )
     place.add_argument("cell", type=Path, help="work-cell YAML file with a place: block")
     place.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: out/<cell name>_place)"
-    )
+        "--out", type=Path, default=None,
+        help="output folder (default: out/<file stem>_place)",
+    )  # fmt: skip
     place.add_argument(
-        "--budget", type=_number(int, low=1, inclusive=True), default=None,
+        "--budget", type=_number(int, low=1, inclusive=True, high=MAX_PLACE_BUDGET), default=None,
         help="candidates through the planning pipeline (default: place.budget)",
     )  # fmt: skip
     place.add_argument(
-        "--seed", type=_number(int, low=0, inclusive=True), default=None,
+        "--seed", type=_number(int, low=0, inclusive=True, high=MAX_PLACE_SEED), default=None,
         help="search seed (default: place.seed)",
     )  # fmt: skip
     where = place.add_mutually_exclusive_group()
