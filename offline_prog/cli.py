@@ -93,22 +93,19 @@ def _run_export(args, console: Console) -> None:
 
 
 def _serve_preview(plan, args, console: Console) -> None:
-    """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
-    from pydrake.geometry import Meshcat, MeshcatParams
-
+    """Show the plan in a MeshCat server on --host (localhost) until Ctrl-C (or --seconds)."""
     from offline_prog.plan import JobPlan
     from offline_prog.viz.job_preview import show_job
+    from offline_prog.viz.local_server import open_meshcat, url
     from offline_prog.viz.preview import near_collision_mask, show_plan
 
-    params = MeshcatParams()
-    params.port = args.port
-    meshcat = Meshcat(params)
+    meshcat = open_meshcat(args.host, args.port)
     if isinstance(plan, JobPlan):
         info = show_job(plan, meshcat)
     else:
         info = show_plan(plan, meshcat, near_collision=near_collision_mask(plan))
     console.print(
-        f"MeshCat preview at [bold]{meshcat.web_url()}[/bold] "
+        f"MeshCat preview at [bold]{url(args.host, args.port, '')}[/bold] "
         f"({info['frames']} animation frames; Ctrl-C to stop)"
     )
     seconds = getattr(args, "seconds", None)
@@ -239,6 +236,10 @@ def main(argv: list[str] | None = None) -> int:
             return fail(failed, EXIT_PLAN_FAILED) if failed else 0
         if args.command == "preview":
             args.preview, args.out = True, None
+        if args.preview:  # a taken port is known before planning
+            from offline_prog.viz.local_server import check_free
+
+            check_free(args.host, args.port)
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now

@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
+from offline_prog.viz.local_server import MAX_PORT, MIN_PORT
 
 EXIT_BAD_INPUT = 2
 MAX_MESSAGE_CHARS = 500  # one stderr line, however long the cause's text
@@ -63,7 +64,8 @@ def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
 
 
 POSITIVE = _number(float, low=0.0, inclusive=False)
-PORT = _number(int, low=1, inclusive=True, high=65535)
+PORT = _number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT)  # MeshCat aborts below 1024
+HOST_HELP = "listen on this host (default localhost; 0.0.0.0: every interface; ::1: IPv6)"
 MIN_LINE_LIMIT = 20  # the smallest program part the writers can split into
 MAX_MATRIX_SAMPLES = 10_000_000  # self-collision samples (10⁴ take ~3 s)
 
@@ -86,9 +88,11 @@ def parser() -> argparse.ArgumentParser:
         "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
     )
     plan.add_argument("--port", type=PORT, default=7000, help="MeshCat port for --preview")
+    plan.add_argument("--host", default="localhost", help=f"--preview: {HOST_HELP}")
     preview = commands.add_parser("preview", help="plan a cell and show it in MeshCat")
     preview.add_argument("cell", type=Path, help="work-cell YAML file")
     preview.add_argument("--port", type=PORT, default=7000, help="MeshCat port (default 7000)")
+    preview.add_argument("--host", default="localhost", help=HOST_HELP)
     preview.add_argument(
         "--seconds",
         type=_number(float, low=0.0, inclusive=True),
@@ -174,13 +178,11 @@ def _session_flags(commands) -> None:
     )
     session.add_argument("cell", type=Path, help="work-cell YAML file")
     session.add_argument(
-        "--port", type=_number(int, low=1, inclusive=True, high=65534), default=7000,
+        "--port", type=_number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT - 1),
+        default=7000,
         help="panel port (default 7000); MeshCat uses the next one",
     )  # fmt: skip
-    session.add_argument(
-        "--host", default="localhost",
-        help="listen on this host (default localhost; 0.0.0.0: every interface)",
-    )  # fmt: skip
+    session.add_argument("--host", default="localhost", help=HOST_HELP)
     session.add_argument("--no-browser", action="store_true", help="do not open a browser")
     session.add_argument(
         "--seconds", type=_number(float, low=0.0, inclusive=True), default=None,
