@@ -283,3 +283,51 @@ def test_trajectory_csv_flow_leads_the_output_by_the_lag(stripe):
     assert t_live == pytest.approx(t_on - LAG_S, abs=dt)
     assert t_idle == pytest.approx(t_off - LAG_S, abs=dt)
     assert np.all(ao[~live] == OFFSET_V)  # idle: the flow at zero speed
+
+
+# --- export refuses what is not this plan's program ------------------------------------
+
+
+def run_cli(argv, capsys) -> tuple[int, list[str]]:
+    from offline_prog.cli import main
+
+    capsys.readouterr()
+    code = main([str(a) for a in argv])
+    return code, capsys.readouterr().err.strip().splitlines()
+
+
+@pytest.mark.parametrize("fmt", ["urscript", "rapid"])
+def test_export_refuses_another_controllers_language(stripe, tmp_path, capsys, fmt):
+    """A KUKA plan has no UR or ABB program (it would carry KR 16 joint angles)."""
+    _, folder, _ = stripe
+    code, err = run_cli(["export", folder, "--format", fmt, "--out", tmp_path], capsys)
+    assert code == 2 and len(err) == 1, err
+    assert f"{fmt} is not the controller language" in err[0] and "kuka_kr16_2" in err[0]
+    assert not list(tmp_path.glob(f"*.{'script' if fmt == 'urscript' else 'mod'}"))
+    code, _ = run_cli(["export", folder, "--format", "csv", "--out", tmp_path], capsys)
+    assert code == 0  # the joint files are for every robot
+
+
+def test_export_refuses_a_job_folder_without_its_job_file(stripe, tmp_path, capsys):
+    import shutil
+
+    _, folder, _ = stripe
+    broken = tmp_path / "plan"
+    shutil.copytree(folder, broken)
+    (broken / "job.npz").unlink()
+    for fmt in ("csv", "krl"):
+        code, err = run_cli(["export", broken, "--format", fmt, "--out", tmp_path / fmt], capsys)
+        assert code == 2 and len(err) == 1, err
+        assert "job.npz" in err[0] and "missing" in err[0]
+
+
+def test_export_refuses_a_foreign_plan_beside_job_npz(stripe, planned_folder, tmp_path, capsys):
+    import shutil
+
+    _, folder, _ = stripe
+    broken = tmp_path / "plan"
+    shutil.copytree(folder, broken)
+    shutil.copy(planned_folder("seal_plate_kr16")[1] / "plan.npz", broken / "plan.npz")
+    code, err = run_cli(["export", broken, "--format", "krl", "--out", tmp_path / "k"], capsys)
+    assert code == 2 and len(err) == 1, err
+    assert "job.npz: does not belong to" in err[0]
