@@ -20,9 +20,7 @@ from offline_prog.config.cell import ProcessIoConfig
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import JobSamples
 
-# A switch this close beyond the last sample of a retract is at its end: the end's own
-# row is the next link's first (its path position is not the seam's), at rest.
-POSITION_TOL_M = 1e-4
+POSITION_TOL_M = 1e-6  # a switch this close to the approach's start or retract's end
 
 
 @dataclasses.dataclass(frozen=True)
@@ -100,13 +98,14 @@ def io_columns(
     lag = settings.lag_s if flowing else 0.0
     events: list[IoEvent] = []
     for seam, (rows, t_end) in _seam_rows(samples).items():
-        path, length = samples.path_m[rows], lengths_m[seam]
+        path, t_seam = _with_retract_end(samples.path_m[rows], t[rows], t_end)
+        length = lengths_m[seam]
         if settings.digital_output is None:  # no switching: the flow runs on the seam
             gate = (0.0, length)
         else:
             gate = (-settings.on_lead_m, length - settings.off_lead_m)
             _check_gate(seam, gate, path, length)
-        times = [_time_at(position, path, t[rows], t_end) for position in gate]
+        times = [_time_at(position, path, t_seam) for position in gate]
         if settings.digital_output is not None:
             on |= (t >= times[0]) & (t < times[1])
             events += [
@@ -152,19 +151,29 @@ def _check_gate(seam: str, gate: tuple[float, float], path: np.ndarray, length: 
     if why is not None:
         raise IoPlacementError(
             "tool.process_io",
-            f"seam {seam}: on at {on * 1e3:.1f} mm and off at {off * 1e3:.1f} mm along its "
+            f"seam {seam}: on at {on * 1e3 + 0.0:.1f} mm and off at {off * 1e3 + 0.0:.1f} mm "
+            "along its "
             f"path (on.lead_mm before the start, off.lead_mm before the end): {why}",
         )
 
 
-def _time_at(position: float, path: np.ndarray, t: np.ndarray, t_end: float) -> float:
+def _with_retract_end(path: np.ndarray, t: np.ndarray, t_end: float):
+    """A seam's path positions and times with the retract's end appended: its row is
+    the next link's first (path_m NaN there), so its position continues the last two
+    samples' speed to ``t_end`` (at rest in a plan: the last position)."""
+    speed = np.diff(path[-2:]).sum() / max(np.diff(t[-2:]).sum(), 1e-12)
+    end = path[-1] + speed * (t_end - t[-1])
+    return np.append(path, end), np.append(t, t_end)
+
+
+def _time_at(position: float, path: np.ndarray, t: np.ndarray) -> float:
     """The first time [s] the tool reaches ``position`` on a seam's non-decreasing
-    path (linear between the samples around it; ``t_end`` beyond the last one)."""
+    path (linear between the samples around it)."""
     i = int(np.searchsorted(path, position, side="left"))
     if i <= 0:
         return float(t[0])
     if i >= len(path):
-        return float(t_end)
+        return float(t[-1])
     a, b = path[i - 1], path[i]
     share = 0.0 if b <= a else (position - a) / (b - a)
     return float(t[i - 1] + share * (t[i] - t[i - 1]))
