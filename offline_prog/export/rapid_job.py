@@ -54,8 +54,12 @@ from offline_prog.robot.model import load_robot
 
 LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the controller's)
 # The triggdata of each kind of event (one TriggL may hold all four).
-TRIGGERS = {(Signal.DIGITAL, True): "tOn", (Signal.DIGITAL, False): "tOff",
-            (Signal.ANALOG, True): "tFlowOn", (Signal.ANALOG, False): "tFlowOff"}  # fmt: skip
+TRIGGERS = {
+    (Signal.DIGITAL, True): "tOn",
+    (Signal.DIGITAL, False): "tOff",
+    (Signal.ANALOG, True): "tFlowOn",
+    (Signal.ANALOG, False): "tFlowOff",
+}
 
 
 def write_rapid_job(

@@ -109,20 +109,29 @@ def io_columns(
         if settings.digital_output is not None:
             on |= (t >= times[0]) & (t < times[1])
             events += [
-                IoEvent(seam, Signal.DIGITAL, settings.digital_output, state, float(state),
-                        position, time)
+                IoEvent(
+                    seam,
+                    Signal.DIGITAL,
+                    settings.digital_output,
+                    state,
+                    float(state),
+                    position,
+                    time,
+                )
                 for state, position, time in zip((True, False), gate, times, strict=True)
-            ]  # fmt: skip
+            ]
         if flowing:
             live |= (t >= times[0] - lag) & (t < times[1] - lag)
             v_on = float(np.interp(times[0], t, tcp_speed))
             values = (float(settings.flow(v_on)), settings.idle)
             events += [
-                IoEvent(seam, Signal.ANALOG, settings.analog_output, state, value, position,
-                        time - lag)
-                for state, value, position, time in zip((True, False), values, gate, times,
-                                                        strict=True)
-            ]  # fmt: skip
+                IoEvent(
+                    seam, Signal.ANALOG, settings.analog_output, state, value, position, time - lag
+                )
+                for state, value, position, time in zip(
+                    (True, False), values, gate, times, strict=True
+                )
+            ]
     digital = on.astype(np.int8) if settings.digital_output is not None else None
     analog = None
     if flowing:

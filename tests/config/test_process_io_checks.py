@@ -49,10 +49,12 @@ def test_process_io_on_a_path_cell_without_job_is_refused(capsys, tmp_path, job)
 
 @pytest.mark.parametrize(
     ("flow", "key"),
-    [("per_mps: -40.0", "tool.process_io.flow.per_mps"),
-     ("per_mps: 0.0", "tool.process_io.flow.per_mps"),
-     ("per_mps: 40.0, lag_s: -0.05", "tool.process_io.flow.lag_s")],
-)  # fmt: skip
+    [
+        ("per_mps: -40.0", "tool.process_io.flow.per_mps"),
+        ("per_mps: 0.0", "tool.process_io.flow.per_mps"),
+        ("per_mps: 40.0, lag_s: -0.05", "tool.process_io.flow.lag_s"),
+    ],
+)
 def test_flow_numbers_are_checked(capsys, tmp_path, flow, key):
     text = (CELLS / "seal_job_kr16.yaml").read_text().replace("per_mps: 40.0", flow, 1)
     code, err = run(capsys, tmp_path, text)
@@ -61,9 +63,11 @@ def test_flow_numbers_are_checked(capsys, tmp_path, flow, key):
 
 @pytest.mark.parametrize(
     ("on_lead", "off_lead", "on_mm", "off_mm"),
-    [(-100, 150, 100.0, 90.0),  # the issue's case: off before on on the stripe
-     (5, 250, -5.0, -10.0)],  # off 250 mm before the 240 mm stripe's end: on the approach
-)  # fmt: skip
+    [
+        (-100, 150, 100.0, 90.0),  # the issue's case: off before on on the stripe
+        (5, 250, -5.0, -10.0),
+    ],  # off 250 mm before the 240 mm stripe's end: on the approach
+)
 def test_off_before_on_is_refused_naming_the_seam_and_both_positions(
     capsys, tmp_path, on_lead, off_lead, on_mm, off_mm
 ):
@@ -83,8 +87,11 @@ def one_seam(length_m: float, approach_m: float, retract_m: float, speed=0.1, dt
     """JobSamples of link → approach → seam → retract → link at a constant speed, with
     path_m the signed position along the seam's path [m]."""
     pieces = [("link", np.zeros(3))]
-    for kind, a, b in (("approach", -approach_m, 0.0), ("process", 0.0, length_m),
-                       ("retract", length_m, length_m + retract_m)):  # fmt: skip
+    for kind, a, b in (
+        ("approach", -approach_m, 0.0),
+        ("process", 0.0, length_m),
+        ("retract", length_m, length_m + retract_m),
+    ):
         n = max(2, int(np.ceil((b - a) / (speed * dt))) + 1)
         pieces.append((kind, np.linspace(a, b, n)[:-1]))
     pieces.append(("link", np.full(3, np.nan)))

@@ -39,10 +39,16 @@ def stripe_cell(tmp_path, on_lead_mm=ON_LEAD_MM, off_lead_mm=OFF_LEAD_MM, lag_s=
     head, rest = text.split("seams:", 1)
     stripe = rest[rest.index("  - name: stripe") : rest.index("job:")]
     tail = rest[rest.index("job:") :]
-    head = re.sub(r"on:  \{digital_output: 1, lead_mm: 5\}",
-                  f"on:  {{digital_output: 1, lead_mm: {on_lead_mm}}}", head)  # fmt: skip
-    head = re.sub(r"off: \{digital_output: 1, lead_mm: 2\}",
-                  f"off: {{digital_output: 1, lead_mm: {off_lead_mm}}}", head)  # fmt: skip
+    head = re.sub(
+        r"on:  \{digital_output: 1, lead_mm: 5\}",
+        f"on:  {{digital_output: 1, lead_mm: {on_lead_mm}}}",
+        head,
+    )
+    head = re.sub(
+        r"off: \{digital_output: 1, lead_mm: 2\}",
+        f"off: {{digital_output: 1, lead_mm: {off_lead_mm}}}",
+        head,
+    )
     head = head.replace("min: 0.0, max: 10.0}", f"min: 0.0, max: 10.0, lag_s: {lag_s}}}")
     stripe = stripe.replace("direction: auto", "direction: forward")
     file = tmp_path / "stripe.yaml"
@@ -148,8 +154,10 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
     # The flow: its factor is live exactly between them, switched lag earlier.
     flow = [(value, position, delay) for what, value, position, delay in events if "_FK" in what]
     assert [float(v) for v, _, _ in flow] == [pytest.approx(PER_MPS / 10), 0.0]
-    assert [p for _, p, _ in flow] == [pytest.approx(on, abs=IO_TOL_M),
-                                       pytest.approx(off, abs=IO_TOL_M)]  # fmt: skip
+    assert [p for _, p, _ in flow] == [
+        pytest.approx(on, abs=IO_TOL_M),
+        pytest.approx(off, abs=IO_TOL_M),
+    ]
     assert all(delay == -LAG_S * 1e3 for _, _, delay in flow)
     # One ANOUT ON before any motion, idle until a trigger: no constant factor.
     anout = [line for line in run if line.startswith("ANOUT ON")]
@@ -208,12 +216,16 @@ def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     on, off = asked()
     out = [(v, p) for what, v, p, _ in events if what == "do1"]
     assert [v for v, _ in out] == ["1", "0"]
-    assert [p for _, p in out] == [pytest.approx(on, abs=IO_TOL_M),
-                                   pytest.approx(off, abs=IO_TOL_M)]  # fmt: skip
+    assert [p for _, p in out] == [
+        pytest.approx(on, abs=IO_TOL_M),
+        pytest.approx(off, abs=IO_TOL_M),
+    ]
     flow = [(float(v), p, lag) for what, v, p, lag in events if what == "ao1"]
     assert [v for v, _, _ in flow] == [pytest.approx(PER_MPS / 1000), 0.0]
-    assert [p for _, p, _ in flow] == [pytest.approx(on, abs=IO_TOL_M),
-                                       pytest.approx(off, abs=IO_TOL_M)]  # fmt: skip
+    assert [p for _, p, _ in flow] == [
+        pytest.approx(on, abs=IO_TOL_M),
+        pytest.approx(off, abs=IO_TOL_M),
+    ]
     assert all(lag == LAG_S for _, _, lag in flow)  # ScaleLag is the cell's lag_s
     assert "\\Start" not in text  # nothing switches at a motion's start
 
