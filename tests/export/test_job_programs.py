@@ -141,7 +141,7 @@ def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
     for module, line in run:
         if line.startswith("PTP "):
             q_link = np.deg2rad(axes[[f for f in ptp].index(main[line.split()[1]][1])])
-        elif line.startswith("TRIGGER"):
+        elif line.startswith("TRIGGER") and "DO $OUT[" in line:  # the process output
             pending = (float(re.search(r"PATH=(-?[\d.]+)", line)[1]) * 1e-3, "TRUE" in line)
         elif line.startswith("LIN "):
             name = line.split()[1]
