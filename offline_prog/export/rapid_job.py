@@ -53,7 +53,8 @@ from offline_prog.io_events import Signal
 from offline_prog.robot.model import load_robot
 
 LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the controller's)
-# The triggdata of each kind of event (one TriggL may hold all four).
+# The triggdata of each kind of event; a second one of a kind on the same move gets a
+# number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
 TRIGGERS = {
     (Signal.DIGITAL, True): "tOn",
     (Signal.DIGITAL, False): "tOff",
@@ -89,10 +90,7 @@ def write_rapid_job(
     ]
     if load is not None:
         decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
-    flow = io is not None and io.analog_output is not None
-    digital = io is not None and io.digital_output is not None
-    decls += ["VAR triggdata tOn;", "VAR triggdata tOff;"] * digital
-    decls += ["VAR triggdata tFlowOn;", "VAR triggdata tFlowOff;"] * flow
+    triggdata: set[str] = set()  # declared once the moves are written
     z = _list((zone_mm,) * 3 + (zone_mm / 10, zone_mm, zone_mm / 10), 5)[1:-1]
     decls.append(f"LOCAL CONST zonedata zPath := [FALSE,{z}];")
     main = ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * (load is not None)
@@ -124,12 +122,15 @@ def write_rapid_job(
             conf = confdata(robot, step.q[None])[0]
             decls.append(_robtarget(name, step.X_PT, conf))
             speed = speed_name(step.speed_m_s * 1e3)
-            triggers = [_trigger(s, io, main) for s in step.switches]
+            triggers = _triggers(step.switches, io, main, triggdata)
             main.append(_move(name, speed, triggers, "fine", tail))
         else:
             proc = f"seam_{seam_no}"
-            procs[proc] = _seam_moves(step, robot, decls, speed_name, tail, zone_mm, proc, io)
+            procs[proc] = _seam_moves(
+                step, robot, decls, speed_name, tail, zone_mm, proc, io, triggdata
+            )
             main.append(f"{proc};  ! seam {step.seam}")
+    decls += [f"VAR triggdata {name};" for name in sorted(triggdata)]
     header = _header(data, robot, forced)
     body = ["! " + rapid_comment(line) for line in header] + decls
     text = _module_text(module, body, {"main": main, **procs})
@@ -139,9 +140,20 @@ def write_rapid_job(
     return files
 
 
-def _trigger(switch, io, lines: list[str]) -> str:
-    """Define the trigger of one I/O event in ``lines``; returns its triggdata."""
-    name = TRIGGERS[switch.signal, switch.state]
+def _triggers(switches, io, lines: list[str], declared: set[str]) -> list[str]:
+    """Define the triggers of one move's I/O events in ``lines`` (each its own
+    triggdata, added to ``declared``); returns their names in path order."""
+    names: list[str] = []
+    for switch in switches:
+        base = TRIGGERS[switch.signal, switch.state]
+        count = sum(name.rstrip("0123456789") == base for name in names)
+        names.append(_trigger(switch, io, lines, base + (str(count + 1) if count else "")))
+    declared.update(names)
+    return names
+
+
+def _trigger(switch, io, lines: list[str], name: str) -> str:
+    """Define the trigger ``name`` of one I/O event in ``lines``; returns its name."""
     distance = _num(switch.before_end_m * 1e3, 3)
     if switch.signal is Signal.DIGITAL:
         lines.append(f"TriggIO {name}, {distance}\\DOp:=do{switch.output}, {int(switch.state)};")
@@ -158,7 +170,9 @@ def _move(target: str, speed: str, triggers: list[str], zone: str, tail: str) ->
     return f"TriggL {target}, {speed}, {triggers[0]}{extra}, {zone}{tail}"
 
 
-def _seam_moves(step: Process, robot, decls, speed_name, tail, zone_mm, proc, io) -> list[str]:
+def _seam_moves(
+    step: Process, robot, decls, speed_name, tail, zone_mm, proc, io, triggdata: set[str]
+) -> list[str]:
     """The seam's moves; its first point is the approach's end (declared there)."""
     data, idx = step.data, step.indices
     conf = confdata(robot, data.q[idx])
@@ -168,7 +182,7 @@ def _seam_moves(step: Process, robot, decls, speed_name, tail, zone_mm, proc, io
         name = f"{proc}_{m}"
         decls.append(_robtarget(name, data.X_PF[idx[m]], conf[m]))
         zone = "fine" if m == len(idx) - 1 or zone_mm == 0 else "zPath"
-        triggers = [_trigger(s, io, lines) for s in step.switches_before(m)]
+        triggers = _triggers(step.switches_before(m), io, lines, triggdata)
         lines.append(_move(name, speed_name(speeds[m - 1]), triggers, zone, tail))
     return lines
 

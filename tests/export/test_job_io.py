@@ -9,16 +9,22 @@ numbers computed here from the cell's ``lead_mm``, ``lag_s`` and the seam's ends
 """
 
 import csv
+import dataclasses
 import re
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from offline_prog.config.cell import load_cell
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.krl_job import write_krl_job
 from offline_prog.export.rapid_job import write_rapid_job
 from offline_prog.export.urscript_job import write_urscript_job
+from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 from offline_prog.robot.model import load_robot
@@ -202,7 +208,7 @@ def rapid_events(data, text):
             here = tool_in_part(data, joints[m[1]])
         elif m := re.match(r"(MoveL|TriggL) (\w+)", line):
             target = points[m[2]]
-            for name in re.findall(r"\b(tOn|tOff|tFlowOn|tFlowOff)\b", line):
+            for name in re.findall(r"\b(t(?:Flow)?O(?:n|ff)\d*)\b", line):
                 what, value, d, lag = defined[name]
                 events.append((what, value, along(point_before(here, target, d)), lag))
             here = target
@@ -343,3 +349,34 @@ def test_export_refuses_a_foreign_plan_beside_job_npz(stripe, planned_folder, tm
     code, err = run_cli(["export", broken, "--format", "krl", "--out", tmp_path / "k"], capsys)
     assert code == 2 and len(err) == 1, err
     assert "job.npz: does not belong to" in err[0]
+
+
+# --- property: any switch positions the plan decides are where the programs switch -----
+
+
+@settings(max_examples=12, deadline=None, derandomize=True)
+@given(
+    positions_mm=st.lists(st.floats(-30.0, 270.0), min_size=2, max_size=6, unique=True)
+    .map(sorted)
+    .filter(lambda p: len(p) % 2 == 0)
+)
+def test_programs_switch_where_the_events_say(stripe, positions_mm):
+    """On/off pairs anywhere on the stripe's approach (from −30 mm), seam and retract
+    (to 270 mm), several on one motion: KRL and RAPID switch at each, in order."""
+    data, _, _ = stripe
+    events = tuple(
+        IoEvent("stripe", Signal.DIGITAL, 1, k % 2 == 0, float(k % 2 == 0), p * 1e-3, 0.0)
+        for k, p in enumerate(positions_mm)
+    )
+    data = dataclasses.replace(data, events=events)
+    expected = [(k % 2 == 0, p * 1e-3) for k, p in enumerate(positions_mm)]
+    with tempfile.TemporaryDirectory() as folder:
+        write_krl_job(data, Path(folder))
+        _, krl = krl_events(data, Path(folder))
+        text = write_rapid_job(data, Path(folder))[0].read_text()
+    got = [(value == "TRUE", p) for what, value, p, _ in krl if what == "$OUT[1]"]
+    assert [s for s, _ in got] == [s for s, _ in expected]
+    assert [p for _, p in got] == [pytest.approx(p, abs=IO_TOL_M) for _, p in expected]
+    got = [(value == "1", p) for what, value, p, _ in rapid_events(data, text) if what == "do1"]
+    assert [s for s, _ in got] == [s for s, _ in expected]
+    assert [p for _, p in got] == [pytest.approx(p, abs=IO_TOL_M) for _, p in expected]
