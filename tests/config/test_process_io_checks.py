@@ -62,18 +62,24 @@ def test_flow_numbers_are_checked(capsys, tmp_path, flow, key):
 
 
 @pytest.mark.parametrize(
-    ("on_lead", "off_lead", "on_mm", "off_mm"),
+    ("on_lead", "off_lead", "half_mm", "on_mm", "off_mm"),
     [
-        (-100, 150, 100.0, 90.0),  # the case: off before on on the stripe
-        (5, 250, -5.0, -10.0),
-    ],  # off 250 mm before the 240 mm stripe's end: on the approach
+        (-100, 150, 120, 100.0, 90.0),  # the case: off before on on the stripe
+        (5, 250, 120, -5.0, -10.0),  # off 250 mm before the 240 mm stripe's end
+        (0, 2, 0.5, 0.0, -1.0),  # a 1 mm seam with a 2 mm off lead
+    ],
 )
 def test_off_before_on_is_refused_naming_the_seam_and_both_positions(
-    capsys, tmp_path, on_lead, off_lead, on_mm, off_mm
+    capsys, tmp_path, on_lead, off_lead, half_mm, on_mm, off_mm
 ):
     from export.test_job_io import stripe_cell
 
-    code, err = run(capsys, tmp_path, stripe_cell(tmp_path, on_lead, off_lead).read_text())
+    text = stripe_cell(tmp_path, on_lead, off_lead).read_text()
+    text = text.replace(
+        "start: [-120, 80, 0], end: [120, 80, 0]",
+        f"start: [{-half_mm}, 80, 0], end: [{half_mm}, 80, 0]",
+    )
+    code, err = run(capsys, tmp_path, text)
     assert code == 2 and len(err) == 1, err
     assert "tool.process_io" in err[0] and "seam stripe" in err[0]
     assert f"on at {on_mm:.1f} mm and off at {off_mm:.1f} mm" in err[0]
