@@ -119,7 +119,8 @@ def _with_switches(steps: list, job: JobProgramData) -> list:
     out = list(steps)
     for seam, k in {name: k for k, name in enumerate(job.seam_names)}.items():
         events = sorted(
-            (e for e in job.events if e.seam == seam), key=lambda e: (e.path_m, e.signal.value)
+            (e for e in job.events if e.seam == seam),
+            key=lambda e: (e.path_m, e.signal is not Signal.DIGITAL),
         )
         if not events:
             continue

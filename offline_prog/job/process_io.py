@@ -138,7 +138,7 @@ def io_columns(
         # The command at t is the flow the tool needs lag_s later.
         value = settings.flow(np.interp(t + lag, t, tcp_speed))
         analog = np.where(live, value, settings.idle)
-    events.sort(key=lambda e: (e.t_s, e.signal.value))
+    events.sort(key=lambda e: (e.t_s, e.signal is not Signal.DIGITAL))
     return IoColumns(digital, analog, events, settings)
 
 
