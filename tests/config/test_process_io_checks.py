@@ -161,3 +161,19 @@ def test_switch_positions_are_the_cells_or_refused(
     disagree = np.flatnonzero(io.digital.astype(bool) != expected)
     assert all(min(abs(path[i] - on), abs(path[i] - off)) <= row_step for i in disagree)
     assert np.array_equal(io.analog > 0.5 + 1e-9, io.digital.astype(bool))  # lag 0
+
+
+def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
+    """No on/off: the flow is live while the seam runs; its command leads by lag_s."""
+    samples, speed = one_seam(0.1, 0.03, 0.03)
+    lag = 0.02
+    io = ProcessIoConfig(flow=AnalogFlow(analog_output=1, per_mps=40.0, offset=0.5, lag_s=lag))
+    columns = io_columns(samples, io, {"s": 0.1}, speed)
+    assert columns.digital is None and columns.switches == []
+    live_t = samples.t[columns.analog > 0.5 + 1e-9]
+    process = next(s for s in samples.segments if s.kind == "process")
+    dt = np.diff(samples.t).max()
+    assert live_t[0] == pytest.approx(process.t_start - lag, abs=dt)
+    assert live_t[-1] == pytest.approx(process.t_stop - lag, abs=dt)
+    assert columns.analog.max() == pytest.approx(0.5 + 40.0 * 0.1)
+    assert [(e.state, e.path_m) for e in columns.events] == [(True, 0.0), (False, 0.1)]
