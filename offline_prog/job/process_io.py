@@ -86,7 +86,8 @@ def io_columns(
     Raises:
         IoPlacementError: on a seam, the output goes off before it goes on, either
             switch lies outside the approach's start .. the retract's end, or the output
-            is never on while the seam runs (one line naming the seam and both positions).
+            is never on while the seam runs (one line naming the seam and both
+            positions); or the flow's lag leads its start before the approach.
     """
     settings = process_io_settings(io)
     if settings is None:
@@ -121,6 +122,13 @@ def io_columns(
                 for state, position, time in zip((True, False), gate, times, strict=True)
             ]
         if flowing:
+            if times[0] - lag < t_seam[0] - 1e-9:  # a program sets it on the approach
+                raise IoPlacementError(
+                    "tool.process_io.flow.lag_s",
+                    f"{lag:g} s before seam {seam}'s output goes on is before its approach "
+                    f"starts ({times[0] - t_seam[0]:.3f} s earlier): a longer approach or "
+                    "on.lead_mm leaves the flow room to lead",
+                )
             live |= (t >= times[0] - lag) & (t < times[1] - lag)
             v_on = float(np.interp(times[0], t, tcp_speed))
             values = (float(settings.flow(v_on)), settings.idle)

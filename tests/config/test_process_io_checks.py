@@ -177,3 +177,11 @@ def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
     assert live_t[-1] == pytest.approx(process.t_stop - lag, abs=dt)
     assert columns.analog.max() == pytest.approx(0.5 + 40.0 * 0.1)
     assert [(e.state, e.path_m) for e in columns.events] == [(True, 0.0), (False, 0.1)]
+
+
+def test_a_lag_that_leads_before_the_approach_is_refused():
+    """The on switch is 25 mm into the 30 mm approach: 0.25 s at 0.1 m/s to lead in."""
+    samples, speed = one_seam(0.1, 0.03, 0.03)
+    with pytest.raises(IoPlacementError, match=r"flow.lag_s: 0.5 s before seam s's output"):
+        io_columns(samples, io_config(5.0, 2.0, lag_s=0.5), {"s": 0.1}, speed)
+    io_columns(samples, io_config(5.0, 2.0, lag_s=0.2), {"s": 0.1}, speed)  # 20 of 25 mm
