@@ -47,6 +47,9 @@ class IoEvent:
             (for the flow: where the dispensed flow starts or stops, the gate).
         t_s: job time at which the controller sets the output [s] (for the flow,
             ``lag_s`` before the tool passes ``path_m``).
+        set_path_m: where the tool is at ``t_s`` [m] (``path_m`` for the digital
+            output; for the flow, where a controller without its own lag
+            compensation sets it).
     """
 
     seam: str
@@ -56,6 +59,7 @@ class IoEvent:
     value: float
     path_m: float
     t_s: float
+    set_path_m: float
 
     def as_dict(self) -> dict:
         """JSON-ready (``signal`` as its value)."""

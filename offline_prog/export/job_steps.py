@@ -87,8 +87,13 @@ def job_steps(
     *,
     style: str = "external_tcp",
     convention: str = "X_TP",
+    flow_where_set: bool = False,
 ) -> list[JointMove | LinearMove | Process]:
-    """The job's motion statements in run order, with the plan's I/O events on them."""
+    """The job's motion statements in run order, with the plan's I/O events on them.
+
+    ``flow_where_set``: place the flow's events where the controller sets them
+    (``IoEvent.set_path_m``: ``lag_s`` ahead, for a controller that does not lead by the
+    lag itself), not at their gate positions (``path_m``, RAPID's ScaleLag leads)."""
     steps, links, rows = [], iter(job.link_waypoints), job.job
     seam_index = {name: k for k, name in enumerate(job.seam_names)}
     for segment in job.segments:
@@ -111,16 +116,21 @@ def job_steps(
         steps.append(
             LinearMove(segment.kind, segment.seam, rows.X_PF[end], rows.q[end], length, speed)
         )
-    return _with_switches(steps, job)
+    return _with_switches(steps, job, flow_where_set)
 
 
-def _with_switches(steps: list, job: JobProgramData) -> list:
+def _position(event: IoEvent, flow_where_set: bool) -> float:
+    """Where along the path a program switches the event [m]."""
+    return event.set_path_m if flow_where_set else event.path_m
+
+
+def _with_switches(steps: list, job: JobProgramData, flow_where_set: bool) -> list:
     """Each seam's events placed on its approach, LIN and retract motions."""
     out = list(steps)
     for seam, k in {name: k for k, name in enumerate(job.seam_names)}.items():
         events = sorted(
             (e for e in job.events if e.seam == seam),
-            key=lambda e: (e.path_m, e.signal is not Signal.DIGITAL),
+            key=lambda e: (_position(e, flow_where_set), e.signal is not Signal.DIGITAL),
         )
         if not events:
             continue
@@ -137,8 +147,9 @@ def _with_switches(steps: list, job: JobProgramData) -> list:
         placed: dict[int, list[Switch]] = {}
         for event in events:
             # The first motion that ends at or past the position (the last one if none).
-            i, m, _, b = next((mv for mv in moves if mv[3] >= event.path_m - 1e-9), moves[-1])
-            before = max(0.0, float(b - event.path_m))
+            at = _position(event, flow_where_set)
+            i, m, _, b = next((mv for mv in moves if mv[3] >= at - 1e-9), moves[-1])
+            before = max(0.0, float(b - at))
             placed.setdefault(i, []).append(Switch(m, before, event))
         for i, switches in placed.items():
             out[i] = dataclasses.replace(out[i], switches=tuple(switches))

@@ -14,9 +14,11 @@ in path order (two on one LIN: two TRIGGERs). The flow follows the TCP speed wit
 ``ANOUT ON $ANOUT[n] = <name>_FK * $VEL_ACT + o DELAY = −lag MINIMUM = lo MAXIMUM = hi``
 at the program's start: ``$VEL_ACT`` in m/s and ``$ANOUT`` normalised to ±1 = ±10 V,
 so the factor is per_mps / 10 while the process output is on and 0 otherwise (the
-idle value o = offset / 10), switched by ``TRIGGER ... DO <name>_FK = f`` at the same
-path positions as ``$OUT[n]``, ``DELAY`` = −lag (the dispenser's ``flow.lag_s``, in
-ms there) earlier, as the ANOUT's own DELAY leads the speed.
+idle value o = offset / 10), switched by ``TRIGGER ... DO <name>_FK = f`` where the
+plan sets the flow: ``flow.lag_s`` (the dispenser's lag) before the tool reaches the
+positions of ``$OUT[n]`` (``IoEvent.set_path_m``), as the ANOUT's own ``DELAY`` leads
+the speed; no TRIGGER needs a negative DELAY, which the controller would stop at the
+motion's start.
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ def write_krl_job(
     if len(name) > 20 or not name.replace("_", "a").isalnum() or not name[0].isalpha():
         raise ValueError(f"write_krl: name {name!r} is not a KRL name of <= 20 characters")
     job, io = data.job, data.process_io
-    steps = job_steps(data, chord_tol_m, angle_tol_rad)
+    steps = job_steps(data, chord_tol_m, angle_tol_rad, flow_where_set=True)
     src, modules = [], []
     decl = []  # main .dat declarations
     q_home = steps[0].targets[0]
@@ -138,14 +140,13 @@ def _anout_on(io, factor: str) -> list[str]:
 
 def _trigger(switch, io, factor: str) -> str:
     """The TRIGGER of one I/O event: $OUT for the process output, the flow's factor
-    (``lag_s`` earlier) for the flow."""
+    for the flow (placed where the plan sets it, ``lag_s`` ahead)."""
     path = krl_num(-switch.before_end_m * 1e3, 3)
     if switch.signal is Signal.DIGITAL:
         state = "TRUE" if switch.state else "FALSE"
         return f"TRIGGER WHEN PATH={path} DELAY=0 DO $OUT[{switch.output}]={state} PRIO=-1"
     f = io.per_mps / ANALOG_FULL_SCALE_V if switch.state else 0.0
-    delay = krl_num(-io.lag_s * 1e3, 0) if io.lag_s > 0 else "0"
-    return f"TRIGGER WHEN PATH={path} DELAY={delay} DO {factor}={krl_num(f, 6)} PRIO=-1"
+    return f"TRIGGER WHEN PATH={path} DELAY=0 DO {factor}={krl_num(f, 6)} PRIO=-1"
 
 
 def _seam_module(

@@ -118,6 +118,7 @@ def io_columns(
                     float(state),
                     position,
                     time,
+                    position,
                 )
                 for state, position, time in zip((True, False), gate, times, strict=True)
             ]
@@ -134,7 +135,14 @@ def io_columns(
             values = (float(settings.flow(v_on)), settings.idle)
             events += [
                 IoEvent(
-                    seam, Signal.ANALOG, settings.analog_output, state, value, position, time - lag
+                    seam,
+                    Signal.ANALOG,
+                    settings.analog_output,
+                    state,
+                    value,
+                    position,
+                    time - lag,
+                    float(np.interp(time - lag, t_seam, path)),
                 )
                 for state, value, position, time in zip(
                     (True, False), values, gate, times, strict=True

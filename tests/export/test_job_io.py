@@ -157,14 +157,14 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
     # Both fall on the stripe's own LIN(s): the seam module holds both TRIGGERs.
     module = next(f for f in files if f.name == "offline_prog_1.src").read_text()
     assert len(re.findall(r"^TRIGGER .* DO \$OUT\[1\]", module, re.M)) == 2
-    # The flow: its factor is live exactly between them, switched lag earlier.
+    # The flow: its factor is live between them, switched lag_s earlier: at v · lag_s
+    # before the on switch (the stripe runs at its speed there), and at most that much
+    # before the off switch (the tool slows down to the stripe's end).
     flow = [(value, position, delay) for what, value, position, delay in events if "_FK" in what]
     assert [float(v) for v, _, _ in flow] == [pytest.approx(PER_MPS / 10), 0.0]
-    assert [p for _, p, _ in flow] == [
-        pytest.approx(on, abs=IO_TOL_M),
-        pytest.approx(off, abs=IO_TOL_M),
-    ]
-    assert all(delay == -LAG_S * 1e3 for _, _, delay in flow)
+    assert flow[0][1] == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
+    assert off - SPEED_M_S * LAG_S - IO_TOL_M <= flow[1][1] < off
+    assert all(delay == 0 for _, _, delay in flow)  # no negative DELAY to be clamped
     # One ANOUT ON before any motion, idle until a trigger: no constant factor.
     anout = [line for line in run if line.startswith("ANOUT ON")]
     assert len(anout) == 1 and run.index(anout[0]) < run.index("PTP XHOME")
@@ -365,7 +365,7 @@ def test_programs_switch_where_the_events_say(stripe, positions_mm):
     (to 270 mm), several on one motion: KRL and RAPID switch at each, in order."""
     data, _, _ = stripe
     events = tuple(
-        IoEvent("stripe", Signal.DIGITAL, 1, k % 2 == 0, float(k % 2 == 0), p * 1e-3, 0.0)
+        IoEvent("stripe", Signal.DIGITAL, 1, k % 2 == 0, float(k % 2 == 0), p * 1e-3, 0.0, p * 1e-3)
         for k, p in enumerate(positions_mm)
     )
     data = dataclasses.replace(data, events=events)
