@@ -59,13 +59,16 @@ class DigitalSwitch:
 @dataclasses.dataclass
 class AnalogFlow:
     """An analog output following the TCP speed: value = offset + per_mps · v_TCP,
-    clipped to [min, max] (the controller's unit, e.g. volts)."""
+    clipped to [min, max] (the controller's unit, e.g. volts), while the digital output
+    is on; at rest (offset clipped to [min, max]) otherwise. ``lag_s``: the dispenser's
+    lag [s], by which the command leads the tool."""
 
     analog_output: int = required()
     per_mps: float = required()
     offset: float = 0.0
     min: float = 0.0
     max: float = 10.0
+    lag_s: float = 0.0
 
 
 @dataclasses.dataclass

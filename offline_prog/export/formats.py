@@ -20,6 +20,9 @@ from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
 FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
+# A controller's own language: only for a plan of that controller's robot (the joint
+# CSV and ROS JSON are for every robot).
+CONTROLLER_FORMATS = ("krl", "rapid", "urscript")
 PROGRAMS_DIR = "programs"
 
 
@@ -58,7 +61,7 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    if fmt in ("krl", "rapid") and fmt != data.language:  # (a job's language is its robot's)
+    if fmt in CONTROLLER_FORMATS and fmt != data.language:  # (a job's is its robot's)
         raise ValueError(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"

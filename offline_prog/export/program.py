@@ -92,6 +92,8 @@ class ProgramData:
     time_law: str = "sin2"
     sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
     X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
+    # These rows are a whole job's (job.npz beside them holds its segments and I/O).
+    whole_job: bool = False
 
     def controller_column(self, col: dict, prefix: str, j: int) -> np.ndarray:
         """Column ``<prefix><j+1>`` of a trajectory table as the controller counts it

@@ -54,10 +54,10 @@ NEAR_SINGULAR = {
 
 
 class JointPlanError(PlanFailedError):
-    """The robot cannot follow the path: σ [m], t [s] and why (a PlanFailure)."""
+    """The robot cannot follow the path: σ [m], t [s], why and the kind of failure."""
 
-    def __init__(self, sigma: float, t: float, reason: str):
-        super().__init__(PlanFailure(Failure.of(reason), float(sigma), float(t), reason))
+    def __init__(self, sigma: float, t: float, reason: str, kind: Failure):
+        super().__init__(PlanFailure(kind, float(sigma), float(t), reason))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -224,7 +224,7 @@ def plan_joint_trajectory(
         path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
-        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason)
+        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason, chosen.kind)
     rates = path.rates(grid, chosen.q)
     # Speed and acceleration limits hold for the controller's joints (a linear map).
     controller = JointRates(
@@ -238,6 +238,7 @@ def plan_joint_trajectory(
             sigma,
             _time_at(retiming.law, sigma),
             f"joint {kinds} limit on axis {joint + 1} ({use:.2f}× the limit) even at reduced speed",
+            Failure.JOINT_RATE_LIMIT,
         )
     trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
     sigma, sd, sdd, _ = retiming.law(trajectory.t)
@@ -256,7 +257,10 @@ def plan_joint_trajectory(
             )
         )
         raise JointPlanError(
-            float(sigma[i]), float(trajectory.t[i]), f"joint limit on axis {joint + 1}"
+            float(sigma[i]),
+            float(trajectory.t[i]),
+            f"joint limit on axis {joint + 1}",
+            Failure.JOINT_LIMIT,
         )
     steps = np.abs(np.diff(q, axis=0))
     i, j = np.unravel_index(np.argmax(steps), steps.shape)

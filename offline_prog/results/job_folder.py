@@ -21,7 +21,7 @@ from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
 from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
-from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessIo
+from offline_prog.export.job_program import JobProgramData, JobSegment
 from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.job.seams import job_config
 from offline_prog.plan import JobPlan
@@ -169,7 +169,7 @@ def job_report(job: JobPlan) -> dict:
                 "path_m": e.path_m,
                 "t_s": e.t_s,
             }
-            for e in io_.events
+            for e in io_.switches
         ],
         "seams": [{"seam": o.name, **report(o.plan)} for o in job.chosen],
         **collision_summary(job),
@@ -233,26 +233,8 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         X_BT=X_BT,
         X_EP=X_EP,
         tcp_speed=job.tcp_speed,
+        whole_job=True,
     )
-    io = cell.tool.process_io
-    process_io = None
-    if io is not None:
-        process_io = ProcessIo(
-            digital_output=None if io.on is None else io.on.digital_output,
-            on_lead_m=0.0 if io.on is None else io.on.lead_mm * 1e-3,
-            off_lead_m=0.0 if io.off is None else io.off.lead_mm * 1e-3,
-            **(
-                {}
-                if io.flow is None
-                else {
-                    "analog_output": io.flow.analog_output,
-                    "per_mps": io.flow.per_mps,
-                    "offset": io.flow.offset,
-                    "min": io.flow.min,
-                    "max": io.flow.max,
-                }
-            ),
-        )
     return JobProgramData(
         job=rows,
         segments=tuple(JobSegment(g.kind, g.seam, g.start, g.stop) for g in s.segments),
@@ -260,7 +242,8 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         seam_names=tuple(o.name for o in job.chosen),
         seam_lengths_m=tuple(o.plan.path.length for o in job.chosen),
         link_waypoints=tuple(np.asarray(link.waypoints, dtype=float) for link in job.links),
-        process_io=process_io,
+        process_io=job.io.settings,
         digital=job.io.digital,
         analog=job.io.analog,
+        events=tuple(job.io.events),
     )
