@@ -197,8 +197,8 @@ def test_every_seam_runs_once_with_one_of_its_own_options(seed, n, most, budget)
     air time, never worse than the given order nor below the lower bound."""
     rng = np.random.default_rng(seed)
     options = instance(rng, n, options=(1, most + 1))
-    result = order_job(options, rng.uniform(-1, 1, 6), qd_max=V, qdd_max=A, n_seams=n,
-                       budget=budget)  # fmt: skip
+    home = rng.uniform(-1, 1, 6)
+    result = order_job(options, home, qd_max=V, qdd_max=A, n_seams=n, budget=budget)
     seams = [options[i][0] for i in result.sequence]
     assert sorted(seams) == list(range(n))
     assert all(0 <= i < len(options) for i in result.sequence)
