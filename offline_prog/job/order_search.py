@@ -1,17 +1,19 @@
 """The seam-order search for jobs too large to solve exactly: a budgeted local search.
 
-Start: nearest-neighbour tours (by each seam pair's cheapest link) from home and from
-the first ``MAX_STARTS`` seams, and the given order; the best, options chosen exactly,
-is the starting tour. Then rounds: every 2-opt move (reverse a stretch) and or-opt move
-(move a block of 1 .. ``MAX_BLOCK`` seams) that puts a seam next to one of its
-``NEAR_SEAMS`` nearest seams (or home) is costed exactly, each order's options chosen by
-the layered shortest path (:class:`~offline_prog.job.link_costs.LinkCosts`), on the
-window where it differs from the current tour; the best move is applied. The search
-stops when no move improves, when a round gains less than ``min_improvement_s``, or
-when the next batch of moves would exceed the budget: a count of link estimates added
-up (deterministic, unlike a clock, and about proportional to the time: 10–50 million
-per second here, the fewer the shorter the windows). The starting tours are always
-costed (at most MAX_STARTS + 2 orders).
+Starts: the given order and nearest-neighbour tours (by each seam pair's cheapest link)
+from home and from the first ``MAX_STARTS`` seams, each costed with its options chosen
+exactly; descents from them, the best first. A descent runs rounds: the 2-opt moves
+(reverse a stretch) and or-opt moves (move a block of 1 .. ``MAX_BLOCK`` seams) that
+put a seam next to one of its ``NEAR_SEAMS`` nearest seams (or home) are costed
+exactly, each moved order's options chosen by the layered shortest path
+(:class:`~offline_prog.job.link_costs.LinkCosts`) on the window where it differs from
+the current tour, the shortest windows first; the best move is applied as soon as one
+gains ``min_improvement_s`` (else the best of all). A descent ends when no move
+improves or the round's gain is below ``min_improvement_s``; the search ends when the
+descents are done or the next moves would pass the budget: a count of link estimates
+added up (deterministic, unlike a clock, and about proportional to the time: 10–50
+million per second here, the fewer the shorter the windows). The starting tours are
+always costed (at most MAX_STARTS + 2 orders).
 """
 
 from __future__ import annotations
