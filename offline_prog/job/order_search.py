@@ -11,9 +11,9 @@ the current tour, the shortest windows first; the best move is applied as soon a
 gains ``min_improvement_s`` (else the best of all). A descent ends when no move
 improves or the round's gain is below ``min_improvement_s``; the search ends when the
 descents are done or the next moves would pass the budget: a count of link estimates
-added up (deterministic, unlike a clock, and about proportional to the time: 10–50
-million per second here, the fewer the shorter the windows). The starting tours are
-always costed (at most MAX_STARTS + 2 orders).
+added up, each round's bookkeeping counted alike (deterministic, unlike a clock, and
+about proportional to the time: ~20 million per second here, so the default budget
+is about a second). The starting tours are always costed (at most MAX_STARTS + 2).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 
 from offline_prog.job.link_costs import LinkCosts
 
-SEARCH_BUDGET = 20_000_000  # link estimates: ~2 s on this machine (100 seams)
+SEARCH_BUDGET = 20_000_000  # link estimates: ~1 s on this machine
 MIN_IMPROVEMENT_S = 0.005  # a round gaining less than this [s] ends the search
 NEAR_SEAMS = 8  # moves join a seam to one of its nearest seams (by the cheapest link)
 MAX_BLOCK = 3  # or-opt moves blocks of up to this many seams
@@ -90,8 +90,13 @@ def _descend(
     (else among all), from ``tour`` of air time ``current`` [s], until a stop (the
     reason in ``result.stopped``)."""
     n = costs.n
+    most = neighbours.size * (3 + 5 * MAX_BLOCK)  # moves a round can generate
     while True:
+        if result.used + _bookkeeping(costs, most) > budget:
+            result.stopped = "budget"
+            return tour, current
         moves = _moves(n, neighbours, tour)
+        result.used += _bookkeeping(costs, moves.shape[1])
         lo, length = _window(moves)
         shortest = np.argsort(_size_class(length, n), kind="stable")
         moves, lo, length = moves[:, shortest], lo[shortest], length[shortest]
@@ -123,6 +128,13 @@ def _descend(
         return tour, current
 
 
+def _bookkeeping(costs: LinkCosts, moves: int) -> int:
+    """A round's work besides costing moves, in link estimates: the current tour's
+    tables (2 (n + 1) steps) and generating and sorting its moves (about one step of
+    one window each: it takes about as long)."""
+    return (2 * (costs.n + 1) + moves) * costs.width**2
+
+
 def _tables(costs: LinkCosts, tour: np.ndarray):
     """The tour and its prefix and suffix tables (LinkCosts.forward, backward)."""
     return tour, costs.forward(tour), costs.backward(tour)
@@ -134,7 +146,7 @@ def _costed(costs, moves, lo, length, tables, result: SearchResult) -> np.ndarra
     unchanged positions: the same answer). Counts the work in ``result``."""
     times, tour = np.empty(len(lo)), tables[0]
     sizes = _size_class(length, costs.n)
-    for size in np.unique(sizes):
+    for size in np.flatnonzero(np.bincount(sizes)):  # the classes present, ascending
         chosen = np.flatnonzero(sizes == size)
         start = np.minimum(lo[chosen], costs.n + 1 - size)  # windows end inside the tour
         per_batch = max(1, BATCH_WORK // costs.window_work(1, size))
@@ -151,7 +163,7 @@ def _costed(costs, moves, lo, length, tables, result: SearchResult) -> np.ndarra
 def _by_window(n: int, length: np.ndarray) -> list[np.ndarray]:
     """Indices of the moves (sorted by window) grouped by window size class."""
     sizes = _size_class(length, n)
-    return [np.flatnonzero(sizes == size) for size in np.unique(sizes)]
+    return [np.flatnonzero(sizes == size) for size in np.flatnonzero(np.bincount(sizes))]
 
 
 def _size_class(length: np.ndarray, n: int) -> np.ndarray:
