@@ -18,6 +18,7 @@ import numpy as np
 from rich.console import Console
 
 from offline_prog.cli_flags import EXIT_BAD_INPUT, one_line, parser
+from offline_prog.cli_progress import PlanProgress
 
 EXIT_PLAN_FAILED = 1
 EXIT_INTERNAL = 3
@@ -244,11 +245,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
         is_job = job_cell(load_cell(args.cell))  # seams:, or path: with job:
-        with errors.status("planning") as status:
-            plan = (plan_job if is_job else plan_cell)(
-                args.cell, progress=lambda stage: status.update(stage)
-            )
-            status.update("writing outputs")
+        # Progress on stderr only while stdout is a terminal: logs and pipes stay clean.
+        with PlanProgress(errors, enabled=console.is_terminal) as progress:
+            plan = (plan_job if is_job else plan_cell)(args.cell, progress=progress)
+            progress("writing outputs")
             if args.command == "plan":
                 files, report = (write_job_outputs if is_job else write_outputs)(plan, out)
         if args.command == "plan":

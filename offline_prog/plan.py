@@ -279,7 +279,7 @@ def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
         return plan_seam(seam_inputs, seam_scene, StageTimer(progress))
 
     options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
-    order = stage("order", "choosing the seam order", choose_order, inputs, options, q_home)
+    order = stage("order", "ordering the seams", choose_order, inputs, options, q_home, progress)
     flat = [option for seam in options for option in seam]
     chosen = [flat[i] for i in order.sequence]
     pieces, links = stage(

@@ -101,6 +101,27 @@ def _segment_times(job: JobPlan) -> dict[str, float]:
     return total
 
 
+def order_search_report(order) -> dict:
+    """report.json ``job.order_search``: how the order (job.order.JobOrder) was found:
+    method, budget and what was used of it, rounds, why it stopped, its time, and the
+    estimated air time it reached against where it started and the lower bound [s]."""
+    search = order.search
+    return {
+        "method": search.method,
+        "budget_link_estimates": search.budget,
+        "used_link_estimates": search.used,
+        "orders_evaluated": search.orders_evaluated,
+        "rounds": search.rounds,
+        "descents": search.descents,
+        "stopped": search.stopped,
+        "min_improvement_s": search.min_improvement_s,
+        "time_s": search.time_s,
+        "air_time_s": order.air_time_s,
+        "start_air_time_s": search.start_air_time_s,
+        "lower_bound_s": search.lower_bound_s,
+    }
+
+
 def job_report(job: JobPlan) -> dict:
     """report.json of a job (SI units unless the key says otherwise)."""
     times, order = _segment_times(job), job.order
@@ -149,6 +170,7 @@ def job_report(job: JobPlan) -> dict:
             "estimated_air_time_s": order.air_time_s,
             "estimated_air_time_given_order_s": order.given_air_time_s,
             "estimated_saving_s": order.saved_s,
+            "order_search": order_search_report(order),
             "cycle_time_s": cycle,
             "process_time_s": times["process"],
             "air_time_s": cycle - times["process"],

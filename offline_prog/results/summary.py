@@ -86,6 +86,15 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         f"  order     {order} ({job['order_mode']}, {job['order_method']}; estimated "
         f"saving {job['estimated_saving_s']:.2f} s against the given order)"
     )
+    search = job["order_search"]
+    if search["method"] == "heuristic":
+        console.print(
+            f"  search    {search['rounds']} rounds, {search['used_link_estimates'] / 1e6:.1f} "
+            f"of {search['budget_link_estimates'] / 1e6:.1f} M link estimates in "
+            f"{search['time_s']:.2f} s, stopped: {search['stopped']}; estimated air "
+            f"{search['air_time_s']:.2f} s from {search['start_air_time_s']:.2f} s (no order "
+            f"below {search['lower_bound_s']:.2f} s)"
+        )
     console.print(
         f"  cycle     {job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
         f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, approach and "
@@ -106,6 +115,8 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         + ("no checked pairs" if distance is None else f"min distance {distance * 1e3:.1f} mm, ")
         + ("collision-free" if report["collision_free"] else "FAILS")
     )
+    stages = ", ".join(f"{k} {v:.1f} s" for k, v in report["timings_s"].items() if v >= 0.05)
+    console.print(f"  time      {stages}", highlight=False)
     for name, path in files.items():
         console.print(f"  {name:<9} {path}")
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
