@@ -46,28 +46,6 @@ def _export_options(args) -> dict:
     return options
 
 
-def _run_robots(args, console: Console) -> None:
-    """``robots list`` and ``robots self-collision ROBOT``."""
-    from offline_prog.errors import InputError
-    from offline_prog.robot.model import ROBOTS_DIR, list_robots, load_robot
-
-    if args.robots_command == "list":
-        for name in list_robots():
-            console.print(name)
-        return
-    from offline_prog.scene.self_collision import write_matrix
-
-    try:
-        robot = load_robot(args.robot)
-    except ValueError as error:
-        raise InputError(ROBOTS_DIR, "", str(error)) from None
-    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed)
-    for kind in ("adjacent", "always", "constant", "never", "check"):
-        names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
-        console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
-    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
-
-
 def _run_export(args, console: Console) -> None:
     from offline_prog.export.formats import export
     from offline_prog.export.job_program import JobProgramData
@@ -212,7 +190,9 @@ def main(argv: list[str] | None = None) -> int:
             _run_export(args, console)
             return 0
         if args.command == "robots":
-            _run_robots(args, console)
+            from offline_prog.cli_robots import run_robots
+
+            run_robots(args, console)
             return 0
         if args.command == "session":
             from offline_prog.session.launch import run_session

@@ -101,6 +101,10 @@ class JobProgramData:
     def language(self) -> str | None:
         return self.job.language
 
+    def load_robot(self):
+        """The job's RobotModel (ProgramData.load_robot)."""
+        return self.job.load_robot()
+
     def switch_positions(self, k: int) -> tuple[float, float] | None:
         """(on, off) positions [m] of seam k's process output along its tool path from
         its start (on: −lead, on the approach when positive), or None."""

@@ -1,0 +1,69 @@
+"""``offline-prog robots list | self-collision ROBOT | import DESCRIPTION``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rich.console import Console
+
+
+def run_robots(args, console: Console) -> None:
+    """The ``robots`` subcommands (bad input raises InputError: one line, exit 2)."""
+    from offline_prog.config.robot_search import ENV_VAR, robots_in, search_path
+    from offline_prog.errors import InputError
+    from offline_prog.robot.model import ROBOTS_DIR, load_robot
+
+    if args.robots_command == "list":
+        for name, folder, used in robots_in(search_path(ROBOTS_DIR)):
+            where = "bundled" if folder == ROBOTS_DIR else f"{ENV_VAR}: {folder}"
+            hidden = "" if used else "  (hidden by the one above)"
+            console.print(f"{name:<24} {where}{hidden}", highlight=False)
+        return
+    if args.robots_command == "import":
+        _run_import(args, console)
+        return
+    from offline_prog.scene.self_collision import write_matrix
+
+    try:
+        robot = load_robot(args.robot)
+    except ValueError as error:
+        raise InputError(ROBOTS_DIR, "", str(error)) from None
+    robots_dir = robot.urdf_path.parent.parent
+    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed, robots_dir=robots_dir)
+    for kind in ("adjacent", "always", "constant", "never", "check"):
+        names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
+        console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
+    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
+
+
+def _run_import(args, console: Console) -> None:
+    import numpy as np
+
+    from offline_prog.config.robot_search import ENV_VAR
+    from offline_prog.robot_import.run import import_robot
+
+    out = args.out or Path("robots")
+    with Console(stderr=True).status(f"importing {args.description.name}"):
+        result = import_robot(
+            args.description, name=args.name, out=out, package_paths=args.package_path or [],
+            vendor=args.vendor, base=args.base, tip=args.tip, samples=args.samples,
+            force=args.force,
+        )  # fmt: skip
+    p = result.params
+    if p is not None:
+        lengths = ", ".join(
+            f"{k} {getattr(p, k):g}" for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")
+        )
+        console.print(f"  kinematics  OPW: {lengths} m", highlight=False)
+        offsets = [round(float(v), 6) for v in np.degrees(p.offsets)]
+        console.print(f"              offsets {offsets} deg, signs {list(p.sign_corrections)}")
+        console.print(
+            f"  FK check    {result.fk.samples} configurations: max {result.fk.max_position_m:.1e} m, "
+            f"{result.fk.max_rotation_rad:.1e} rad"
+        )
+    else:
+        console.print("  kinematics  no closed form fits: Drake InverseKinematics (family drake)")
+    check = sum(pair.kind == "check" for pair in result.pairs)
+    console.print(f"  self-collision  {len(result.pairs)} link pairs, {check} checked")
+    console.print(f"wrote {result.folder} (cells: robot: {{model: {args.name}, robots_dir: {out}}} "
+                  f"or {ENV_VAR}={out.resolve()})", highlight=False)  # fmt: skip
