@@ -41,7 +41,7 @@ def _export_options(args) -> dict:
         options["style"] = args.style
     if args.mode is not None and args.format == "urscript":
         options["mode"] = args.mode
-    if args.line_limit is not None and args.format in ("krl", "rapid"):
+    if args.line_limit is not None and args.format in ("krl", "rapid", "fanuc"):
         options["line_limit"] = args.line_limit
     return options
 

@@ -101,7 +101,7 @@ def parser() -> argparse.ArgumentParser:
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
-        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
+        "--format", required=True, choices=["krl", "rapid", "urscript", "fanuc", "csv", "ros-json"]
     )
     export.add_argument(
         "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"

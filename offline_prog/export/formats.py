@@ -19,7 +19,7 @@ from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
-FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
+FORMATS = ("krl", "rapid", "urscript", "fanuc", "csv", "ros-json")
 PROGRAMS_DIR = "programs"
 
 
@@ -58,7 +58,9 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    if fmt in ("krl", "rapid") and fmt != data.language:  # (a job's language is its robot's)
+    if (
+        fmt in ("krl", "rapid", "fanuc") and fmt != data.language
+    ):  # (a job's language is its robot's)
         raise ValueError(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"
@@ -114,6 +116,10 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
         from offline_prog.export.urscript import write_urscript
 
         return [write_urscript(data, out_dir, forced=forced, **options).file]
+    if fmt == "fanuc":
+        from offline_prog.export.fanuc_ls import write_fanuc
+
+        return list(write_fanuc(data, out_dir, forced=forced, **options).files)
     if fmt == "krl":
         from offline_prog.export.krl import write_krl
 
