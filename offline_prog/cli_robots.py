@@ -58,7 +58,8 @@ def _run_import(args, console: Console) -> None:
         offsets = [round(float(v), 6) for v in np.degrees(p.offsets)]
         console.print(f"              offsets {offsets} deg, signs {list(p.sign_corrections)}")
         console.print(
-            f"  FK check    {result.fk.samples} configurations: max {result.fk.max_position_m:.1e} m, "
+            f"  FK check    {result.fk.samples} configurations: "
+            f"max {result.fk.max_position_m:.1e} m, "
             f"{result.fk.max_rotation_rad:.1e} rad"
         )
     else:

@@ -128,7 +128,8 @@ def write_fanuc(
         "Positions: flange in UFRAME[1], mm and W,P,R deg (fixed axes x, y, z).",
         "CONFIG: N/F = J5 <= 0 / > 0, U/D elbow, T/B wrist centre front/back of J1;",
         "turns of J1, J4, J6. Joint positions: FANUC axes, J3 from the horizontal",
-        f"(J3 = q3 {'+' if robot.j23_factor > 0 else '-'} q2 of the URDF, ROS-I fanuc_driver J23_factor)."
+        f"(J3 = q3 {'+' if robot.j23_factor > 0 else '-'} q2 of the URDF, "
+        "ROS-I fanuc_driver J23_factor)."
         if robot.j23_coupled
         else "(J1..J6 = the URDF joints).",
         f"Points: {len(idx)} of {len(data.t)} samples; tool point within {deviation * 1e3:.4f} mm "

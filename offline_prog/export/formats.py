@@ -32,9 +32,14 @@ def default_formats(language: str | None) -> list[str]:
     return ([language] if language else []) + ["csv", "ros-json"]
 
 
+# Controller languages with a whole-job writer (FANUC: one-seam programs only so far).
+JOB_LANGUAGES = ("krl", "rapid", "urscript")
+
+
 def job_formats(language: str | None) -> list[str]:
-    """The formats a whole job is exported in: as for one seam (default_formats)."""
-    return default_formats(language)
+    """The formats a whole job is exported in: as for one seam (default_formats), for
+    the languages that have a job writer."""
+    return default_formats(language if language in JOB_LANGUAGES else None)
 
 
 def export(
@@ -143,6 +148,8 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
     """
     if fmt == "urscript":  # servoj streams the plan: point tolerances do not apply
         options = {k: v for k, v in options.items() if k not in ("chord_tol_m", "angle_tol_rad")}
+    if fmt == "fanuc":
+        raise ValueError("fanuc: whole jobs are not written as FANUC programs yet (one seam is)")
     unknown = sorted(set(options) - _JOB_OPTIONS.get(fmt, set()))
     if unknown:
         raise ValueError(

@@ -28,7 +28,7 @@ def readme_text(
     joints = chain.revolute
     rows = "".join(
         f"| {j.name} | {np.degrees(j.lower):.3f} .. {np.degrees(j.upper):.3f} | "
-        f"{'%.3f' % np.degrees(j.velocity) if j.velocity else 'not given'} |\n"
+        f"{f'{np.degrees(j.velocity):.3f}' if j.velocity else 'not given'} |\n"
         for j in joints
     )
     counts = {
@@ -48,7 +48,8 @@ def readme_text(
         f"max position difference {fk.max_position_m:.1e} m, max rotation-matrix entry difference "
         f"{fk.max_rotation_rad:.1e} (tolerance {VERIFY_TOL_M:g}).\n"
         if params is not None
-        else "## Kinematics\n\n**No closed form.** The chain is not ortho-parallel with a spherical "
+        else "## Kinematics\n\n**No closed form.** The chain is not ortho-parallel with a "
+        "spherical "
         "wrist (or the derived parameters did not reproduce its FK"
         + (f": {fk.max_position_m:.1e} m" if fk is not None else "")
         + "), so `family: drake`: joint paths come from Drake's InverseKinematics, slower and "
@@ -80,7 +81,8 @@ def readme_text(
         + "\n"
         + "".join(f"- {note}\n" for note in notes)
         + coupling
-        + f"\n## Self-collision\n\n`self_collision.yaml`, {samples} sampled configurations, seed 0: "
+        + "\n## Self-collision\n\n"
+        + f"`self_collision.yaml`, {samples} sampled configurations, seed 0: "
         + ", ".join(f"{v} {k}" for k, v in counts.items())
         + " pairs; the planner checks the `check` pairs.\n"
     )

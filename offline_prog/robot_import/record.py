@@ -166,7 +166,8 @@ def sources_md(name: str, sources: list[MeshSource], licence: Path | None) -> st
         + rows
         + "\n## Licence\n\n"
         + (
-            f"The source package's licence is copied beside the meshes (`LICENSE`, from `{licence}`)."
+            "The source package's licence is copied beside the meshes "
+            f"(`LICENSE`, from `{licence}`)."
             if licence
             else "No licence file was found in or above the source package: check the\n"
             "package's `package.xml` before distributing these meshes."

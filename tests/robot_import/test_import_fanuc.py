@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from fanuc_reader import joints_from_config, pose, read_ls
+
 from offline_prog.errors import InputError
 from offline_prog.robot.model import load_robot
 from offline_prog.robot_import.run import import_robot
