@@ -1,18 +1,18 @@
 """FANUC TP programs as LS text (``/PROG … /ATTR … /MN … /POS … /END``) for one seam.
 
-Form: **flange-style, dense point list**. FANUC sells a Remote TCP option for a robot
-that carries the part past a fixed tool, but this writer has no FANUC document at hand
-to cite for its instructions, so it does not use it (the issue's rule: cite the source or
-write the flange form and say so). The tool frame is therefore the faceplate
-(UTOOL[1] = 0, 0, 0, 0, 0, 0: URDF tool0, z out of the flange) and every position is the
-flange pose X_BE in a user frame equal to the URDF base_link
-(UFRAME[1] = 0, 0, -c1, 0, 0, 0 in FANUC's world, see export.fanuc). The points are
-chosen on the flange path so that linear moves between them keep the fixed tool's point
-on the part within the chord tolerance: chord ≤ tol/2 of the flange and angle ≤
-tol / (2 · lever), lever = the largest distance from the flange to the tool point
-(``select_points`` on X_BE, after ``densify``). Speeds are each segment's planned mean
-flange speed [mm/sec]; CNT100 between process points, FINE at the ends. Each program
-holds at most ``line_limit`` /MN lines; longer ones call sub-programs ``NAME_2 …``.
+Form: **flange-style, dense point list** (KRL's ``flange`` style, ``export.krl_points``).
+FANUC sells a Remote TCP option for a robot that carries the part past a fixed tool, but
+this writer has no FANUC document at hand to cite for its instructions, so it does not
+use it (the issue's rule: cite the source or write the flange form and say so). The
+tool frame is the part: UTOOL[1] = X_EP (P in the faceplate = URDF tool0, z out of the
+flange), and every position is the part frame X_BP = X_BE · X_EP in a user frame equal
+to the URDF base_link (UFRAME[1] = 0, 0, -c1, 0, 0, 0 in FANUC's world, see
+export.fanuc). The controller interpolates P linearly between the points while the
+tool stays fixed, so the points are split until the tool's curve on the part also stays
+within the chord and angle tolerances (``process_points(style="flange")`` after
+``densify``). Speeds are each segment's planned mean speed of P's origin [mm/sec];
+CNT100 between process points, FINE at the ends. Each program holds at most
+``line_limit`` /MN lines; longer ones call sub-programs ``NAME_2 …``.
 """
 
 from __future__ import annotations
@@ -25,9 +25,16 @@ import numpy as np
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.densify import densify
-from offline_prog.export.density import DEFAULT_CHORD_TOL_M, select_points
-from offline_prog.export.fanuc import cartesian_pos, config_strings, fanuc_axes_deg, joint_pos
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
+from offline_prog.export.fanuc import (
+    cartesian_pos,
+    config_strings,
+    fanuc_axes_deg,
+    joint_pos,
+    wpr_deg,
+)
 from offline_prog.export.header import header_lines
+from offline_prog.export.krl_points import process_points
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import fanuc_comments, identifier
@@ -41,12 +48,13 @@ UF, UT = 1, 1
 
 @dataclasses.dataclass(frozen=True)
 class FanucResult:
-    """Files written (main program first), the plan rows behind each process point,
-    and the bound on the tool point's deviation [m]."""
+    """Files written (main program first), the (densified) plan rows behind each process
+    point, and the bounds on the tool's deviation on the part [m, rad]."""
 
     files: tuple[Path, ...]
     indices: np.ndarray
-    max_deviation_m: float
+    max_chord_m: float
+    max_angle_rad: float
 
 
 def _attr(name: str, lines: int, comment: str) -> str:
@@ -69,10 +77,11 @@ def ls_text(name: str, statements: list[str], positions: list[str], comment: str
     return _attr(name, len(statements), comment) + f"/MN\n{mn}/POS\n{pos}\n/END\n"
 
 
-def segment_speeds_mms(data: ProgramData, idx: np.ndarray) -> np.ndarray:
-    """(n-1,) mean flange speed of each segment [mm/sec], whole numbers in [1, 2000]."""
-    p = data.X_BE[idx, :3, 3]
-    dt = np.maximum(np.diff(data.t[idx]), 1e-9)
+def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """(n-1,) planned mean speed of the TCP U (origin of X_BU (N, 4, 4) [m]; times t
+    (N,) [s]) on each segment between rows idx [mm/sec], whole numbers in [1, 2000]."""
+    p = X_BU[idx, :3, 3]
+    dt = np.maximum(np.diff(t[idx]), 1e-9)
     speeds = np.linalg.norm(np.diff(p, axis=0), axis=1) / dt * 1e3
     return np.clip(np.round(speeds), 1, MAX_SPEED_MMS).astype(int)
 
@@ -83,7 +92,7 @@ def write_fanuc(
     *,
     name: str = "OFFLINE_PROG",
     chord_tol_m: float = DEFAULT_CHORD_TOL_M,
-    angle_tol_rad: float | None = None,
+    angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
     line_limit: int = DEFAULT_LINE_LIMIT,
     forced: bool = False,
 ) -> FanucResult:
@@ -91,49 +100,41 @@ def write_fanuc(
 
     Args:
         data: the plan, of an OPW robot.
-        chord_tol_m: the tool point's largest deviation from the planned path [m].
-        angle_tol_rad: a tighter bound on the flange's rotation between points (None:
-            from chord_tol_m and the lever, see the module docstring).
+        chord_tol_m, angle_tol_rad: the tool's largest deviation on the part [m, rad].
         line_limit: most /MN lines in one program.
 
     Raises:
         ValueError: naming the bad argument.
     """
     identifier(name, max_chars=NAME_MAX - 4, what="name")
-    if not chord_tol_m > 0 or line_limit < 8:
-        raise ValueError("need chord_tol_m > 0 and line_limit >= 8")
+    if not (chord_tol_m > 0 and angle_tol_rad > 0) or line_limit < 8:
+        raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0 and line_limit >= 8")
     robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: FANUC export needs an OPW robot")
-    p_BT = data.X_BT[:3, 3]
-    lever = float(np.max(np.linalg.norm(
-        np.einsum("nji,nj->ni", data.X_BE[:, :3, :3], p_BT - data.X_BE[:, :3, 3]), axis=1
-    )))  # fmt: skip
-    angle = chord_tol_m / (2.0 * max(lever, 1e-3))
-    angle = angle if angle_tol_rad is None else min(angle, angle_tol_rad)
-    dense = densify(data, chord_tol_m / 2.0, angle)
+    dense = densify(data, chord_tol_m, angle_tol_rad)
     data = dense.data
-    chord_sel, angle_sel = dense.selection_tolerances(chord_tol_m / 2.0, angle)
-    sel = select_points(data.X_BE[:, :3, 3], data.X_BE[:, :3, :3],
-                        chord_tol_m=chord_sel, angle_tol_rad=angle_sel)  # fmt: skip
-    idx = sel.indices
-    max_chord, max_angle = dense.bound(sel.max_chord_m, sel.max_angle_rad)
-    deviation = max_chord + lever * max_angle
+    tolerances = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
+    idx, chord, angle = process_points(data, "flange", *tolerances)
+    max_chord, max_angle = dense.bound(chord, angle)
+    X_BP = data.X_BE @ data.X_EP
     configs = config_strings(robot, data.q[idx])
-    speeds = segment_speeds_mms(data, idx)
+    speeds = segment_speeds_mms(data.t, X_BP, idx)
     conventions = [
         "FLANGE-STYLE PROGRAM, DENSE POINT LIST: not FANUC Remote TCP (no FANUC document",
-        "cited for it). UTOOL[1] = faceplate (0,0,0,0,0,0): URDF tool0.",
-        f"UFRAME[1] = URDF base_link = (0,0,{-robot.params.c1 * 1e3:.3f},0,0,0) mm in FANUC world.",
-        "Positions: flange in UFRAME[1], mm and W,P,R deg (fixed axes x, y, z).",
+        "cited for it). UTOOL[1] = the part frame P in the faceplate (URDF tool0):",
+        f"({_frame(data.X_EP)}).",
+        f"UFRAME[1] = URDF base_link = (0,0,{-robot.params.c1 * 1e3:.3f},0,0,0) in FANUC world.",
+        "Positions: P in UFRAME[1]; frames (X,Y,Z mm, W,P,R deg about fixed x, y, z).",
         "CONFIG: N/F = J5 <= 0 / > 0, U/D elbow, T/B wrist centre front/back of J1;",
         "turns of J1, J4, J6. Joint positions: FANUC axes, J3 from the horizontal",
         f"(J3 = q3 {'+' if robot.j23_factor > 0 else '-'} q2 of the URDF, "
         "ROS-I fanuc_driver J23_factor)."
         if robot.j23_coupled
         else "(J1..J6 = the URDF joints).",
-        f"Points: {len(idx)} of {len(data.t)} samples; tool point within {deviation * 1e3:.4f} mm "
-        f"of the plan ({dense.basis}); speeds = planned mean flange speed per segment.",
+        f"Points: {len(idx)} of {len(data.t)} samples; the tool on the part within "
+        f"{max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg of the plan ({dense.basis});",
+        "speeds = the planned mean speed of P per segment.",
     ]
     load = payload(data.payload)
     if load is not None:
@@ -155,13 +156,19 @@ def write_fanuc(
     for i in range(1, len(idx)):
         term = "FINE" if i == len(idx) - 1 else "CNT100"
         moves.append((i + 1, f"L P[{i + 1}] {speeds[i - 1]}mm/sec {term} ;"))
-        positions[i + 1] = cartesian_pos(i + 1, data.X_BE[idx[i]], configs[i], uf=UF, ut=UT)
+        positions[i + 1] = cartesian_pos(i + 1, X_BP[idx[i]], configs[i], uf=UF, ut=UT)
     texts = _split(name, remarks + start, moves, positions, line_limit)
     files = []
     for program, text in texts.items():
         files.append(Path(out_dir) / f"{program}.ls")
         write_atomic(files[-1], text)
-    return FanucResult(tuple(files), idx, deviation)
+    return FanucResult(tuple(files), idx, max_chord, max_angle)
+
+
+def _frame(X: np.ndarray) -> str:
+    """``x, y, z, w, p, r`` [mm, deg] of a 4x4 transform [m]."""
+    values = [*(X[:3, 3] * 1e3), *wpr_deg(X[:3, :3])]
+    return ", ".join(f"{v:.3f}" for v in values)
 
 
 def _split(name, head, moves, positions, line_limit) -> dict[str, str]:

@@ -132,9 +132,9 @@ def _check_program(program: Path, plan_dir: Path, robot):
     assert all(re.match(r"L P\[\d+\] \d+mm/sec (CNT100|FINE)", m) for m in moves[1:])
     start = np.radians(ls["pos"][1]["joints"])
     assert np.allclose(robot.urdf_joints(start[None])[0], data.q[0], atol=np.radians(1e-4))
-    X_plan, i = robot.forward(data.q), 0
+    X_plan, i, X_PE = robot.forward(data.q), 0, np.linalg.inv(data.X_EP)
     for k, entry in list(ls["pos"].items())[1:]:
-        X = pose(entry["xyzwpr"])
+        X = pose(entry["xyzwpr"]) @ X_PE  # the written TCP is P (UTOOL[1] = X_EP)
         q = joints_from_config(robot, X, entry["config"], entry["turns"])
         # the planned sample this point was written from (points follow the plan in
         # order): the reconstructed flange pose and joints must equal its FK and joints
