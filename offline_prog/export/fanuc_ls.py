@@ -71,8 +71,9 @@ def _attr(name: str, lines: int, comment: str) -> str:
 
 
 def ls_text(name: str, statements: list[str], positions: list[str], comment: str) -> str:
-    """A whole LS file: numbered /MN lines and the /POS entries."""
-    mn = "".join(f"{k:4d}:{s}\n" for k, s in enumerate(statements, start=1))
+    """A whole LS file: numbered /MN lines (statements without the closing `` ;``) and
+    the /POS entries."""
+    mn = "".join(f"{k:4d}:{s} ;\n" for k, s in enumerate(statements, start=1))
     pos = "\n".join(positions)
     return _attr(name, len(statements), comment) + f"/MN\n{mn}/POS\n{pos}\n/END\n"
 
@@ -120,10 +121,39 @@ def write_fanuc(
     X_BP = data.X_BE @ data.X_EP
     configs = config_strings(robot, data.q[idx])
     speeds = segment_speeds_mms(data.t, X_BP, idx)
-    conventions = [
+    conventions = frame_conventions(robot, data.X_EP) + [
+        f"Points: {len(idx)} of {len(data.t)} samples; the tool on the part within "
+        f"{max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg of the plan ({dense.basis});",
+        "speeds = the planned mean speed of P per segment.",
+    ]
+    conventions += payload_conventions(data)
+    header = header_lines(data, conventions=conventions, forced=forced)
+    start = [
+        f"  UFRAME_NUM={UF}",
+        f"  UTOOL_NUM={UT}",
+        "  PAYLOAD[1]",
+        f"J P[1] {JOINT_SPEED_PCT}% FINE",
+    ]
+    positions = {1: joint_pos(1, fanuc_axes_deg(robot, data.q[idx[:1]])[0], uf=UF, ut=UT)}
+    moves = []
+    for i in range(1, len(idx)):
+        term = "FINE" if i == len(idx) - 1 else "CNT100"
+        moves.append((i + 1, f"L P[{i + 1}] {speeds[i - 1]}mm/sec {term}"))
+        positions[i + 1] = cartesian_pos(i + 1, X_BP[idx[i]], configs[i], uf=UF, ut=UT)
+    texts = _split(name, remarks(header) + start, moves, positions, line_limit)
+    files = []
+    for program, text in texts.items():
+        files.append(Path(out_dir) / f"{program}.ls")
+        write_atomic(files[-1], text)
+    return FanucResult(tuple(files), idx, max_chord, max_angle)
+
+
+def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:
+    """Header lines: the program's form, frames, configuration and axis conventions."""
+    return [
         "FLANGE-STYLE PROGRAM, DENSE POINT LIST: not FANUC Remote TCP (no FANUC document",
         "cited for it). UTOOL[1] = the part frame P in the faceplate (URDF tool0):",
-        f"({_frame(data.X_EP)}).",
+        f"({_frame(X_EP)}).",
         f"UFRAME[1] = URDF base_link = (0,0,{-robot.params.c1 * 1e3:.3f},0,0,0) in FANUC world.",
         "Positions: P in UFRAME[1]; frames (X,Y,Z mm, W,P,R deg about fixed x, y, z).",
         "CONFIG: N/F = J5 <= 0 / > 0, U/D elbow, T/B wrist centre front/back of J1;",
@@ -132,37 +162,24 @@ def write_fanuc(
         "ROS-I fanuc_driver J23_factor)."
         if robot.j23_coupled
         else "(J1..J6 = the URDF joints).",
-        f"Points: {len(idx)} of {len(data.t)} samples; the tool on the part within "
-        f"{max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg of the plan ({dense.basis});",
-        "speeds = the planned mean speed of P per segment.",
     ]
+
+
+def payload_conventions(data: ProgramData) -> list[str]:
+    """The PAYLOAD[1] header line, when the cell gives the masses."""
     load = payload(data.payload)
-    if load is not None:
-        mass, p_EC = load.total(data.X_EP)
-        conventions.append(
-            f"PAYLOAD[1]: {mass:.3f} kg at ({', '.join(f'{v * 100:.2f}' for v in p_EC)}) cm "
-            "in the faceplate frame: set it in the payload schedule before running."
-        )
-    header = header_lines(data, conventions=conventions, forced=forced)
-    remarks = [f"  ! {piece} ;" for line in header for piece in fanuc_comments(line)]
-    start = [
-        f"  UFRAME_NUM={UF} ;",
-        f"  UTOOL_NUM={UT} ;",
-        "  PAYLOAD[1] ;",
-        f"J P[1] {JOINT_SPEED_PCT}% FINE ;",
+    if load is None:
+        return []
+    mass, p_EC = load.total(data.X_EP)
+    return [
+        f"PAYLOAD[1]: {mass:.3f} kg at ({', '.join(f'{v * 100:.2f}' for v in p_EC)}) cm "
+        "in the faceplate frame: set it in the payload schedule before running."
     ]
-    positions = {1: joint_pos(1, fanuc_axes_deg(robot, data.q[idx[:1]])[0], uf=UF, ut=UT)}
-    moves = []
-    for i in range(1, len(idx)):
-        term = "FINE" if i == len(idx) - 1 else "CNT100"
-        moves.append((i + 1, f"L P[{i + 1}] {speeds[i - 1]}mm/sec {term} ;"))
-        positions[i + 1] = cartesian_pos(i + 1, X_BP[idx[i]], configs[i], uf=UF, ut=UT)
-    texts = _split(name, remarks + start, moves, positions, line_limit)
-    files = []
-    for program, text in texts.items():
-        files.append(Path(out_dir) / f"{program}.ls")
-        write_atomic(files[-1], text)
-    return FanucResult(tuple(files), idx, max_chord, max_angle)
+
+
+def remarks(lines: list[str]) -> list[str]:
+    """TP remark statements (``! text``, at most 32 characters each) for header lines."""
+    return [f"  ! {piece}" for line in lines for piece in fanuc_comments(line)]
 
 
 def _frame(X: np.ndarray) -> str:
@@ -182,13 +199,13 @@ def _split(name, head, moves, positions, line_limit) -> dict[str, str]:
     size = line_limit - 2
     chunks = [moves[k : k + size] for k in range(0, len(moves), size)]
     subs = [f"{name}_{k}" for k in range(2, len(chunks) + 2)]
-    main_lines = head + [f"  CALL {sub} ;" for sub in subs]
+    main_lines = head + [f"  CALL {sub}" for sub in subs]
     if len(main_lines) > line_limit:
         raise ValueError(
             f"line_limit={line_limit}: the main program alone needs {len(main_lines)} lines"
         )
     texts = {name: ls_text(name, main_lines, [positions[1]], comment)}
     for sub, chunk in zip(subs, chunks, strict=True):
-        lines = [f"  UFRAME_NUM={UF} ;", f"  UTOOL_NUM={UT} ;"] + [s for _, s in chunk]
+        lines = [f"  UFRAME_NUM={UF}", f"  UTOOL_NUM={UT}"] + [s for _, s in chunk]
         texts[sub] = ls_text(sub, lines, [positions[k] for k, _ in chunk], comment)
     return texts

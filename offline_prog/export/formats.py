@@ -32,8 +32,8 @@ def default_formats(language: str | None) -> list[str]:
     return ([language] if language else []) + ["csv", "ros-json"]
 
 
-# Controller languages with a whole-job writer (FANUC: one-seam programs only so far).
-JOB_LANGUAGES = ("krl", "rapid", "urscript")
+# Controller languages with a whole-job writer.
+JOB_LANGUAGES = ("krl", "rapid", "urscript", "fanuc")
 
 
 def job_formats(language: str | None) -> list[str]:
@@ -137,7 +137,8 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
 # The options each job writer takes (the rest are one-seam options: refused by name).
 _JOB_OPTIONS = {"krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m"},
                 "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
-                "urscript": {"name", "period_s"}}  # fmt: skip
+                "urscript": {"name", "period_s"},
+                "fanuc": {"chord_tol_m", "angle_tol_rad", "name"}}  # fmt: skip
 
 
 def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
@@ -148,8 +149,6 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
     """
     if fmt == "urscript":  # servoj streams the plan: point tolerances do not apply
         options = {k: v for k, v in options.items() if k not in ("chord_tol_m", "angle_tol_rad")}
-    if fmt == "fanuc":
-        raise ValueError("fanuc: whole jobs are not written as FANUC programs yet (one seam is)")
     unknown = sorted(set(options) - _JOB_OPTIONS.get(fmt, set()))
     if unknown:
         raise ValueError(
@@ -168,6 +167,10 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
         from offline_prog.export.krl_job import write_krl_job
 
         return write_krl_job(data, out_dir, forced=not data.feasible, **options)
+    if fmt == "fanuc":
+        from offline_prog.export.fanuc_job import write_fanuc_job
+
+        return write_fanuc_job(data, out_dir, forced=not data.feasible, **options)
     if fmt == "rapid":
         from offline_prog.export.rapid_job import write_rapid_job
 
