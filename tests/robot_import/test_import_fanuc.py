@@ -180,3 +180,58 @@ def test_unknown_package_in_library_call_names_the_file(tmp_path):
     with pytest.raises(InputError, match="fanuc_m20ia_support"):
         import_robot(FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro", name="x", out=tmp_path,
                      package_paths=[tmp_path])  # fmt: skip
+
+
+def test_preview_draws_the_imported_meshes(robots, tmp_path):
+    """The preview's scene holds each link's converted visual mesh, every triangle."""
+    import trimesh
+    import umsgpack
+
+    from offline_prog.config.cell import load_cell
+    from offline_prog.scene.drake_cell import build_cell_model
+    from offline_prog.viz.preview import draw_cell
+    from offline_prog.viz.static_scene import StaticScene
+
+    out, _ = robots
+    text = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
+    text = text.replace("model: kuka_kr16_2\n", f"model: fanuc_m20ia\n  robots_dir: {out}\n")
+    (tmp_path / "cell.yaml").write_text(text)
+    robot = load_robot("fanuc_m20ia", out)
+    drake = build_cell_model(load_cell(tmp_path / "cell.yaml"), tmp_path / "cell.yaml", robot)
+    scene = StaticScene()
+    draw_cell(scene, drake)
+    drawn = {}
+    for message in scene.messages:
+        command = umsgpack.unpackb(message) if isinstance(message, bytes) else {}
+        path = command.get("path", "")
+        if command.get("type") == "set_object" and path.startswith("/drake/fanuc_m20ia/"):
+            index = command["object"]["geometries"][0]["data"]["index"]["array"].data
+            drawn[path.split("/")[3]] = len(index) // 4 // 3
+    for link in ("base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6"):
+        obj = out / "fanuc_m20ia" / "meshes" / "visual" / f"{link}.obj"
+        assert drawn[link] == len(trimesh.load(obj, force="mesh").faces), link
+
+
+def test_m10ia_on_the_search_path_plans_the_seal_demo(robots, tmp_path):
+    """The M-10iA found through OFFLINE_PROG_ROBOTS (no robots_dir in the cell) plans the
+    seal demo collision-free and exports a FANUC program that reads back as planned;
+    `robots list` names the folder it comes from."""
+    out, _ = robots
+    env = {**os.environ, "OFFLINE_PROG_ROBOTS": str(out)}
+    listing = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "robots", "list"],
+        cwd=REPO, capture_output=True, text=True, timeout=300, env=env,
+    )  # fmt: skip
+    rows = {line.split()[0]: line for line in listing.stdout.splitlines()}
+    assert f"OFFLINE_PROG_ROBOTS: {out}" in rows["fanuc_m10ia"] and "bundled" in rows["ur10e"]
+    cell = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
+    (tmp_path / "seal_m10ia.yaml").write_text(cell.replace("kuka_kr16_2", "fanuc_m10ia"))
+    run = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "plan", str(tmp_path / "seal_m10ia.yaml"),
+         "--out", str(tmp_path / "plan")],
+        cwd=REPO, capture_output=True, text=True, timeout=900, env=env,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "collision-free" in run.stdout
+    program = tmp_path / "plan" / "programs" / "OFFLINE_PROG.ls"
+    _check_program(program, tmp_path / "plan", load_robot("fanuc_m10ia", out))
