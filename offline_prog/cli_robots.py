@@ -40,7 +40,10 @@ def _run_import(args, console: Console) -> None:
     import numpy as np
 
     from offline_prog.config.robot_search import ENV_VAR
+    from offline_prog.robot_import.record import family as robot_family
     from offline_prog.robot_import.run import import_robot
+
+    OPW_KEYS = ("a1", "a2", "b", "c1", "c2", "c3", "c4")
 
     out = args.out or Path("robots")
     with Console(stderr=True).status(f"importing {args.description.name}"):
@@ -51,16 +54,15 @@ def _run_import(args, console: Console) -> None:
         )  # fmt: skip
     p = result.params
     if p is not None:
-        lengths = ", ".join(
-            f"{k} {getattr(p, k):g}" for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")
-        )
-        console.print(f"  kinematics  OPW: {lengths} m", highlight=False)
-        offsets = [round(float(v), 6) for v in np.degrees(p.offsets)]
-        console.print(f"              offsets {offsets} deg, signs {list(p.sign_corrections)}")
+        keys = ("d1", "a2", "a3", "d4", "d5", "d6") if robot_family(p) == "ur" else OPW_KEYS
+        lengths = ", ".join(f"{k} {getattr(p, k):g}" for k in keys)
+        console.print(f"  kinematics  {robot_family(p).upper()}: {lengths} m", highlight=False)
+        if robot_family(p) == "opw":
+            offsets = [round(float(v), 6) for v in np.degrees(p.offsets)]
+            console.print(f"              offsets {offsets} deg, signs {list(p.sign_corrections)}")
         console.print(
             f"  FK check    {result.fk.samples} configurations: "
-            f"max {result.fk.max_position_m:.1e} m, "
-            f"{result.fk.max_rotation_rad:.1e} rad"
+            f"max {result.fk.max_position_m:.1e} m, {result.fk.max_rotation_rad:.1e} rad"
         )
     else:
         console.print("  kinematics  no closed form fits: Drake InverseKinematics (family drake)")

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.robot.kinematics_opw import OpwParameters
+from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot_import.chain import Chain
 from offline_prog.robot_import.verify import VERIFY_TOL_M, FkCheck
 
@@ -35,26 +36,7 @@ def readme_text(
         kind: sum(p.kind == kind for p in pairs)
         for kind in ("adjacent", "always", "constant", "never", "check")
     }
-    kinematics = (
-        "## Kinematics\n\nOPW (ortho-parallel base, spherical wrist; Brandstötter et al. 2014, "
-        "opw_kinematics conventions), derived from the URDF's joint origins and axes at q = 0:\n\n"
-        + "".join(
-            f"- {k}: {getattr(params, k):g} m\n" for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")
-        )
-        + f"- offsets: {[round(float(np.degrees(o)), 6) for o in params.offsets]} deg\n"
-        f"- sign corrections: {list(params.sign_corrections)}\n\n"
-        f"Check: Drake's FK of the description (`{chain.base}` -> `{chain.tip}`) against the OPW "
-        f"model on {fk.samples} uniform configurations within the limits (seed {fk.seed}): "
-        f"max position difference {fk.max_position_m:.1e} m, max rotation-matrix entry difference "
-        f"{fk.max_rotation_rad:.1e} (tolerance {VERIFY_TOL_M:g}).\n"
-        if params is not None
-        else "## Kinematics\n\n**No closed form.** The chain is not ortho-parallel with a "
-        "spherical "
-        "wrist (or the derived parameters did not reproduce its FK"
-        + (f": {fk.max_position_m:.1e} m" if fk is not None else "")
-        + "), so `family: drake`: joint paths come from Drake's InverseKinematics, slower and "
-        "one solution per pose.\n"
-    )
+    kinematics = "## Kinematics\n\n" + _kinematics(chain, params, fk) + "\n"
     coupling = (
         f"\n## Controller axes\n\nFANUC counts J3 from the horizontal, not from the upper arm: "
         f"controller J3 = q3 + ({controller['j23_factor']}) q2 of this URDF "
@@ -85,4 +67,43 @@ def readme_text(
         + f"`self_collision.yaml`, {samples} sampled configurations, seed 0: "
         + ", ".join(f"{v} {k}" for k, v in counts.items())
         + " pairs; the planner checks the `check` pairs.\n"
+    )
+
+
+def _kinematics(chain: Chain, params, fk: FkCheck | None) -> str:
+    """The Kinematics section: the derived parameters and the FK check, or why none."""
+    if params is None:
+        return (
+            "**No closed form.** The chain is neither ortho-parallel with a spherical wrist "
+            "nor a UR-type arm in UR's conventions (or the derived parameters did not "
+            "reproduce its FK"
+            + (f": {fk.max_position_m:.1e} m" if fk is not None else "")
+            + "), so `family: drake`: joint paths come from Drake's InverseKinematics, slower "
+            "and one solution per pose.\n"
+        )
+    if isinstance(params, UrParameters):
+        text = (
+            "UR form (UR's Denavit-Hartenberg lengths, `kinematics_ur`), read off the joint "
+            "axes and fitted to the URDF's FK:\n\n"
+            + "".join(
+                f"- {k}: {getattr(params, k):g} m\n" for k in ("d1", "a2", "a3", "d4", "d5", "d6")
+            )
+        )
+    else:
+        text = (
+            "OPW (ortho-parallel base, spherical wrist; Brandstötter et al. 2014, "
+            "opw_kinematics conventions), derived from the URDF's joint origins and axes at "
+            "q = 0:\n\n"
+            + "".join(
+                f"- {k}: {getattr(params, k):g} m\n"
+                for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")
+            )
+            + f"- offsets: {[round(float(np.degrees(o)), 6) for o in params.offsets]} deg\n"
+            f"- sign corrections: {list(params.sign_corrections)}\n"
+        )
+    return text + (
+        f"\nCheck: Drake's FK of the description (`{chain.base}` -> `{chain.tip}`) against "
+        f"this model on {fk.samples} uniform configurations within the limits (seed "
+        f"{fk.seed}): max position difference {fk.max_position_m:.1e} m, max rotation-matrix "
+        f"entry difference {fk.max_rotation_rad:.1e} (tolerance {VERIFY_TOL_M:g}).\n"
     )

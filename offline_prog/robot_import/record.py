@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 
 from offline_prog.robot.kinematics_opw import OpwParameters
+from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot_import.chain import Chain
 from offline_prog.robot_import.meshes import MeshSource
 
@@ -97,10 +98,17 @@ def _deg(value: float) -> float:
     return round(float(np.degrees(value)), 6)
 
 
-def kinematics_record(params: OpwParameters | None) -> dict | None:
-    """robot.yaml ``kinematics`` of an OPW robot (None for family drake)."""
+def family(params) -> str:
+    """robot.yaml ``family`` of a derived parameter record (None: drake)."""
+    return {OpwParameters: "opw", UrParameters: "ur"}.get(type(params), "drake")
+
+
+def kinematics_record(params: OpwParameters | UrParameters | None) -> dict | None:
+    """robot.yaml ``kinematics`` of an OPW or UR robot (None for family drake)."""
     if params is None:
         return None
+    if isinstance(params, UrParameters):
+        return {k: float(getattr(params, k)) for k in ("d1", "a2", "a3", "d4", "d5", "d6")}
     record = {k: float(getattr(params, k)) for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")}
     record["offsets_deg"] = [round(float(np.degrees(o)), 9) + 0.0 for o in params.offsets]
     record["sign_corrections"] = [int(s) for s in params.sign_corrections]
@@ -111,7 +119,7 @@ def home_deg(params: OpwParameters | None, limits: dict) -> list[float]:
     """A home pose [deg, controller axes]: the description's zero with axis 5 turned
     HOME_WRIST_DEG off the wrist singularity, clipped into the limits."""
     home = np.zeros(6)
-    if params is not None:
+    if isinstance(params, OpwParameters):
         home[4] = (HOME_WRIST_DEG + np.degrees(params.offsets[4])) * params.sign_corrections[4]
     position = np.array(limits["position_deg"])
     return [round(float(v), 6) + 0.0 for v in np.clip(home, position[:, 0], position[:, 1])]
@@ -121,7 +129,7 @@ def robot_yaml(*, chain: Chain, vendor: str, params, limits, notes, controller) 
     """The text of robot.yaml (comments say where each number comes from)."""
     record = {
         "vendor": vendor,
-        "family": "opw" if params is not None else "drake",
+        "family": family(params),
         "urdf": None,
         "joint_names": [j.name for j in chain.revolute],
     }
@@ -130,8 +138,8 @@ def robot_yaml(*, chain: Chain, vendor: str, params, limits, notes, controller) 
         "# Angles at this edge are in degrees (keys say so); lengths in metres.\n"
         + "".join(f"# limits.{note}\n" for note in notes)
         + (
-            "# kinematics: OPW parameters derived from the URDF's joint origins and axes and\n"
-            "# checked against its FK (README.md).\n"
+            f"# kinematics: {family(params).upper()} parameters derived from the URDF's joint\n"
+            "# origins and axes and checked against its FK (README.md).\n"
             if params is not None
             else "# family drake: no closed-form kinematics fits this chain; joint paths come\n"
             "# from Drake's InverseKinematics (slower, one solution per pose).\n"

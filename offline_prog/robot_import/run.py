@@ -18,10 +18,12 @@ import numpy as np
 
 from offline_prog.errors import InputError
 from offline_prog.robot.kinematics_opw import OpwParameters
+from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot.model import PARAMS_FILE, RobotModel, load_robot
 from offline_prog.robot_import import record
 from offline_prog.robot_import.chain import Chain, parse_chain
 from offline_prog.robot_import.derive import axes_at_zero, derive_opw
+from offline_prog.robot_import.derive_ur import derive_ur
 from offline_prog.robot_import.meshes import convert_meshes
 from offline_prog.robot_import.readme import readme_text
 from offline_prog.robot_import.sources import description_text, find_packages
@@ -33,13 +35,13 @@ IMPORT_SAMPLES = 10_000  # self-collision samples, as the bundled robots'
 
 @dataclasses.dataclass(frozen=True)
 class ImportResult:
-    """What an import wrote: the folder, the loaded robot, the derived OPW parameters
-    (None: Drake IK), the FK check (None without a closed form) and the self-collision
+    """What an import wrote: the folder, the loaded robot, the derived OPW or UR
+    parameters (None: Drake IK), the FK check (None without a closed form) and the self-collision
     pairs."""
 
     folder: Path
     robot: RobotModel
-    params: OpwParameters | None
+    params: OpwParameters | UrParameters | None
     fk: FkCheck | None
     pairs: list
 
@@ -74,7 +76,7 @@ def import_robot(
         raise InputError(target, "--name", "folder exists (use --force to replace it)")
     packages = find_packages([Path(p) for p in package_paths] or [description.parent.parent])
     chain = parse_chain(description_text(description, packages), description, base=base, tip=tip)
-    params = derive_opw(chain)
+    params = derive_opw(chain) or derive_ur(chain)
     fk = check_fk(chain, params) if params is not None else None
     if fk is not None and not fk.ok:
         params, fk = None, fk  # keep the figures for the README; Drake IK instead

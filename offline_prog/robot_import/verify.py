@@ -14,8 +14,9 @@ import numpy as np
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from offline_prog.robot import kinematics_opw
+from offline_prog.robot import kinematics_opw, kinematics_ur
 from offline_prog.robot.kinematics_opw import OpwParameters
+from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot_import.chain import Chain
 
 VERIFY_SAMPLES = 1000
@@ -47,10 +48,14 @@ def kinematic_urdf(chain: Chain) -> str:
 
 
 def check_fk(
-    chain: Chain, params: OpwParameters, *, samples: int = VERIFY_SAMPLES, seed: int = 0
+    chain: Chain,
+    params: OpwParameters | UrParameters,
+    *,
+    samples: int = VERIFY_SAMPLES,
+    seed: int = 0,
 ) -> FkCheck:
-    """Compare Drake's FK of the description (base → tip of ``chain``) with the OPW
-    model's on ``samples`` uniform configurations within the URDF limits."""
+    """Compare Drake's FK of the description (base → tip of ``chain``) with the OPW or
+    UR model's on ``samples`` uniform configurations within the URDF limits."""
     plant = MultibodyPlant(time_step=0.0)
     (model,) = Parser(plant).AddModelsFromString(kinematic_urdf(chain), "urdf")
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(chain.base, model))
@@ -62,7 +67,8 @@ def check_fk(
     lower = np.array([j.lower for j in chain.revolute])
     upper = np.array([j.upper for j in chain.revolute])
     q = rng.uniform(lower, upper, size=(samples, 6))
-    X_opw = kinematics_opw.forward(params, q)
+    module = kinematics_ur if isinstance(params, UrParameters) else kinematics_opw
+    X_opw = module.forward(params, q)
     worst_p = worst_R = 0.0
     for k in range(samples):
         for joint, value in zip(joints, q[k], strict=True):
