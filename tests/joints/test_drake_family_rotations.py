@@ -6,10 +6,11 @@ import dataclasses
 
 import numpy as np
 
-from conftest import CELLS
 from offline_prog.joints.joint_plan import tool_rotations
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import fit_path, load_inputs
+
+from conftest import CELLS
 
 
 def test_free_rotation_of_a_drake_family_robot_is_tried_smallest_first():
