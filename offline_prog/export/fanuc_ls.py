@@ -124,7 +124,9 @@ def write_fanuc(
     conventions = frame_conventions(robot, data.X_EP) + [
         f"Points: {len(idx)} of {len(data.t)} samples; the tool on the part within "
         f"{max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg of the plan ({dense.basis});",
-        "speeds = the planned mean speed of P per segment.",
+        "speeds = the planned mean speed of P per segment. CNT100 between points, FINE at",
+        "the ends: the rounding stays between neighbouring points, which FANUC does not",
+        "bound in mm; lower --chord-tol-mm for denser points.",
     ]
     conventions += payload_conventions(data)
     header = header_lines(data, conventions=conventions, forced=forced)

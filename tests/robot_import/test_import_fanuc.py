@@ -120,6 +120,25 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
     assert "collision-free" in run.stdout
     program = plan_dir / "programs" / "OFFLINE_PROG.ls"
     _check_program(program, plan_dir, load_robot("fanuc_m20ia", out))
+    # A line limit splits the moves into called sub-programs that run the same points.
+    whole = read_ls(program)["pos"]
+    run = subprocess.run(
+        [sys.executable, "-m", "offline_prog", "export", str(plan_dir), "--format", "fanuc",
+         "--line-limit", "100", "--out", str(tmp_path / "split")],
+        cwd=REPO, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    main = read_ls(tmp_path / "split" / "OFFLINE_PROG.ls")
+    calls = [s.split()[1] for s in main["mn"] if s.startswith("CALL ")]
+    assert len(calls) > 1 and len(main["mn"]) <= 100
+    points = list(main["pos"].values())
+    for sub in calls:
+        part = read_ls(tmp_path / "split" / f"{sub}.ls")
+        assert len(part["mn"]) <= 100
+        points += list(part["pos"].values())
+    assert [p.get("xyzwpr", p.get("joints")) for p in points] == [
+        p.get("xyzwpr", p.get("joints")) for p in whole.values()
+    ]
 
 
 def _check_program(program: Path, plan_dir: Path, robot):
