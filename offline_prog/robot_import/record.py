@@ -125,14 +125,26 @@ def home_deg(params: OpwParameters | None, limits: dict) -> list[float]:
     return [round(float(v), 6) + 0.0 for v in np.clip(home, position[:, 0], position[:, 1])]
 
 
-def robot_yaml(*, chain: Chain, vendor: str, params, limits, notes, controller) -> str:
+def robot_yaml(
+    *,
+    name: str,
+    chain: Chain,
+    vendor: str,
+    params,
+    limits: dict,
+    notes: list[str],
+    controller: dict,
+) -> str:
     """The text of robot.yaml (comments say where each number comes from)."""
     record = {
         "vendor": vendor,
         "family": family(params),
-        "urdf": None,
+        "urdf": f"{name}.urdf",
         "joint_names": [j.name for j in chain.revolute],
     }
+    if params is not None:
+        record["kinematics"] = kinematics_record(params)
+    record["limits"], record["controller"] = limits, controller
     header = (
         f"# Imported by `offline-prog robots import` from {chain.file}.\n"
         "# Angles at this edge are in degrees (keys say so); lengths in metres.\n"
@@ -145,11 +157,7 @@ def robot_yaml(*, chain: Chain, vendor: str, params, limits, notes, controller) 
             "# from Drake's InverseKinematics (slower, one solution per pose).\n"
         )
     )
-    return header, record
-
-
-def dump(header: str, record: dict) -> str:
-    return header + yaml.safe_dump(record, sort_keys=False, width=100)
+    return header + yaml.safe_dump(record, sort_keys=False, width=100, default_flow_style=None)
 
 
 def sources_md(name: str, sources: list[MeshSource], licence: Path | None) -> str:

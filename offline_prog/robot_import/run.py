@@ -74,12 +74,12 @@ def import_robot(
     target = Path(out) / name
     if target.exists() and not force:
         raise InputError(target, "--name", "folder exists (use --force to replace it)")
-    packages = find_packages([Path(p) for p in package_paths] or [description.parent.parent])
+    packages = find_packages([Path(p) for p in package_paths] or [_above_package(description)])
     chain = parse_chain(description_text(description, packages), description, base=base, tip=tip)
     params = derive_opw(chain) or derive_ur(chain)
     fk = check_fk(chain, params) if params is not None else None
-    if fk is not None and not fk.ok:
-        params, fk = None, fk  # keep the figures for the README; Drake IK instead
+    if fk is not None and not fk.ok:  # the README keeps the figures; Drake IK instead
+        params = None
     Path(out).mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(dir=out, prefix=f".{name}."))
     try:
@@ -94,20 +94,11 @@ def import_robot(
         record.write_urdf(chain, files, staging, name)
         limits, notes = record.limits_record(chain)
         controller = _controller(chain, vendor, params, limits)
-        header, body = record.robot_yaml(
-            chain=chain,
-            vendor=vendor,
-            params=params,
-            limits=limits,
-            notes=notes,
+        text = record.robot_yaml(
+            name=name, chain=chain, vendor=vendor, params=params, limits=limits, notes=notes,
             controller=controller,
-        )
-        body["urdf"] = f"{name}.urdf"
-        if params is not None:
-            body["kinematics"] = record.kinematics_record(params)
-        body["limits"] = limits
-        body["controller"] = controller
-        (staging / PARAMS_FILE).write_text(record.dump(header, body))
+        )  # fmt: skip
+        (staging / PARAMS_FILE).write_text(text)
         _load_staged(staging, name)
         if target.exists():
             shutil.rmtree(target)
@@ -150,6 +141,16 @@ def _controller(chain: Chain, vendor: str, params, limits: dict) -> dict:
         controller["j23_coupled"] = True
         controller["j23_factor"] = int(np.sign(u[1] @ u[2]))
     return controller
+
+
+def _above_package(description: Path) -> Path:
+    """The folder holding the description's ROS package (the first folder up with a
+    package.xml), where its sibling packages are; else the description's folder."""
+    folder = description.resolve().parent
+    for candidate in [folder, *folder.parents]:
+        if (candidate / "package.xml").is_file():
+            return candidate.parent
+    return folder
 
 
 def _licence(description: Path, packages: dict[str, Path]) -> Path | None:

@@ -254,3 +254,11 @@ def test_m10ia_on_the_search_path_plans_the_seal_demo(robots, tmp_path):
     assert "collision-free" in run.stdout
     program = tmp_path / "plan" / "programs" / "OFFLINE_PROG.ls"
     _check_program(program, tmp_path / "plan", load_robot("fanuc_m10ia", out))
+
+
+def test_default_package_path_is_the_folder_holding_the_package(tmp_path):
+    """Without --package-path, the packages beside the description's own are found
+    (fanuc_resources next to fanuc_m10ia_support)."""
+    result = import_robot(FANUC / "fanuc_m10ia_support/urdf/m10ia.xacro", name="m10ia",
+                          out=tmp_path, vendor="fanuc", samples=20)  # fmt: skip
+    assert result.params.c3 == pytest.approx(0.64) and result.fk.ok
