@@ -120,6 +120,10 @@ def parse_chain(text: str, file: Path, *, base: str = "base_link", tip: str = "t
             raise InputError(
                 file, key, f"no link named {name!r} (links: {', '.join(sorted(links))})"
             )
+    for joint in root.findall("joint"):
+        for tag in ("parent", "child"):
+            if joint.find(tag) is None or not joint.find(tag).get("link"):
+                raise InputError(file, f"joint {joint.get('name')}", f"needs <{tag} link=...>")
     by_child = {j.find("child").get("link"): j for j in root.findall("joint")}
     path: list[ET.Element] = []
     link = tip
