@@ -28,6 +28,7 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.fanuc import cartesian_pos, config_strings, fanuc_axes_deg, joint_pos
 from offline_prog.export.fanuc_ls import (
+    DEFAULT_LINE_LIMIT,
     JOINT_SPEED_PCT,
     NAME_MAX,
     UF,
@@ -80,10 +81,15 @@ def write_fanuc_job(
     name: str = "OFFLINE_PROG",
     chord_tol_m: float = DEFAULT_CHORD_TOL_M,
     angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
+    line_limit: int = DEFAULT_LINE_LIMIT,
     forced: bool = False,
 ) -> list[Path]:
-    """Write ``<name>.ls`` and one ``<name>_S<k>.ls`` per seam; returns the files."""
-    identifier(name, max_chars=NAME_MAX - 4, what="name")
+    """Write ``<name>.ls`` and one ``<name>_S<k>.ls`` per seam (``<name>_S<k>_<j>.ls``,
+    called in turn, where a seam's moves exceed ``line_limit`` lines); returns the files.
+    """
+    identifier(name, max_chars=NAME_MAX - 8, what="name")
+    if line_limit < 8:
+        raise ValueError(f"line_limit={line_limit}: need at least 8 lines per program")
     robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: FANUC export needs an OPW robot")
@@ -104,12 +110,15 @@ def write_fanuc_job(
             speed = max(1, int(round(step.speed_m_s * 1e3)))
             main.linear(X_BP, config_strings(robot, step.q[None])[0], speed, "FINE", option)
         else:
-            sub = _Program(f"{name}_S{seam_no}")
-            _seam(sub, step, robot, io if flow else None)
-            seams.append(sub)
-            main.lines.append(f"  CALL {sub.name}")
+            parts = _seam(f"{name}_S{seam_no}", step, robot, io if flow else None, line_limit)
+            seams += parts
+            main.lines += [f"  CALL {part.name}" for part in parts]
     header = header_lines(job, conventions=_conventions(data, robot), forced=forced)
     main.lines[2:2] = remarks(header)
+    if len(main.lines) > line_limit:
+        raise ValueError(
+            f"line_limit={line_limit}: the main program alone needs {len(main.lines)} lines"
+        )
     files = []
     for program in [main, *seams]:
         files.append(Path(out_dir) / f"{program.name}.ls")
@@ -117,14 +126,19 @@ def write_fanuc_job(
     return files
 
 
-def _seam(sub: _Program, step: Process, robot, io) -> None:
-    """The seam's L moves from its first point (the approach's end) on."""
+def _seam(name: str, step: Process, robot, io, line_limit: int) -> list[_Program]:
+    """The seam's L moves from its first point (the approach's end) on, in programs of
+    at most line_limit lines (``name``, or ``name_1``, ``name_2`` ... called in turn)."""
+    parts = [_Program(name)]
     data, idx = step.data, step.indices
     X_BP = data.X_BE @ data.X_EP
     configs = config_strings(robot, data.q[idx])
     speeds = segment_speeds_mms(data.t, X_BP, idx)
     by_move = {s.move: s for s in step.switches}
     for m in range(1, len(idx)):
+        if len(parts[-1].lines) + 3 > line_limit:  # AO, the move, and a closing AO
+            parts.append(_Program(f"{name}_{len(parts) + 1}"))
+        sub = parts[-1]
         if io is not None:
             a, b = idx[m - 1], idx[m]
             v = np.trapezoid(data.tcp_speed[a : b + 1], data.t[a : b + 1]) / max(
@@ -136,7 +150,10 @@ def _seam(sub: _Program, step: Process, robot, io) -> None:
         option = _db(by_move[m]) if m in by_move else ""
         sub.linear(X_BP[idx[m]], configs[m], int(speeds[m - 1]), term, option)
     if io is not None:
-        sub.lines.append(f"  AO[{io.analog_output}]=0")
+        parts[-1].lines.append(f"  AO[{io.analog_output}]=0")
+    if len(parts) > 1:
+        parts[0].name = f"{name}_1"
+    return parts
 
 
 def _conventions(data: JobProgramData, robot) -> list[str]:

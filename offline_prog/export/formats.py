@@ -138,7 +138,7 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
 _JOB_OPTIONS = {"krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m"},
                 "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
                 "urscript": {"name", "period_s"},
-                "fanuc": {"chord_tol_m", "angle_tol_rad", "name"}}  # fmt: skip
+                "fanuc": {"chord_tol_m", "angle_tol_rad", "name", "line_limit"}}  # fmt: skip
 
 
 def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:

@@ -60,8 +60,18 @@ def _run(folder, name="OFFLINE_PROG"):
     return out
 
 
-def test_fanuc_job_links_poses_and_io(fanuc_job):
+def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
     data, folder, robot = fanuc_job
+    _check_job(data, folder, robot)
+    # With a line limit each seam runs as called parts that switch at the same places.
+    from offline_prog.export.formats import export
+
+    files = export(data, "fanuc", tmp_path, line_limit=100)
+    assert len(files) > 2 and all(len(read_ls(f)["mn"]) <= 100 for f in files)
+    _check_job(data, tmp_path, robot)
+
+
+def _check_job(data, folder, robot):
     run = _run(folder)
     joints = [np.radians(e["joints"]) for s, e in run if s.startswith("J ")]
     planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
