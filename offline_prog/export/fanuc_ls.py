@@ -11,7 +11,9 @@ export.fanuc). The controller interpolates P linearly between the points while t
 tool stays fixed, so the points are split until the tool's curve on the part also stays
 within the chord and angle tolerances (``process_points(style="flange")`` after
 ``densify``). Speeds are each segment's planned mean speed of P's origin [mm/sec];
-CNT100 between process points, FINE at the ends. Each program holds at most
+CNT100 between process points, FINE at the ends. As the RAPID writer: ``J`` (joint
+represented) to the approach pose, ``approach_m`` off the surface along -y of F, ``L``
+onto the first point and ``L`` back off after the last. Each program holds at most
 ``line_limit`` /MN lines; longer ones call sub-programs ``NAME_2 …``.
 """
 
@@ -37,11 +39,13 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.krl_points import process_points
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
+from offline_prog.export.rapid import DEFAULT_APPROACH_M, approach_and_retract
 from offline_prog.export.text import fanuc_comments, identifier
 
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
 DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
 JOINT_SPEED_PCT = 20  # J moves to the start
+APPROACH_SPEED_MMS = 20  # L moves onto and off the surface
 MAX_SPEED_MMS = 2000  # FANUC L moves take at most 2000 mm/sec
 UF, UT = 1, 1
 
@@ -95,6 +99,7 @@ def write_fanuc(
     chord_tol_m: float = DEFAULT_CHORD_TOL_M,
     angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
     line_limit: int = DEFAULT_LINE_LIMIT,
+    approach_m: float = DEFAULT_APPROACH_M,
     forced: bool = False,
 ) -> FanucResult:
     """Write ``<name>.ls`` (and ``<name>_<k>.ls`` sub-programs) for a one-seam plan.
@@ -103,13 +108,18 @@ def write_fanuc(
         data: the plan, of an OPW robot.
         chord_tol_m, angle_tol_rad: the tool's largest deviation on the part [m, rad].
         line_limit: most /MN lines in one program.
+        approach_m: approach / retract distance off the surface [m] (0 or out of reach:
+            none), as the RAPID writer's: J to the approach, L to the first point, and L
+            back off after the last.
 
     Raises:
         ValueError: naming the bad argument.
     """
     identifier(name, max_chars=NAME_MAX - 4, what="name")
-    if not (chord_tol_m > 0 and angle_tol_rad > 0) or line_limit < 8:
-        raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0 and line_limit >= 8")
+    if not (chord_tol_m > 0 and angle_tol_rad > 0 and approach_m >= 0) or line_limit < 8:
+        raise ValueError(
+            "need chord_tol_m > 0, angle_tol_rad > 0, approach_m >= 0 and line_limit >= 8"
+        )
     robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: FANUC export needs an OPW robot")
@@ -128,6 +138,12 @@ def write_fanuc(
         "the ends: the rounding stays between neighbouring points, which FANUC does not",
         "bound in mm; lower --chord-tol-mm for denser points.",
     ]
+    off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
+    approach = f"{approach_m * 1e3:g} mm along -y of F" if off else "none"
+    conventions.append(
+        f"Approach/retract: {approach}" + (" (OUT OF REACH)" if approach_m and not off else "")
+        + f", L at {APPROACH_SPEED_MMS} mm/sec, not collision-checked."
+    )  # fmt: skip
     conventions += payload_conventions(data)
     header = header_lines(data, conventions=conventions, forced=forced)
     start = [
@@ -136,12 +152,24 @@ def write_fanuc(
         "  PAYLOAD[1]",
         f"J P[1] {JOINT_SPEED_PCT}% FINE",
     ]
-    positions = {1: joint_pos(1, fanuc_axes_deg(robot, data.q[idx[:1]])[0], uf=UF, ut=UT)}
-    moves = []
+    q_start, targets = data.q[idx[0]], []  # (X_BP, config, statement tail) per L move
+    if off is not None:
+        q_start = off[0][1]
+        targets.append((X_BP[idx[0]], configs[0], f"{APPROACH_SPEED_MMS}mm/sec FINE"))
     for i in range(1, len(idx)):
         term = "FINE" if i == len(idx) - 1 else "CNT100"
-        moves.append((i + 1, f"L P[{i + 1}] {speeds[i - 1]}mm/sec {term}"))
-        positions[i + 1] = cartesian_pos(i + 1, X_BP[idx[i]], configs[i], uf=UF, ut=UT)
+        targets.append((X_BP[idx[i]], configs[i], f"{speeds[i - 1]}mm/sec {term}"))
+    if off is not None:
+        q_ret = off[1][1]
+        X_BP_ret = robot.forward(q_ret[None])[0] @ data.X_EP
+        targets.append(
+            (X_BP_ret, config_strings(robot, q_ret[None])[0], f"{APPROACH_SPEED_MMS}mm/sec FINE")
+        )
+    positions = {1: joint_pos(1, fanuc_axes_deg(robot, q_start[None])[0], uf=UF, ut=UT)}
+    moves = []
+    for k, (X, config, tail) in enumerate(targets, start=2):
+        moves.append((k, f"L P[{k}] {tail}"))
+        positions[k] = cartesian_pos(k, X, config, uf=UF, ut=UT)
     texts = _split(name, remarks(header) + start, moves, positions, line_limit)
     files = []
     for program, text in texts.items():

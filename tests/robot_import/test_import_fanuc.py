@@ -142,6 +142,8 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
 
 
 def _check_program(program: Path, plan_dir: Path, robot):
+    """J to the approach (20 mm off the surface), L onto the first process point, the
+    process points (each the FK of a planned sample, in order), L 20 mm back off."""
     from offline_prog.export.program import ProgramData
 
     data = ProgramData.load(plan_dir)
@@ -149,21 +151,36 @@ def _check_program(program: Path, plan_dir: Path, robot):
     moves = [s for s in ls["mn"] if s.startswith(("J ", "L "))]
     assert moves[0].startswith("J P[1]") and moves[-1].endswith("FINE")
     assert all(re.match(r"L P\[\d+\] \d+mm/sec (CNT100|FINE)", m) for m in moves[1:])
-    start = np.radians(ls["pos"][1]["joints"])
-    assert np.allclose(robot.urdf_joints(start[None])[0], data.q[0], atol=np.radians(1e-4))
-    X_plan, i, X_PE = robot.forward(data.q), 0, np.linalg.inv(data.X_EP)
-    for k, entry in list(ls["pos"].items())[1:]:
+    X_PE, p_BT = np.linalg.inv(data.X_EP), data.X_BT[:3, 3]
+
+    def tool_in_part(X_BE):  # p_PT: where the fixed tool's origin is on the part
+        X_BP = X_BE @ data.X_EP
+        return X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])
+
+    start = robot.urdf_joints(np.radians(ls["pos"][1]["joints"])[None])
+    off = np.linalg.norm(tool_in_part(robot.forward(start)[0]) - data.X_PF[0, :3, 3])
+    assert off == pytest.approx(0.020, abs=POSITION_TOL_M)
+    X_plan, i = robot.forward(data.q), 0
+    entries = list(ls["pos"].items())[1:]
+    for k, entry in entries[:-1]:
         X = pose(entry["xyzwpr"]) @ X_PE  # the written TCP is P (UTOOL[1] = X_EP)
         q = joints_from_config(robot, X, entry["config"], entry["turns"])
         # the planned sample this point was written from (points follow the plan in
         # order): the reconstructed flange pose and joints must equal its FK and joints
-        i += int(np.argmin(np.linalg.norm(X_plan[i:, :3, 3] - X[:3, 3], axis=1)))
+        # (the first one within tolerance: a closed seam ends where it starts)
+        gap = np.linalg.norm(X_plan[i:, :3, 3] - X[:3, 3], axis=1)
+        near = np.flatnonzero(gap <= POSITION_TOL_M)
+        i += int(near[0] if len(near) else np.argmin(gap))
         assert np.linalg.norm(X_plan[i, :3, 3] - X[:3, 3]) <= POSITION_TOL_M, k
         R_err = X_plan[i, :3, :3].T @ X[:3, :3]
         angle = np.degrees(np.arccos(np.clip((np.trace(R_err) - 1) / 2, -1, 1)))
         assert angle <= ANGLE_TOL_DEG, k
         assert np.abs(robot.forward(q[None])[0] - X).max() < 1e-9
         assert np.abs(q - data.q[i]).max() < np.radians(1e-3), k
+    assert np.linalg.norm(X_plan[-1, :3, 3] - X[:3, 3]) <= POSITION_TOL_M  # the plan's end
+    retract = pose(entries[-1][1]["xyzwpr"]) @ X_PE
+    off = np.linalg.norm(tool_in_part(retract) - data.X_PF[-1, :3, 3])
+    assert off == pytest.approx(0.020, abs=POSITION_TOL_M)
 
 
 @pytest.mark.parametrize(
