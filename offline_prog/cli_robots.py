@@ -22,18 +22,26 @@ def run_robots(args, console: Console) -> None:
     if args.robots_command == "import":
         _run_import(args, console)
         return
-    from offline_prog.scene.self_collision import write_matrix
+    from offline_prog.scene.self_collision import MATRIX_FILE, write_matrix
 
     try:
         robot = load_robot(args.robot)
     except ValueError as error:
         raise InputError(ROBOTS_DIR, "", str(error)) from None
-    robots_dir = robot.urdf_path.parent.parent
-    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed, robots_dir=robots_dir)
+    file = args.out / MATRIX_FILE if args.out.is_dir() else args.out
+    if file.exists() and not file.is_file():
+        raise InputError(file, "--out", "exists and is not a file")
+    pairs = write_matrix(robot, file, samples=args.samples, seed=args.seed)
     for kind in ("adjacent", "always", "constant", "never", "check"):
         names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
         console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
-    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
+    used = robot.urdf_path.parent / MATRIX_FILE
+    console.print(
+        f"wrote {file} ({args.samples} samples, seed {args.seed}). The planner reads "
+        f"{used}" + ("" if file.resolve() == used.resolve() else
+                     f"; to plan with this matrix, copy it there: cp {file} {used}"),
+        highlight=False, markup=False,
+    )  # fmt: skip
 
 
 def _run_import(args, console: Console) -> None:

@@ -28,7 +28,7 @@ from offline_prog.robot_import.meshes import convert_meshes
 from offline_prog.robot_import.readme import readme_text
 from offline_prog.robot_import.sources import description_text, find_packages
 from offline_prog.robot_import.verify import FkCheck, check_fk
-from offline_prog.scene.self_collision import write_matrix
+from offline_prog.scene.self_collision import MATRIX_FILE, write_matrix
 
 IMPORT_SAMPLES = 10_000  # self-collision samples, as the bundled robots'
 
@@ -107,7 +107,7 @@ def import_robot(
         shutil.rmtree(staging, ignore_errors=True)
         raise
     robot = load_robot(name, Path(out))
-    _, pairs = write_matrix(robot, samples=samples, seed=0, robots_dir=Path(out))
+    pairs = write_matrix(robot, target / MATRIX_FILE, samples=samples, seed=0)
     (target / "README.md").write_text(
         readme_text(name=name, chain=chain, vendor=vendor, params=params, fk=fk, notes=notes,
                     controller=controller, packages=packages, pairs=pairs, samples=samples)
