@@ -48,6 +48,13 @@ def _export_options(args) -> dict:
     return options
 
 
+def _run_robots(args, console: Console) -> None:
+    """``robots list | self-collision | import`` (offline_prog.cli_robots)."""
+    from offline_prog.cli_robots import run_robots
+
+    run_robots(args, console)
+
+
 def _run_export(args, console: Console) -> None:
     from offline_prog.export.formats import export
     from offline_prog.export.job_program import JobProgramData
@@ -192,9 +199,7 @@ def main(argv: list[str] | None = None) -> int:
             _run_export(args, console)
             return 0
         if args.command == "robots":
-            from offline_prog.cli_robots import run_robots
-
-            run_robots(args, console)
+            _run_robots(args, console)
             return 0
         if args.command == "session":
             from offline_prog.session.launch import run_session
