@@ -44,40 +44,16 @@ def _export_options(args) -> dict:
         options["tcp_pose_convention"] = args.tcp_pose_convention
     if args.mode is not None and args.format == "urscript":
         options["mode"] = args.mode
-    if args.line_limit is not None and args.format in ("krl", "rapid"):
+    if args.line_limit is not None and args.format in ("krl", "rapid", "fanuc"):
         options["line_limit"] = args.line_limit
     return options
 
 
 def _run_robots(args, console: Console) -> None:
-    """``robots list`` and ``robots self-collision ROBOT``."""
-    from offline_prog.errors import InputError
-    from offline_prog.robot.model import ROBOTS_DIR, list_robots, load_robot
+    """``robots list | self-collision | import`` (offline_prog.cli_robots)."""
+    from offline_prog.cli_robots import run_robots
 
-    if args.robots_command == "list":
-        for name in list_robots():
-            console.print(name)
-        return
-    from offline_prog.scene.self_collision import MATRIX_FILE, write_matrix
-
-    try:
-        robot = load_robot(args.robot)
-    except ValueError as error:
-        raise InputError(ROBOTS_DIR, "", str(error)) from None
-    file = args.out / MATRIX_FILE if args.out.is_dir() else args.out
-    if file.exists() and not file.is_file():
-        raise InputError(file, "--out", "exists and is not a file")
-    pairs = write_matrix(robot, file, samples=args.samples, seed=args.seed)
-    for kind in ("adjacent", "always", "constant", "never", "check"):
-        names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
-        console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
-    used = robot.urdf_path.parent / MATRIX_FILE
-    console.print(
-        f"wrote {file} ({args.samples} samples, seed {args.seed}). The planner reads "
-        f"{used}" + ("" if file.resolve() == used.resolve() else
-                     f"; to plan with this matrix, copy it there: cp {file} {used}"),
-        highlight=False, markup=False,
-    )  # fmt: skip
+    run_robots(args, console)
 
 
 def _run_export(args, console: Console) -> None:

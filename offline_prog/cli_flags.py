@@ -105,7 +105,8 @@ def parser() -> argparse.ArgumentParser:
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
     )
-    robot_commands.add_parser("list", help="the robots in offline_prog/robots")
+    robot_commands.add_parser("list", help="the robots found, and where each comes from")
+    _import_flags(robot_commands)
     matrix = robot_commands.add_parser(
         "self-collision",
         help="sample configurations and write the robot's self-collision matrix",
@@ -124,7 +125,7 @@ def parser() -> argparse.ArgumentParser:
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
-        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
+        "--format", required=True, choices=["krl", "rapid", "urscript", "fanuc", "csv", "ros-json"]
     )
     export.add_argument(
         "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"
@@ -217,3 +218,29 @@ def _place_flags(commands) -> None:
         "--scheduler", default=None,
         help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
     )  # fmt: skip
+
+
+def _import_flags(robot_commands) -> None:
+    """``robots import DESCRIPTION --name NAME ...``."""
+    imp = robot_commands.add_parser(
+        "import", help="a robot folder from a URDF or xacro (six revolute joints)"
+    )
+    imp.add_argument("description", type=Path, help="the robot's .urdf or .xacro file")
+    imp.add_argument("--name", required=True, help="the robot folder's name, e.g. fanuc_m20ia")
+    imp.add_argument(
+        "--package-path", type=Path, action="append",
+        help="a folder holding ROS packages (package.xml), for package:// and $(find); "
+        "repeatable (default: the folder above the description's package)",
+    )  # fmt: skip
+    imp.add_argument(
+        "--vendor", default="other", choices=("fanuc", "kuka", "abb", "universal_robots", "other"),
+        help="the maker: chooses the controller language (default other: none)",
+    )  # fmt: skip
+    imp.add_argument("--out", type=Path, default=None, help="ROBOTS_DIR to write into (./robots)")
+    imp.add_argument("--base", default="base_link", help="the chain's base link (base_link)")
+    imp.add_argument("--tip", default="tool0", help="the chain's flange link (tool0)")
+    imp.add_argument(
+        "--samples", type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
+        default=10_000, help="self-collision configurations (10000)",
+    )  # fmt: skip
+    imp.add_argument("--force", action="store_true", help="replace an existing robot folder")

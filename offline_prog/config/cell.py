@@ -43,7 +43,8 @@ class ShapeConfig:
 
 @dataclasses.dataclass
 class RobotConfig:
-    model: str = required()  # folder name in robots/
+    model: str = required()  # folder name in robots/ (or robots_dir, OFFLINE_PROG_ROBOTS)
+    robots_dir: str | None = None  # a folder of robot folders, relative to the cell file
     X_IB: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
 
 

@@ -5,12 +5,14 @@ Every failure is a InputError naming the file and key (one line).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.config.job_checks import check_job
+from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -30,15 +32,14 @@ def _error(file, key, reason) -> InputError:
 
 def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     """Semantic checks the types alone cannot express."""
-    robot_dirs = (
-        sorted(p.name for p in robots_dir.iterdir() if p.is_dir()) if (robots_dir.is_dir()) else []
-    )
-    if cell.robot.model not in robot_dirs:
+    folders = search_path(robots_dir, cell_file=file, robots_dir=cell.robot.robots_dir)
+    if find_robot(cell.robot.model, folders) is None:
+        have = sorted({name for name, _, _ in robots_in(folders)})
         raise _error(
             file,
             "robot.model",
             f"{cell.robot.model!r} is not a robot folder in "
-            f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})",
+            f"{os.pathsep.join(map(str, folders))} (have: {', '.join(have) or 'none'})",
         )
     motion = cell.motion
     if cell.part.mesh_units not in UNIT_SCALE:

@@ -35,7 +35,6 @@ from offline_prog.export.krl import _load, _process_lines, _write
 from offline_prog.export.krl_header import krl_comments
 from offline_prog.export.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
 from offline_prog.io_events import Signal
-from offline_prog.robot.model import load_robot
 
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 100, 100  # links: the planned joint moves at full rate
@@ -57,7 +56,7 @@ def write_krl_job(
     forced: bool = False,
 ) -> list[Path]:
     """Write the job's KRL modules into out_dir; returns the files (main first)."""
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
     if len(name) > 20 or not name.replace("_", "a").isalnum() or not name[0].isalpha():

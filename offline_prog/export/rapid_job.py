@@ -50,7 +50,6 @@ from offline_prog.export.rapid import (
 )
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.io_events import Signal
-from offline_prog.robot.model import load_robot
 
 LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the controller's)
 # The triggdata of each kind of event; a second one of a kind on the same move gets a
@@ -75,7 +74,7 @@ def write_rapid_job(
 ) -> list[Path]:
     """Write ``<module>.mod`` and ``<module>.pgf`` into out_dir; returns the files."""
     identifier(module, max_chars=NAME_MAX - 6, what="module")
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
     job, io = data.job, data.process_io

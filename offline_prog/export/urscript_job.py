@@ -36,7 +36,6 @@ from offline_prog.export.urscript import (
     _list,
 )
 from offline_prog.io_events import Signal
-from offline_prog.robot.model import load_robot
 
 ANALOG_RANGE_V = 10.0  # standard analog outputs: 0..10 V as 0..1
 ANALOG_STEP_V = 0.02  # write the flow when it changed by this much
@@ -52,7 +51,7 @@ def write_urscript_job(
 ) -> Path:
     """Write ``out_dir/<name>.script``; returns the file."""
     identifier(name, max_chars=NAME_MAX, what="name")
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     job, io = data.job, data.process_io
     v_link, a_link = float(robot.qd_max.min()), float(robot.qdd_max.min())
     conventions = [

@@ -141,8 +141,9 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
     ``path.tool_turn.SmoothTurn``) the tool turns by φ₀ + θ − θ̄ along the path, and
     φ₀ keeps the whole turn within ±bound (if θ − θ̄ spans more than 2·bound, a
     share of it is taken up, about the middle φ₀). Ranked by the joint-limit margin
-    of each φ₀'s best branch (the smaller |φ₀| on ties); the collision check may
-    move on to the next.
+    of each φ₀'s best branch (the smaller |φ₀| on ties; a robot of family drake has no
+    analytic IK to rank with: smallest |φ₀| first); the collision check may move on to
+    the next.
 
     Returns:
         [(φ₀ [rad], the FlangePath built with it), ...], best first.
@@ -171,6 +172,9 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
         else:
             turn = smooth_turn.with_offset(float(phi), scale)
             flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=unit)
+        if robot.family == "drake":  # no analytic IK to rank with: smallest |φ₀| first
+            ranked.append(((True, 0.0), -abs(phi), float(phi), flange))
+            continue
         f = flange(s)
         result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)

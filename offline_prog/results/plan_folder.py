@@ -109,6 +109,8 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "q_upper": robot.q_upper,
         "qd_max": robot.qd_max,
         "j23_coupled": robot.j23_coupled,
+        "j23_factor": robot.j23_factor,
+        "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
         "payload": payload_record(cell),
     }
