@@ -207,6 +207,9 @@ def normal_fit_summary(plan: Plan) -> dict:
         "normal_max_error_deg": None if fit is None else fit.max_error_deg,
         "normal_rms_error_deg": None if fit is None else fit.rms_error_deg,
         "normal_worst_row": None if fit is None else fit.worst_row,
+        # cad: seams: the fitted path's distance from the model's exact seam [mm]
+        "edge_max_error_mm": None if fit is None else fit.edge_max_error_mm,
+        "edge_rms_error_mm": None if fit is None else fit.edge_rms_error_mm,
     }
 
 
@@ -214,7 +217,8 @@ def report(plan: Plan) -> dict:
     """The machine-readable plan summary (SI units unless the key says otherwise)."""
     cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
     law = tr.law
-    source = next(k for k in ("points", "dxf", "analytic") if getattr(cell.path, k) is not None)
+    sources = ("points", "dxf", "analytic", "cad")
+    source = next(k for k in sources if getattr(cell.path, k) is not None)
     smoothing = None
     if hasattr(plan.flange, "max_deviation_m"):
         smoothing = {
