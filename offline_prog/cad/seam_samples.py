@@ -12,6 +12,10 @@ import numpy as np
 
 # Points handed to the B-spline fit are this far apart along the edge [mm] ...
 FIT_SPACING_MM = 0.5
+# ... and closer near the edges' ends, growing from this [mm]: where a fillet meets a
+# line the curvature and the normal's turn rate jump, and the fit's knots gather where
+# its points do.
+FIT_END_SPACING_MM = 0.01
 # ... and the reference the fit error is measured against, this far [mm] (its chords
 # are within r·(1 − cos(δ/2r)) ≈ δ²/8r of the exact edge: 0.25 µm for r = 5 mm).
 REFERENCE_SPACING_MM = 0.1

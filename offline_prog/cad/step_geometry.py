@@ -15,7 +15,7 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
-from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_UniformAbscissa
+from OCP.GCPnts import GCPnts_AbscissaPoint
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.GeomLProp import GeomLProp_SLProps
 from OCP.gp import gp_Pnt, gp_Vec
@@ -29,18 +29,36 @@ from offline_prog.cad.step_model import edge_length, sub_shapes
 # tolerance [rad]: the part's Drake geometry is within this of the exact solid.
 TESSELLATION_TOLERANCE_MM = 0.05
 TESSELLATION_ANGLE_RAD = 0.1
+GRADING = 1.3  # growth of the point spacing away from an edge's ends
 
 
 def _xyz(point) -> np.ndarray:
     return np.array([point.X(), point.Y(), point.Z()])
 
 
-def sample_edge(edge, spacing_mm: float, *, reverse: bool = False):
-    """Points and unit tangents on an edge, equally spaced by exact arc length.
+def graded_abscissae(length: float, spacing: float, first: float) -> np.ndarray:
+    """(n,) arc lengths from 0 to ``length``: ``spacing`` apart in the middle, growing
+    geometrically (×GRADING) from ``first`` at both ends, where an edge meets the next
+    and the curvature may jump (the fit's knots follow the points there)."""
+    steps = []
+    step = min(first, spacing)
+    while step < spacing and 2 * (sum(steps) + step) < length:
+        steps.append(step)
+        step *= GRADING
+    end = sum(steps)
+    middle = max(1, int(np.ceil((length - 2 * end) / spacing)))
+    inner = np.linspace(end, length - end, middle + 1)
+    head = np.cumsum([0.0, *steps])[:-1]
+    return np.concatenate([head, inner, length - head[::-1]])
+
+
+def sample_edge(edge, spacing_mm: float, *, reverse: bool = False, first_mm: float | None = None):
+    """Points and unit tangents on an edge, spaced by exact arc length.
 
     Args:
         edge: TopoDS_Edge (its curve's direction unless ``reverse``).
         spacing_mm: largest arc length between neighbours [mm].
+        first_mm: the spacing at both ends, growing to ``spacing_mm`` (default: even).
 
     Returns:
         p: (n, 3) points [mm], both ends included; t: (n, 3) unit tangents along the
@@ -49,13 +67,15 @@ def sample_edge(edge, spacing_mm: float, *, reverse: bool = False):
     curve = BRepAdaptor_Curve(edge)
     first, last = curve.FirstParameter(), curve.LastParameter()
     length = edge_length(edge)
-    n = max(3, int(np.ceil(length / min(spacing_mm, 1e9))) + 1)
-    abscissa = GCPnts_UniformAbscissa(curve, n, first, last, 1e-9)
-    if abscissa.IsDone() and abscissa.NbPoints() == n:
-        u = np.array([abscissa.Parameter(i) for i in range(1, n + 1)])
-    else:  # not expected on B-rep curves; equal parameter steps are still exact points
-        u = np.linspace(first, last, n)
-    p, t = np.empty((n, 3)), np.empty((n, 3))
+    if first_mm is None:
+        s = np.linspace(0.0, length, max(3, int(np.ceil(length / min(spacing_mm, 1e9))) + 1))
+    else:
+        s = graded_abscissae(length, spacing_mm, first_mm)
+    u = np.empty(len(s))
+    u[0], u[-1] = first, last
+    for i in range(1, len(s) - 1):
+        u[i] = GCPnts_AbscissaPoint(curve, float(s[i]), first).Parameter()
+    p, t = np.empty((len(u), 3)), np.empty((len(u), 3))
     point, vector = gp_Pnt(), gp_Vec()
     for i, ui in enumerate(u):
         curve.D1(ui, point, vector)

@@ -19,6 +19,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from offline_prog.cad.picking import PickError, pick
 from offline_prog.cad.seam_samples import (
+    FIT_END_SPACING_MM,
     FIT_SPACING_MM,
     REFERENCE_SPACING_MM,
     SeamSamples,
@@ -167,7 +168,9 @@ def sample_run(model: StepModel, run, normal_face: int, *, closed: bool, offset_
     for k, (edge, backwards) in enumerate(run):
         on = [f for f in model.edge_faces[edge] if f in group]
         face = model.faces[on[0] if on else normal_face]
-        p, t, _ = sample_edge(model.edges[edge], FIT_SPACING_MM, reverse=backwards)
+        p, t, _ = sample_edge(
+            model.edges[edge], FIT_SPACING_MM, reverse=backwards, first_mm=FIT_END_SPACING_MM
+        )
         n = outward_normals(face, p)
         reference, _, _ = sample_edge(model.edges[edge], REFERENCE_SPACING_MM, reverse=backwards)
         if offset_mm:
@@ -176,7 +179,7 @@ def sample_run(model: StepModel, run, normal_face: int, *, closed: bool, offset_
         normals.append(n)
         references.append(reference)
         next_edge, next_back = run[(k + 1) % len(run)]
-        _, t_next, _ = sample_edge(model.edges[next_edge], np.inf, reverse=next_back)
+        _, t_next, _ = sample_edge(model.edges[next_edge], 1e9, reverse=next_back)
         ends.append((p[-1], t[-1], t_next[0]))
     return SeamSamples(
         join_pieces(points, closed=closed),

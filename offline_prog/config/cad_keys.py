@@ -15,8 +15,6 @@ Points are in the part frame P, in mm (the keys say so). A STEP model is read in
 (the reader converts the file's units); a mesh is in its declared units.
 """
 
-from __future__ import annotations
-
 import dataclasses
 
 from offline_prog.errors import InputError
@@ -32,7 +30,7 @@ def _required():
 class CadLoop:
     """The outer loop (boundary) of the model face nearest ``face_near_mm`` (in P, mm)."""
 
-    face_near_mm: list[float] = _required()
+    face_near_mm: list[float] | None = _required()
 
 
 @dataclasses.dataclass
@@ -40,14 +38,14 @@ class CadChain:
     """Connected model edges from the one nearest the first point to the one nearest the
     last, through those nearest the points between (in P, mm)."""
 
-    near_mm: list[list[float]] = _required()
+    near_mm: list[list[float]] | None = _required()
 
 
 @dataclasses.dataclass
 class CadNormal:
     """The face (nearest ``face_near_mm``, in P, mm) whose normal the seam takes."""
 
-    face_near_mm: list[float] = _required()
+    face_near_mm: list[float] | None = _required()
 
 
 @dataclasses.dataclass

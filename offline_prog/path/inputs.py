@@ -141,6 +141,10 @@ def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
         )
     if cell.path.normal is not None:
         return constant_normal(np.asarray(cell.path.normal, float))
+    if points.exact is not None:  # a cad: seam: exact normals, fitted to tolerance
+        from offline_prog.path.cad_normal import model_normal
+
+        return model_normal(path, points.normals_P, np.deg2rad(cell.path.normal_tolerance_deg))
     if points.normals_P is not None:
         return spline_normal(path, points.normals_P)
     import trimesh
