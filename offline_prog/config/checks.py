@@ -172,7 +172,7 @@ def _check_shapes(file: Path, cell: Cell) -> None:
         ("tool.geometry", cell.tool.geometry),
         ("obstacles", cell.obstacles),
     ]
-    names = {cell.part.name} if cell.part.mesh else set()
+    names = {cell.part.name} if cell.part.mesh or cell.part.model else set()
     for key, shapes in owners:
         for i, shape in enumerate(shapes):
             where = f"{key}[{i}]"
