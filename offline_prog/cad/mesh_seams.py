@@ -3,8 +3,8 @@ runs, with normals from the chosen region's triangles (area-weighted at each ver
 
 The seam is the mesh's own polyline of feature edges: it lies on the part's edge at
 the vertices and within the tessellation's chord error between them, which is
-estimated from the polyline's turning (a chord of length L turning θ per chord
-length ℓ sits L²θ / 8ℓ off its arc) and reported. All in the part frame P [mm].
+estimated from the polyline's turning (:func:`chord_error`) and reported. All in the
+part frame P [mm].
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from offline_prog.cad.edge_chain import chain
-from offline_prog.cad.mesh_model import MeshModel
+from offline_prog.cad.mesh_model import CORNER_DEG, MeshModel
 from offline_prog.cad.picking import PickError, pick
 from offline_prog.cad.seam_samples import FIT_SPACING_MM, SeamSamples, corners
 
@@ -116,17 +116,19 @@ def _resample(p: np.ndarray, n: np.ndarray, spacing: float):
 
 def chord_error(p: np.ndarray) -> float:
     """Estimated largest distance [mm] of a polyline's chords from the smooth curve
-    through its vertices (corners above the run limit excluded)."""
+    through its vertices: a chord of length L on an arc of radius r turns θ = L/r from
+    its neighbour and sits L²/8r = Lθ/8 off the arc. Each vertex's turn is charged to
+    its shorter chord (a tessellated line is one long exact chord; the turn where it
+    meets a fillet belongs to the fillet's short chords). Corners above the run limit
+    are corners, not chord error."""
     chords = np.diff(p, axis=0)
     lengths = np.linalg.norm(chords, axis=1)
     if len(chords) < 2:
         return 0.0
     cos = np.einsum("ij,ij->i", chords[:-1], chords[1:]) / (lengths[:-1] * lengths[1:])
     turn = np.arccos(np.clip(cos, -1.0, 1.0))
-    turn = np.where(turn > np.deg2rad(20.0), 0.0, turn)
-    span = (lengths[:-1] + lengths[1:]) / 2
-    sag = np.maximum(lengths[:-1], lengths[1:]) ** 2 * turn / (8 * span)
-    return float(sag.max())
+    turn = np.where(turn > np.deg2rad(CORNER_DEG), 0.0, turn)
+    return float((np.minimum(lengths[:-1], lengths[1:]) * turn / 8).max())
 
 
 def _samples(model, vertex_runs, region, *, closed, offset_mm, edges) -> SeamSamples:
