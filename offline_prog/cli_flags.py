@@ -82,6 +82,7 @@ def parser() -> argparse.ArgumentParser:
     )
     _session_flags(commands)
     _place_flags(commands)
+    _seams_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
@@ -188,3 +189,17 @@ def _place_flags(commands) -> None:
         "--scheduler", default=None,
         help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
     )  # fmt: skip
+
+
+def _seams_flags(commands) -> None:
+    """``seams PART.step|PART.stl [--out seams.html] [--mesh-units m|mm]``."""
+    seams = commands.add_parser(
+        "seams", help="list a part model's faces, loops and edge chains; write a 3D page"
+    )
+    seams.add_argument("part", type=Path, help="STEP (.step, .stp) or mesh (.stl, .obj, .ply)")
+    seams.add_argument(
+        "--out", type=Path, default=None, help="the page (default: <part>_seams.html beside it)"
+    )
+    seams.add_argument(
+        "--mesh-units", choices=("m", "mm"), default="m", help="a mesh file's unit (default m)"
+    )

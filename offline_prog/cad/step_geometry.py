@@ -118,8 +118,11 @@ def distance(shape, point_mm) -> float:
     return float(extrema.Value())
 
 
-def tessellate(shape, tolerance_mm: float = TESSELLATION_TOLERANCE_MM):
+def tessellate(shape, tolerance_mm: float = TESSELLATION_TOLERANCE_MM, faces=None):
     """Triangles of the solid within ``tolerance_mm`` of its surface (chord deviation).
+
+    Args:
+        faces: the shape's faces in the order to number them (default: file order).
 
     Returns:
         vertices: (V, 3) [mm]; triangles: (T, 3) vertex indices, counter-clockwise seen
@@ -128,7 +131,7 @@ def tessellate(shape, tolerance_mm: float = TESSELLATION_TOLERANCE_MM):
     BRepMesh_IncrementalMesh(shape, tolerance_mm, False, TESSELLATION_ANGLE_RAD, True)
     vertices, triangles, face_of = [], [], []
     offset = 0
-    for k, face in enumerate(sub_shapes(shape, TopAbs_FACE)):
+    for k, face in enumerate(sub_shapes(shape, TopAbs_FACE) if faces is None else faces):
         face = TopoDS.Face(face)
         location = TopLoc_Location()
         mesh = BRep_Tool.Triangulation_s(face, location)
