@@ -14,7 +14,12 @@ import numpy as np
 from offline_prog.cad.edge_chain import chain
 from offline_prog.cad.mesh_model import CORNER_DEG, MeshModel
 from offline_prog.cad.picking import PickError, pick
-from offline_prog.cad.seam_samples import FIT_SPACING_MM, SeamSamples, corners
+from offline_prog.cad.seam_samples import (
+    FIT_SPACING_MM,
+    REFERENCE_SPACING_MM,
+    SeamSamples,
+    corners,
+)
 
 
 def region_distances(model: MeshModel, point_mm) -> np.ndarray:
@@ -137,7 +142,8 @@ def _samples(model, vertex_runs, region, *, closed, offset_mm, edges) -> SeamSam
     path = np.concatenate([pieces[0]] + [r[1:] for r in pieces[1:]])
     normals = region_vertex_normals(model, region, path)
     p, n = _resample(v[path], normals, FIT_SPACING_MM)
-    reference = v[path] - offset_mm * normals
+    reference, reference_n = _resample(v[path], normals, REFERENCE_SPACING_MM)
+    reference = reference - offset_mm * reference_n
     ends = []
     for k, r in enumerate(pieces):
         nxt = pieces[(k + 1) % len(pieces)]
@@ -178,5 +184,12 @@ def chain_seam(model: MeshModel, near_mm, normal_near_mm, *, offset_mm: float, c
     vertex_runs = [model.runs[e][::-1] if back else model.runs[e] for e, back in run]
     if closed and vertex_runs[0][0] != vertex_runs[-1][-1]:
         raise PickError(f"{key}.closed", "true, but the chain's ends do not meet")
+    if not closed and len(run) == 1 and vertex_runs[0][0] == vertex_runs[0][-1]:
+        raise PickError(
+            f"{key}.closed",
+            f"false, but feature edge {run[0][0]} is a closed run with no corner to start "
+            "or end at (a mesh keeps no tangent edge ends): set closed: true, or use the "
+            "STEP model",
+        )
     return _samples(model, vertex_runs, region, closed=closed, offset_mm=offset_mm,
                     edges=[e for e, _ in run])  # fmt: skip

@@ -73,3 +73,14 @@ def test_the_demo_plans_exports_and_previews(tmp_path):
     )  # fmt: skip
     assert exported.returncode == 0, exported.stderr
     assert (tmp_path / "csv" / "joint_trajectory.csv").is_file()
+
+
+def test_a_placement_worker_gets_the_model():
+    """``offline-prog place`` sends the cell and its data files to its workers: the
+    STEP model must be among them, re-pointed in the cell text."""
+    from offline_prog.placement.payload import cell_payload, unpack
+
+    payload = cell_payload(CELL, load_cell(CELL))
+    assert any(name.endswith("seal_plate.step") for name, _ in payload.files)
+    inputs = load_inputs(unpack(payload), ROBOTS_DIR)
+    assert seam_inputs(inputs, 0).points.exact.length_m * 1e3 == pytest.approx(RIM_MM)
