@@ -197,6 +197,23 @@ def payload_summary(cell) -> dict:
     return {"set": complete, "warning": warning, **record}
 
 
+def cad_summary(points) -> dict | None:
+    """A cad: seam's model facts: what was picked, the exact length [m], the reference's
+    tolerance [mm] and the corners between its edges (cusps of the path); else None."""
+    exact = getattr(points, "exact", None)
+    if exact is None:
+        return None
+    return {
+        "model": exact.model,
+        "length_m": exact.length_m,
+        "reference_tolerance_mm": exact.tolerance_m * 1e3,
+        "corners": [
+            {"p_P_mm": [round(float(v) * 1e3, 3) for v in p], "turn_deg": round(turn, 3)}
+            for p, turn in exact.corners
+        ],
+    }
+
+
 def normal_fit_summary(plan: Plan) -> dict:
     """report.json's normal-fit keys: the angle from the given normals to the fitted
     field [deg] (0 for a constant path.normal, None for normals from part.mesh)."""
@@ -240,6 +257,7 @@ def report(plan: Plan) -> dict:
             "closed": bool(cell.path.closed),
             "polygon_length_m": fitted.period,
             "length_m": plan.path.length,
+            "cad": cad_summary(plan.points),
         },
         "fit": {
             "degree": fitted.degree,

@@ -65,6 +65,8 @@ def test_the_demo_plans_exports_and_previews(tmp_path):
         assert seam["fit"]["normal_source"] == "cad"
         assert seam["fit"]["edge_max_error_mm"] <= seam["fit"]["tolerance_mm"] * 1.01
         assert seam["path"]["length_m"] * 1e3 == pytest.approx(length, abs=0.1)
+        assert seam["path"]["cad"]["length_m"] * 1e3 == pytest.approx(length, rel=1e-9)
+        assert seam["path"]["cad"]["corners"] == []
     assert (out / "preview.html").stat().st_size > 100_000  # the scene, robot and part
     exported = subprocess.run(
         [sys.executable, "-m", "offline_prog", "export", str(out), "--format", "csv",

@@ -18,7 +18,7 @@ from cad_parts import (
 
 from offline_prog.job.seams import seam_inputs
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.stages import fit_path, load_inputs
+from offline_prog.stages import fit_path, flange_paths, load_inputs
 
 PATH_TOL_MM = 0.01
 NORMAL_TOL_DEG = 0.05
@@ -150,3 +150,30 @@ def test_cylinder_rim_loop_with_the_chamfer_normal(parts):
     outward = np.column_stack([radial, np.ones(len(p))]) / np.sqrt(2.0)
     assert angle_deg(n, -outward).max() < NORMAL_TOL_DEG
     assert angle_deg(sampled(top)[1], [0.0, 0.0, -1.0]).max() < NORMAL_TOL_DEG
+
+
+def test_a_sharp_corner_is_a_corner_and_a_cusp_as_for_any_path(tmp_path):
+    """A box's top loop (the path: shorthand): four 90° corners between its edges,
+    reported with the seam, and the flange path's speed peaks there, as for a CSV."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+
+    write_step(BRepPrimAPI_MakeBox(300, 200, 10).Shape(), tmp_path / "box.step")
+    file = cad_cell(tmp_path, "box.step", [])
+    text = file.read_text().replace(
+        "seams: []", "path:\n  cad:\n    loop: {face_near_mm: [150, 100, 10]}"
+    )
+    file.write_text(text)
+    inputs = load_inputs(file, ROBOTS_DIR)
+    corners = inputs.points.exact.corners
+    assert sorted(tuple(np.round(p * 1e3, 6)) for p, _ in corners) == [
+        (0, 0, 10), (0, 200, 10), (300, 0, 10), (300, 200, 10)]  # fmt: skip
+    assert [turn for _, turn in corners] == pytest.approx([90.0] * 4)
+    fit = fit_path(inputs)
+    cusps = flange_paths(inputs, fit).cusps
+    grid = np.linspace(0.0, fit.path.length, 20001)
+    on_path = fit.path(grid, 0)[0]
+    s_corners = np.array([grid[np.argmin(np.linalg.norm(on_path - p, axis=1))] for p, _ in corners])
+    assert cusps
+    for cusp in cusps:  # each flange-speed peak at one of the corners, none elsewhere
+        gap = np.abs(s_corners - cusp.sigma_m)
+        assert np.minimum(gap, fit.path.length - gap).min() < 0.02  # within 20 mm
