@@ -110,19 +110,29 @@ def write_stl(shape, file: Path, tolerance_mm: float) -> Path:
     return file
 
 
+PLACEMENT = """\
+robot:
+  model: kuka_kr16_2
+  X_IB: {translation: [0, 0, 0]}
+tool:
+  X_IT: {translation: [1.0, 0.0, 0.5], rotation: !Rpy {deg: [90, 0, 0]}}
+motion: {speed: 0.1, max_acceleration: 1.0, max_jerk: 10.0}
+"""  # the KR 16 and nozzle of cells/seal_job_kr16.yaml
+
+
 def cad_cell(tmp_path: Path, model: str, seams: list[dict], **part) -> Path:
-    """A KR 16 cell (robot and nozzle as in cells/seal_job_kr16.yaml) whose part is
-    ``model`` and whose seams are ``seams`` (each a dict with a ``cad`` block)."""
-    cell = {
-        "robot": {"model": "kuka_kr16_2", "X_IB": {"translation": [0, 0, 0]}},
-        "tool": {"X_IT": {"translation": [1.0, 0.0, 0.5]}},
-        "part": {"X_PE": {"translation": [0.0, 0.0, 0.1]}, "model": model, **part},
-        "seams": [
-            {"name": f"s{k}", "fit_tolerance_mm": 0.005, "normal_tolerance_deg": 0.05, **s}
-            for k, s in enumerate(seams)
-        ],
-        "motion": {"speed": 0.1, "max_acceleration": 1.0, "max_jerk": 10.0},
-    }
+    """A KR 16 cell (robot and nozzle as in cells/seal_job_kr16.yaml, the part held
+    100 mm below the flange) whose part is ``model`` and whose seams are ``seams``
+    (each a dict with a ``cad`` block)."""
+    part = {"model": model, **part}
+    seams = [{"name": f"s{k}", "fit_tolerance_mm": 0.005, "normal_tolerance_deg": 0.05, **s}
+             for k, s in enumerate(seams)]  # fmt: skip
+    text = (
+        PLACEMENT
+        + "part:\n  X_PE: {translation: [0, 0, 0.1], rotation: !Rpy {deg: [180, 0, 0]}}\n"
+        + yaml.safe_dump({"part": part}).removeprefix("part:\n")
+        + yaml.safe_dump({"seams": seams}, sort_keys=False)
+    )
     file = tmp_path / "cell.yaml"
-    file.write_text(yaml.safe_dump(cell, sort_keys=False))
+    file.write_text(text)
     return file
