@@ -48,30 +48,28 @@ def _label(scene: StaticScene, path: str, text: str, p_I: np.ndarray, size: floa
     )  # fmt: skip
 
 
-def seams_page(catalog, out: Path) -> Path:
-    """Write the page for a :class:`~offline_prog.cad.catalog.Catalog` to ``out``."""
+def seams_html(catalog) -> str:
+    """The page of a :class:`~offline_prog.cad.catalog.Catalog`: the model, its loops and
+    chains as lines and every number as a label."""
     scene = StaticScene()
     vertices = np.asarray(catalog.vertices) * MM
     scene.set_mesh("/seams/model", vertices, np.asarray(catalog.triangles), MODEL_RGBA)
     low, high = vertices.min(axis=0), vertices.max(axis=0)
     extent = float(max(high - low))
-    size = LABEL_SIZE
     for entry in catalog.entries:
         name = f"{PREFIX[entry.kind]}{entry.number}"
         if len(entry.polyline) > 1:
             scene.set_lines(f"/seams/lines/{name}", entry.polyline * MM, LINE_RGBA[entry.kind])
-        _label(scene, f"/seams/labels/{name}", name, np.asarray(entry.label_at) * MM, size)
+        _label(scene, f"/seams/labels/{name}", name, np.asarray(entry.label_at) * MM, LABEL_SIZE)
     centre = (low + high) / 2
     scene.set_camera(centre + extent * np.array([0.45, -0.6, 0.5]), centre)
     scene.set_property("/Grid", "visible", False)
     scene.set_property("/Axes", "visible", False)
-    Path(out).write_text(scene.html(f"seams of {Path(catalog.file).name}"))
-    return Path(out)
+    return scene.html(f"seams of {Path(catalog.file).name}")
 
 
-def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
-    """``offline-prog seams``: list the model's faces, loops and chains (numbers, sizes,
-    the cell-file keys that pick each) through ``say`` and write the page.
+def model_catalog(part: Path, mesh_units: str = "m"):
+    """The :class:`~offline_prog.cad.catalog.Catalog` of a STEP or mesh file.
 
     Raises:
         InputError: not a model file, unreadable, or not a solid (one line).
@@ -87,18 +85,28 @@ def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
         raise InputError(part, "", "no such file")
     try:
         if kind == "step":
-            catalog = step_catalog(part)
-        else:
-            catalog = mesh_catalog(part, UNIT_SCALE[mesh_units] / MM)
+            return step_catalog(part)
+        return mesh_catalog(part, UNIT_SCALE[mesh_units] / MM)
     except ModelError as error:
         raise InputError(part, "", str(error)) from None
+
+
+def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
+    """``offline-prog seams``: list the model's faces, loops and chains (numbers, sizes,
+    the cell-file keys that pick each) through ``say`` and write the page.
+
+    Raises:
+        InputError: not a model file, unreadable, or not a solid (one line).
+    """
+    catalog = model_catalog(part, mesh_units)
     unit = {"face": "mm²", "loop": "mm", "chain": "mm"}
     for entry in catalog.entries:
         name = f"{PREFIX[entry.kind]}{entry.number}"
         keys = str(entry.keys).replace("'", "")
         say(f"  {entry.kind:<5} {name:<4} {entry.size:10.2f} {unit[entry.kind]:<3}  "
             f"{entry.description:<40} cad: {keys}", highlight=False)  # fmt: skip
+    part = Path(part)
     out = Path(out) if out is not None else part.with_name(f"{part.stem}_seams.html")
-    seams_page(catalog, out)
+    out.write_text(seams_html(catalog))
     say(f"page      {out}", highlight=False)
     return out
