@@ -177,3 +177,20 @@ def test_a_sharp_corner_is_a_corner_and_a_cusp_as_for_any_path(tmp_path):
     for cusp in cusps:  # each flange-speed peak at one of the corners, none elsewhere
         gap = np.abs(s_corners - cusp.sigma_m)
         assert np.minimum(gap, fit.path.length - gap).min() < 0.02  # within 20 mm
+
+
+def test_offset_moves_the_seam_along_the_normal(parts):
+    """offset_mm: along n (into the part); negative lifts the seam off the surface. The
+    exact reference moves with it (the fit error is still against the moved edge)."""
+    seams = [
+        {"cad": {"loop": {"face_near_mm": [150, 100, 10]}, "offset_mm": -1.0}},
+        {"cad": {"chain": {"near_mm": [[100, 0, 0], [100, 0, 0]]},
+                 "normal": {"face_near_mm": [150, 0, 5]}, "offset_mm": 2.0}},
+    ]  # fmt: skip
+    lifted, inside = fitted_seams(parts, "plate.step", seams)
+    p, _ = sampled(lifted)
+    assert rounded_rectangle(p, PLATE[2] + 1.0)[0].max() < PATH_TOL_MM
+    p, _ = sampled(inside)  # the bottom edge at y = 0, moved 2 mm into the side face
+    np.testing.assert_allclose(p[:, 1:], [[2.0, 0.0]] * len(p), atol=PATH_TOL_MM)
+    for fit in (lifted, inside):
+        assert fit.normal_fit.edge_max_error_mm < PATH_TOL_MM
