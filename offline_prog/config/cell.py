@@ -130,7 +130,7 @@ class AnalyticPath:
 @dataclasses.dataclass
 class PathConfig:
     units: str | None = None  # m | mm; required except for cad: (config.cad_keys)
-    closed: bool = False  # a closed contour (periodic spline): the ends must meet
+    closed: bool = False  # a closed contour (periodic spline); its ends: path.closing
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
@@ -277,7 +277,9 @@ def load_cell(file: str | os.PathLike) -> Cell:
     raw = safe_yaml.load(file, text)  # aliases, depth, duplicate keys
     check_mapping(file, "", raw, Cell)
     try:
-        return yaml_load_typed(schema=Cell, data=safe_yaml.quote_bool_keys(text))
+        # Drake's loader reads YAML 1.1 (on, off, yes, no are booleans): it gets the
+        # data our YAML 1.2 loader read, written out by Drake's own dumper.
+        return yaml_load_typed(schema=Cell, data=safe_yaml.drake_text(raw))
     except Exception as error:  # Drake's message is multi-line; keep its first line.
         first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
         raise InputError(file, "", first_line) from None

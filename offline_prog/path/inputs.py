@@ -15,6 +15,7 @@ from offline_prog.config.cell import Cell
 from offline_prog.errors import InputError
 from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.closing import OpenEndsError
 from offline_prog.path.process_frames import (
     constant_normal,
     mesh_normals,
@@ -93,13 +94,14 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
 
         return cad_points(file, cell)
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
+    close_tolerance_m = path.fit_tolerance_mm * 1e-3
     try:
         if path.points:
             return path_sources.read_csv_points(
                 file.parent / source,
                 units=path.units,
                 closed=path.closed,
-                close_tolerance_m=path.fit_tolerance_mm * 1e-3,
+                close_tolerance_m=close_tolerance_m,
                 seam=path.csv_seam,
             )
         return path_sources.read_dxf_points(
@@ -108,14 +110,16 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
             closed=path.closed,
             units=path.units,
             entity=path.dxf_entity,
+            close_tolerance_m=close_tolerance_m,
         )
-    except path_sources.OpenEndsError as error:
+    except OpenEndsError as error:
         raise _error(
             file,
             "path.closed",
-            f"true, but the ends of {source} are {error.gap_m * 1e3:.3f} mm apart (more than "
-            f"path.fit_tolerance_mm {path.fit_tolerance_mm:g}): end the points where they "
-            "start, or set closed: false",
+            f"true, but the ends of {source} are {error.gap_m * 1e3:.3f} mm apart, more "
+            f"than twice the point spacing there (first step {error.first_step_m * 1e3:.3f} "
+            f"mm, last step {error.last_step_m * 1e3:.3f} mm): a stretch of the contour is "
+            "missing; add its points, or set closed: false",
         ) from None
     except ValueError as error:
         raise _error(file, key, f"{source}: {error}") from None

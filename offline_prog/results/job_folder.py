@@ -32,7 +32,7 @@ from offline_prog.results.plan_folder import (
     program_names,
     time_law_name,
 )
-from offline_prog.results.report import collision_summary, report
+from offline_prog.results.report import collision_summary, payload_summary, report
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
 from offline_prog.viz.job_report_html import write_job_report_html
@@ -131,6 +131,7 @@ def job_report(job: JobPlan) -> dict:
         "robot": job.cell.robot.model,
         "tool": job.cell.tool.name,
         "part": job.cell.part.name,
+        "payload": payload_summary(job.cell),
         "job": {
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
             "order_mode": job_config(job.cell).order,
@@ -200,7 +201,8 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
             for fmt in job_formats(data.language):
                 for file in export(data, fmt, folder / PROGRAMS_DIR):
                     files[f"{fmt}:{file.name}"] = file
-        files["report_html"] = write_job_report_html(folder)  # after the programs
+        # After the programs; it names the folder the user gets, not the staged one.
+        files["report_html"] = write_job_report_html(folder, folder_name=out_dir.name)
         preview.wait()
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})

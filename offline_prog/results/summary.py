@@ -25,8 +25,7 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
         f"{traj['n_samples']} samples, speed error "
         f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
     )
-    if not report["payload"]["set"]:
-        console.print(f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]")
+    print_payload_warning(console, report)
     robot = report["robot_motion"]
     reductions = robot["speed_reductions"]
     console.print(
@@ -66,6 +65,15 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
 
 
+def print_payload_warning(console: Console, report: dict) -> None:
+    """The payload line when the programs do not set it (a seam's or a job's report)."""
+    if not report["payload"]["set"]:
+        console.print(
+            f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]",
+            highlight=False,
+        )
+
+
 def print_job_summary(console: Console, report: dict, files: dict, seconds: float) -> None:
     """A few lines for a job: order, cycle time split, each seam, links, clearance."""
     job = report["job"]
@@ -83,6 +91,7 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, approach and "
         f"retract {job['approach_retract_time_s']:.2f} s)"
     )
+    print_payload_warning(console, report)
     for seam in report["seams"]:
         console.print(
             f"  seam      {seam['seam']}: {seam['path']['length_m'] * 1e3:.1f} mm, "

@@ -12,17 +12,32 @@ from), the controls and the status line on the right. The API:
 - ``GET /seams``: for a cell with ``part.model``, the page of ``offline-prog seams`` on
   it (the model's faces, loops and chains with the numbers its ``cad:`` seams pick by),
   linked from the panel.
+
+Every request passes the :mod:`~offline_prog.session.guard` checks first (403 if not:
+Host, Origin, token; 415 for a POST that is not ``application/json``); a body or value
+the session cannot use is 400 with a one-line ``message`` (:mod:`request`), and the
+session keeps its values. An unexpected error is a 500 with one line, never a
+traceback on the user's terminal.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
+from urllib.parse import urlsplit
 
-MAX_BODY_BYTES = 10_000
+from offline_prog.session.guard import Guard, is_json
+from offline_prog.session.request import MAX_BODY_BYTES, RequestError, read_body
+from offline_prog.viz.local_server import bind_address, family
+
+log = logging.getLogger(__name__)
+PAGES = ("/", "/index.html")
+KEYS = {"/set": ("key", "value"), "/action": ("name", "value")}  # what each POST takes
 
 
 SEAMS_LINK = (
@@ -54,6 +69,7 @@ def seams_page_of(cell_file) -> bytes | None:
 
 class _Handler(BaseHTTPRequestHandler):
     session = None  # set on the subclass made by serve_panel
+    guard: Guard | None = None
     html = b""
     seams: bytes | None = None  # the model's seams page, made at start
 
@@ -65,52 +81,107 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Type", kind)
         self.send_header("Content-Length", str(len(body)))
         self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.send_header("X-Frame-Options", "DENY")  # no other page frames the panel
         self.end_headers()
         self.wfile.write(body)
 
     def _json(self, value, status: int = HTTPStatus.OK) -> None:
         self._send(status, json.dumps(value).encode(), "application/json")
 
+    def _refuse(self, status: int, message: str) -> None:
+        self._json({"ok": False, "message": message}, status)
+
+    def _checked(self) -> bool:
+        """Host, Origin and token (see guard); False after a 403."""
+        reason = self.guard.refusal(self.path, self.headers)
+        if reason is not None and urlsplit(self.path).path in (*PAGES, "/seams"):  # a person
+            self._send(HTTPStatus.FORBIDDEN, f"refused: {reason}\n".encode(), "text/plain")
+        elif reason is not None:
+            self._refuse(HTTPStatus.FORBIDDEN, f"refused: {reason}")
+        return reason is None
+
     def do_GET(self) -> None:
-        path = self.path.split("?")[0]
-        if path in ("/", "/index.html"):
-            self._send(HTTPStatus.OK, self.html, "text/html; charset=utf-8")
-        elif path == "/status":
-            self._json(self.session.snapshot())
-        elif path == "/seams" and self.seams is not None:
-            self._send(HTTPStatus.OK, self.seams, "text/html; charset=utf-8")
-        else:
-            self._json({"ok": False, "message": "not found"}, HTTPStatus.NOT_FOUND)
+        try:
+            if not self._checked():
+                return
+            path = urlsplit(self.path).path
+            if path in PAGES:
+                self._send(HTTPStatus.OK, self.html, "text/html; charset=utf-8")
+            elif path == "/status":
+                self._json(self.session.snapshot())
+            elif path == "/seams" and self.seams is not None:
+                self._send(HTTPStatus.OK, self.seams, "text/html; charset=utf-8")
+            else:
+                self._refuse(HTTPStatus.NOT_FOUND, "not found")
+        except Exception as error:  # one line to the page, never a traceback here
+            self._failed(error)
 
     def do_POST(self) -> None:
         try:
-            length = int(self.headers.get("Content-Length") or 0)
-            if not 0 <= length <= MAX_BODY_BYTES:
-                raise ValueError("request too large")
-            body = json.loads(self.rfile.read(length) or b"{}")
-            if not isinstance(body, dict):
-                raise ValueError("expected a JSON object")
-        except ValueError as error:
-            self._json({"ok": False, "message": f"bad request: {error}"}, HTTPStatus.BAD_REQUEST)
+            self._post()
+        except Exception as error:
+            self._failed(error)
+
+    def _post(self) -> None:
+        if not self._checked():
             return
-        if self.path == "/set":
-            self._json(self.session.set_value(body.get("key"), body.get("value")))
-        elif self.path == "/action":
-            self._json(self.session.action(str(body.get("name")), body.get("value")))
+        path = urlsplit(self.path).path
+        if path not in KEYS:
+            self._refuse(HTTPStatus.NOT_FOUND, "not found")
+            return
+        if not is_json(self.headers.get("Content-Type")):
+            kind = self.headers.get("Content-Type")
+            message = f"refused: Content-Type {kind!r}: the panel takes application/json"
+            self._refuse(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, message)
+            return
+        try:
+            body = read_body(self._body(), keys=KEYS[path])
+        except RequestError as error:
+            self._refuse(HTTPStatus.BAD_REQUEST, f"bad request: {error}")
+            return
+        if path == "/set":
+            reply = self.session.set_value(body.get("key"), body.get("value"))
         else:
-            self._json({"ok": False, "message": "not found"}, HTTPStatus.NOT_FOUND)
+            reply = self.session.action(body.get("name"), body.get("value"))
+        self._json(reply, HTTPStatus.OK if reply["ok"] else HTTPStatus.BAD_REQUEST)
+
+    def _body(self) -> bytes:
+        """The body, at most MAX_BODY_BYTES (RequestError otherwise; never read past)."""
+        if self.headers.get("Transfer-Encoding") is not None:
+            raise RequestError("send a Content-Length, not a Transfer-Encoding")
+        try:
+            length = int(self.headers.get("Content-Length") or 0)
+        except ValueError:
+            raise RequestError("Content-Length is not a number") from None
+        if not 0 <= length <= MAX_BODY_BYTES:
+            raise RequestError(f"body larger than {MAX_BODY_BYTES} bytes")
+        return self.rfile.read(length)
+
+    def _failed(self, error: Exception) -> None:
+        log.exception("session panel request failed")
+        with contextlib.suppress(OSError):  # the page went away
+            self._refuse(HTTPStatus.INTERNAL_SERVER_ERROR, f"{type(error).__name__}: {error}")
 
 
-def serve_panel(session, host: str, port: int, meshcat_port: int) -> ThreadingHTTPServer:
+def serve_panel(session, host: str, port: int, meshcat_port: int, *, guard: Guard):
     """Start the panel's server in a daemon thread; returns it (``shutdown()`` stops it).
+
+    Args:
+        host: ``--host`` (IPv6 literals too); guard: the checks every request passes.
 
     Raises:
         OSError: the port is taken or the host unknown.
     """
     seams = seams_page_of(session.file)
     html = page(meshcat_port, seams=seams is not None)
-    handler = type("Handler", (_Handler,), {"session": session, "html": html, "seams": seams})
-    server = ThreadingHTTPServer((host, port), handler)
-    server.daemon_threads = True
+    attributes = {"session": session, "guard": guard, "html": html, "seams": seams}
+    handler = type("Handler", (_Handler,), attributes)
+    server_class = type(
+        "PanelServer",
+        (ThreadingHTTPServer,),
+        {"address_family": family(host), "daemon_threads": True},
+    )
+    server = server_class((bind_address(host), port), handler)
     threading.Thread(target=server.serve_forever, name="session-panel", daemon=True).start()
     return server
