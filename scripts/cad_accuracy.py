@@ -45,51 +45,81 @@ def cylinder_truth(p, chamfer_normal):
 
 
 CASES = [
-    ("plate top loop", "plate", {"loop": {"face_near_mm": [150, 100, 10]}},
-     lambda p: (rounded_rectangle(p, PLATE[2])[0], np.tile([0, 0, 1.0], (len(p), 1))),
-     2 * (PLATE[0] + PLATE[1] - 4 * PLATE_R) + 2 * np.pi * PLATE_R),
-    ("plate bottom chain, side normal", "plate",
-     {"chain": {"near_mm": [[100, 0, 0], [300, 100, 0]]}, "normal": {"face_near_mm": [150, 0, 5]}},
-     lambda p: rounded_rectangle(p, 0.0), PLATE[0] + PLATE[1] - 4 * PLATE_R + np.pi * PLATE_R / 2),
-    ("bracket chain across the fillet", "bracket",
-     {"chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
-      "normal": {"face_near_mm": [12.9289, 30, 12.9289]}},
-     bracket_profile, 160 + 5 * np.pi),
-    ("cylinder rim, chamfer normal", "cylinder",
-     {"loop": {"face_near_mm": [0, 10, 40]},
-      "normal": {"face_near_mm": [33.09, 34.07, 37.5]}},
-     lambda p: cylinder_truth(p, True), 2 * np.pi * 45),
-]  # fmt: skip
+    (
+        "plate top loop",
+        "plate",
+        {"loop": {"face_near_mm": [150, 100, 10]}},
+        lambda p: (rounded_rectangle(p, PLATE[2])[0], np.tile([0, 0, 1.0], (len(p), 1))),
+        2 * (PLATE[0] + PLATE[1] - 4 * PLATE_R) + 2 * np.pi * PLATE_R,
+    ),
+    (
+        "plate bottom chain, side normal",
+        "plate",
+        {
+            "chain": {"near_mm": [[100, 0, 0], [300, 100, 0]]},
+            "normal": {"face_near_mm": [150, 0, 5]},
+        },
+        lambda p: rounded_rectangle(p, 0.0),
+        PLATE[0] + PLATE[1] - 4 * PLATE_R + np.pi * PLATE_R / 2,
+    ),
+    (
+        "bracket chain across the fillet",
+        "bracket",
+        {
+            "chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
+            "normal": {"face_near_mm": [12.9289, 30, 12.9289]},
+        },
+        bracket_profile,
+        160 + 5 * np.pi,
+    ),
+    (
+        "cylinder rim, chamfer normal",
+        "cylinder",
+        {"loop": {"face_near_mm": [0, 10, 40]}, "normal": {"face_near_mm": [33.09, 34.07, 37.5]}},
+        lambda p: cylinder_truth(p, True),
+        2 * np.pi * 45,
+    ),
+]
 
 
 def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="cad_accuracy_"))
     stdout = os.dup(1)
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)  # the STEP writer's banner (C++ stdout)
-    for name, build in (("plate", filleted_plate), ("bracket", l_bracket),
-                        ("cylinder", chamfered_cylinder)):  # fmt: skip
+    for name, build in (
+        ("plate", filleted_plate),
+        ("bracket", l_bracket),
+        ("cylinder", chamfered_cylinder),
+    ):
         shape = build()
         write_step(shape, folder / f"{name}.step")
         write_stl(shape, folder / f"{name}.stl", 0.01)
     sys.stdout.flush()
     os.dup2(stdout, 1)
-    print(f"{'seam':34} {'model':5} {'path mm':>9} {'normal °':>9} {'length %':>9} "
-          f"{'fit→edge mm':>11} {'chord mm':>9}")  # fmt: skip
+    print(
+        f"{'seam':34} {'model':5} {'path mm':>9} {'normal °':>9} {'length %':>9} "
+        f"{'fit→edge mm':>11} {'chord mm':>9}"
+    )
     for label, part, cad, truth, length in CASES:
         for kind, tolerance in (("step", 0.005), ("stl", 0.02)):
             if kind == "stl" and "bottom chain" in label:
                 continue  # a mesh run is the whole outline: no edge ends at the fillets
-            seam = {"cad": cad, "fit_tolerance_mm": tolerance,
-                    "normal_tolerance_deg": 0.05 if kind == "step" else 2.0}  # fmt: skip
+            seam = {
+                "cad": cad,
+                "fit_tolerance_mm": tolerance,
+                "normal_tolerance_deg": 0.05 if kind == "step" else 2.0,
+            }
             file = cad_cell(folder, f"{part}.{kind}", [seam], mesh_units="mm")
             inputs = seam_inputs(load_inputs(file, ROBOTS_DIR), 0)
             fit = fit_path(inputs)
             p, n = sampled(fit)
             distance, outward = truth(p)
-            print(f"{label:34} {kind:5} {distance.max():9.5f} {angle_deg(n, -outward).max():9.4f}"
-                  f" {abs(fit.path.length * 1e3 - length) / length * 100:9.5f}"
-                  f" {fit.normal_fit.edge_max_error_mm:11.5f}"
-                  f" {inputs.points.exact.tolerance_m * 1e3:9.5f}")  # fmt: skip
+            print(
+                f"{label:34} {kind:5} {distance.max():9.5f} {angle_deg(n, -outward).max():9.4f}"
+                f" {abs(fit.path.length * 1e3 - length) / length * 100:9.5f}"
+                f" {fit.normal_fit.edge_max_error_mm:11.5f}"
+                f" {inputs.points.exact.tolerance_m * 1e3:9.5f}"
+            )
 
 
 if __name__ == "__main__":

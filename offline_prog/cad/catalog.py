@@ -75,23 +75,47 @@ def step_catalog(file: Path) -> Catalog:
         near = (
             _mm(interior_point(centres, boundary)) if len(centres) else _mm(model.face_centroids[k])
         )
-        entries.append(Entry("face", k, face_label(model, k).split(" ", 2)[2].strip("()"),
-                             float(model.face_areas[k]), {"face_near_mm": near}, np.array(near),
-                             np.empty((0, 3))))  # fmt: skip
+        entries.append(
+            Entry(
+                "face",
+                k,
+                face_label(model, k).split(" ", 2)[2].strip("()"),
+                float(model.face_areas[k]),
+                {"face_near_mm": near},
+                np.array(near),
+                np.empty((0, 3)),
+            )
+        )
         run = outer_loop(model, k)
         if run:
             loop = sample_run(model, run, k, closed=True, offset_mm=0.0)
-            entries.append(Entry("loop", k, f"outer loop of face {k}, {len(run)} edges",
-                                 loop.length_mm, {"loop": {"face_near_mm": near}},
-                                 loop.p[0], loop.p))  # fmt: skip
+            entries.append(
+                Entry(
+                    "loop",
+                    k,
+                    f"outer loop of face {k}, {len(run)} edges",
+                    loop.length_mm,
+                    {"loop": {"face_near_mm": near}},
+                    loop.p[0],
+                    loop.p,
+                )
+            )
     for number, chain in enumerate(g1_chains(model)):
         points = np.vstack([polylines[e][::-1] if back else polylines[e] for e, back in chain])
         mids = [_mm(polylines[e][len(polylines[e]) // 2]) for e, _ in chain]
         length = float(sum(model.edge_lengths[e] for e, _ in chain))
         edges = ", ".join(str(e) for e, _ in chain)
-        entries.append(Entry("chain", number, f"edges {edges}", length,
-                             {"chain": {"near_mm": mids if len(mids) > 1 else mids * 2}},
-                             points[len(points) // 2], points))  # fmt: skip
+        entries.append(
+            Entry(
+                "chain",
+                number,
+                f"edges {edges}",
+                length,
+                {"chain": {"near_mm": mids if len(mids) > 1 else mids * 2}},
+                points[len(points) // 2],
+                points,
+            )
+        )
     return Catalog(Path(file), entries, vertices, triangles)
 
 
@@ -156,18 +180,36 @@ def mesh_catalog(file: Path, mm_per_unit: float) -> Catalog:
         loops = region_loops(model, k)
         boundary = v[np.concatenate(loops)] if loops else np.empty((0, 3))
         near = _mm(interior_point(mesh.triangles_center[faces], boundary))
-        entries.append(Entry("face", k, f"{len(faces)} triangles", float(area),
-                             {"face_near_mm": near}, np.array(near), np.empty((0, 3))))  # fmt: skip
+        entries.append(
+            Entry(
+                "face",
+                k,
+                f"{len(faces)} triangles",
+                float(area),
+                {"face_near_mm": near},
+                np.array(near),
+                np.empty((0, 3)),
+            )
+        )
         if loops:
             loop = max(loops, key=lambda r: np.linalg.norm(np.diff(v[r], axis=0), axis=1).sum())
             length = float(np.linalg.norm(np.diff(v[loop], axis=0), axis=1).sum())
             keys = {"loop": {"face_near_mm": near}}
-            entries.append(Entry("loop", k, f"outer loop of face {k}", length, keys,
-                                 v[loop[0]], v[loop]))  # fmt: skip
+            entries.append(
+                Entry("loop", k, f"outer loop of face {k}", length, keys, v[loop[0]], v[loop])
+            )
     for number, run in enumerate(model.runs):
         points = v[run]
         third = [_mm(points[len(points) // 3]), _mm(points[2 * len(points) // 3])]
-        entries.append(Entry("chain", number, f"{len(run) - 1} feature edges",
-                             float(model.edge_lengths[number]), {"chain": {"near_mm": third}},
-                             points[len(points) // 2], points))  # fmt: skip
+        entries.append(
+            Entry(
+                "chain",
+                number,
+                f"{len(run) - 1} feature edges",
+                float(model.edge_lengths[number]),
+                {"chain": {"near_mm": third}},
+                points[len(points) // 2],
+                points,
+            )
+        )
     return Catalog(Path(file), entries, np.asarray(v), np.asarray(mesh.faces))

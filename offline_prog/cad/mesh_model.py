@@ -87,9 +87,11 @@ def model_of(mesh) -> MeshModel:
     )
     areas = np.array([mesh.area_faces[c].sum() for c in components])
     centroids = np.array(
-        [(mesh.triangles_center[c] * mesh.area_faces[c, None]).sum(0) / a
-         for c, a in zip(components, areas, strict=True)]
-    )  # fmt: skip
+        [
+            (mesh.triangles_center[c] * mesh.area_faces[c, None]).sum(0) / a
+            for c, a in zip(components, areas, strict=True)
+        ]
+    )
     order = _position_order(centroids)
     face_region = np.empty(len(mesh.faces), dtype=int)
     for number, k in enumerate(order):
@@ -98,10 +100,14 @@ def model_of(mesh) -> MeshModel:
     midpoints = [_midpoint(mesh.vertices[r]) for r in runs]
     runs = [runs[i] for i in _position_order(np.array(midpoints).reshape(-1, 3))]
     return MeshModel(
-        mesh, face_region, areas[order], centroids[order].reshape(-1, 3), runs,
+        mesh,
+        face_region,
+        areas[order],
+        centroids[order].reshape(-1, 3),
+        runs,
         [(int(r[0]), int(r[-1])) for r in runs],
         np.array([np.linalg.norm(np.diff(mesh.vertices[r], axis=0), axis=1).sum() for r in runs]),
-    )  # fmt: skip
+    )
 
 
 def _midpoint(p: np.ndarray) -> np.ndarray:

@@ -84,8 +84,11 @@ def region_loops(model: MeshModel, region: int) -> list[np.ndarray]:
     counts = np.bincount(mesh.edges_unique_inverse, minlength=len(mesh.edges_unique))
     open_edges = np.flatnonzero(counts == 1)
     faces_of_edge = mesh.edges_face[np.isin(mesh.edges_unique_inverse, open_edges)]
-    edges.append(mesh.edges_unique[open_edges][inside[faces_of_edge]] if open_edges.size else
-                 np.empty((0, 2), int))  # fmt: skip
+    edges.append(
+        mesh.edges_unique[open_edges][inside[faces_of_edge]]
+        if open_edges.size
+        else np.empty((0, 2), int)
+    )
     neighbours: dict[int, list[int]] = {}
     for a, b in np.vstack(edges):
         neighbours.setdefault(int(a), []).append(int(b))
@@ -154,8 +157,16 @@ def _samples(model, vertex_runs, region, *, closed, offset_mm, edges) -> SeamSam
         p, n, reference = p[:-1], n[:-1], reference[:-1]
     length = float(np.linalg.norm(np.diff(v[path], axis=0), axis=1).sum())
     tolerance = max(chord_error(v[r]) for r in pieces)
-    return SeamSamples(p - offset_mm * n, n, closed, length, reference, tolerance, tuple(edges),
-                       corners(ends, closed=closed))  # fmt: skip
+    return SeamSamples(
+        p - offset_mm * n,
+        n,
+        closed,
+        length,
+        reference,
+        tolerance,
+        tuple(edges),
+        corners(ends, closed=closed),
+    )
 
 
 def loop_seam(model: MeshModel, face_near_mm, normal_near_mm, *, offset_mm: float, key: str):
@@ -172,8 +183,9 @@ def loop_seam(model: MeshModel, face_near_mm, normal_near_mm, *, offset_mm: floa
     return _samples(model, [loop], normal_region, closed=True, offset_mm=offset_mm, edges=())
 
 
-def chain_seam(model: MeshModel, near_mm, normal_near_mm, *, offset_mm: float, closed: bool,
-               key: str):  # fmt: skip
+def chain_seam(
+    model: MeshModel, near_mm, normal_near_mm, *, offset_mm: float, closed: bool, key: str
+):
     """Whole feature-edge runs from the one nearest the first point to the one nearest
     the last (see :mod:`offline_prog.cad.mesh_model` for what a run is)."""
     if not model.runs:
@@ -191,5 +203,6 @@ def chain_seam(model: MeshModel, near_mm, normal_near_mm, *, offset_mm: float, c
             "or end at (a mesh keeps no tangent edge ends): set closed: true, or use the "
             "STEP model",
         )
-    return _samples(model, vertex_runs, region, closed=closed, offset_mm=offset_mm,
-                    edges=[e for e, _ in run])  # fmt: skip
+    return _samples(
+        model, vertex_runs, region, closed=closed, offset_mm=offset_mm, edges=[e for e, _ in run]
+    )

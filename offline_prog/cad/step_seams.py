@@ -34,8 +34,19 @@ from offline_prog.cad.step_geometry import (
 from offline_prog.cad.step_model import StepModel
 
 SMOOTH_FACES_DEG = 1.0  # faces whose normals differ less across an edge meet smoothly
-SURFACE_KINDS = ("plane", "cylinder", "cone", "sphere", "torus", "Bezier", "B-spline",
-                 "revolution", "extrusion", "offset", "other")  # fmt: skip
+SURFACE_KINDS = (
+    "plane",
+    "cylinder",
+    "cone",
+    "sphere",
+    "torus",
+    "Bezier",
+    "B-spline",
+    "revolution",
+    "extrusion",
+    "offset",
+    "other",
+)
 
 
 def face_label(model: StepModel, k: int) -> str:
@@ -146,12 +157,12 @@ def loop_seam(model: StepModel, face_near_mm, normal_near_mm, *, offset_mm: floa
     normal_face = face
     if normal_near_mm is not None:
         normal_face = pick_face(model, normal_near_mm, f"{key}.normal.face_near_mm")
-    return sample_run(model, outer_loop(model, face), normal_face, closed=True,
-                      offset_mm=offset_mm)  # fmt: skip
+    return sample_run(model, outer_loop(model, face), normal_face, closed=True, offset_mm=offset_mm)
 
 
-def chain_seam(model: StepModel, near_mm, normal_near_mm, *, offset_mm: float, closed: bool,
-               key: str):  # fmt: skip
+def chain_seam(
+    model: StepModel, near_mm, normal_near_mm, *, offset_mm: float, closed: bool, key: str
+):
     """The chain of edges through those nearest the ``near_mm`` points."""
     picked = [pick_edge(model, p, f"{key}.chain.near_mm[{i}]") for i, p in enumerate(near_mm)]
     run = chain(model, picked, key)

@@ -55,8 +55,9 @@ def model_normal(path: ArcLengthPath, normals_P: np.ndarray, tolerance_rad: floa
         spans = np.unique(np.clip(np.searchsorted(breaks, u[off], side="right") - 1, 0, None))
         spans = spans[spans < len(breaks) - 1]
         # the span of each bad point and its neighbours: the error spreads one span
-        spans = np.unique(np.clip(np.concatenate([spans - 1, spans, spans + 1]), 0,
-                                  len(breaks) - 2))  # fmt: skip
+        spans = np.unique(
+            np.clip(np.concatenate([spans - 1, spans, spans + 1]), 0, len(breaks) - 2)
+        )
         middles = (breaks[spans] + breaks[spans + 1]) / 2
         breaks = np.unique(np.concatenate([breaks, middles]))
 

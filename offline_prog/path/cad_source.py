@@ -82,9 +82,13 @@ def cad_samples(file: Path, cell: Cell, key: str = "path"):
                 model, cad.loop.face_near_mm, normal, offset_mm=cad.offset_mm, key=f"{key}.cad"
             )
         return seams.chain_seam(
-            model, cad.chain.near_mm, normal, offset_mm=cad.offset_mm, closed=path.closed,
+            model,
+            cad.chain.near_mm,
+            normal,
+            offset_mm=cad.offset_mm,
+            closed=path.closed,
             key=f"{key}.cad",
-        )  # fmt: skip
+        )
     except ModelError as error:
         raise InputError(file, model_key, f"{name}: {error}") from None
     except PickError as error:

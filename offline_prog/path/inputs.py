@@ -193,9 +193,13 @@ def _check_cad_fit(file: Path, cell: Cell, points, path: ArcLengthPath, angles) 
     worst = int(np.argmax(angles))
     edge_max, edge_rms = path_to_reference(points.exact, path)
     fit = NormalFit(
-        "cad", float(angles[worst]), float(np.sqrt(np.mean(angles**2))), None,
-        edge_max * 1e3, edge_rms * 1e3,
-    )  # fmt: skip
+        "cad",
+        float(angles[worst]),
+        float(np.sqrt(np.mean(angles**2))),
+        None,
+        edge_max * 1e3,
+        edge_rms * 1e3,
+    )
     tolerance = cell.path.normal_tolerance_deg
     if fit.max_error_deg > tolerance:
         at = np.round(points.p_PR[worst] * 1e3, 2).tolist()

@@ -36,16 +36,36 @@ def _label(scene: StaticScene, path: str, text: str, p_I: np.ndarray, size: floa
             "path": path,
             "object": {
                 "metadata": {"version": 4.5, "type": "Object"},
-                "textures": [{"uuid": texture, "type": "_text", "text": text,
-                              "font_size": LABEL_FONT_PX, "font_face": "sans-serif"}],
-                "materials": [{"uuid": material, "type": "SpriteMaterial", "map": texture,
-                               "transparent": True, "depthTest": False, "color": 0xFFFFFF,
-                               "sizeAttenuation": False}],
-                "object": {"uuid": f"{path}#o", "type": "Sprite", "material": material,
-                           "matrix": matrix.T.ravel().tolist(), "renderOrder": 10},
+                "textures": [
+                    {
+                        "uuid": texture,
+                        "type": "_text",
+                        "text": text,
+                        "font_size": LABEL_FONT_PX,
+                        "font_face": "sans-serif",
+                    }
+                ],
+                "materials": [
+                    {
+                        "uuid": material,
+                        "type": "SpriteMaterial",
+                        "map": texture,
+                        "transparent": True,
+                        "depthTest": False,
+                        "color": 0xFFFFFF,
+                        "sizeAttenuation": False,
+                    }
+                ],
+                "object": {
+                    "uuid": f"{path}#o",
+                    "type": "Sprite",
+                    "material": material,
+                    "matrix": matrix.T.ravel().tolist(),
+                    "renderOrder": 10,
+                },
             },
         }
-    )  # fmt: skip
+    )
 
 
 def seams_html(catalog) -> str:
@@ -103,8 +123,11 @@ def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
     for entry in catalog.entries:
         name = f"{PREFIX[entry.kind]}{entry.number}"
         keys = str(entry.keys).replace("'", "")
-        say(f"  {entry.kind:<5} {name:<4} {entry.size:10.2f} {unit[entry.kind]:<3}  "
-            f"{entry.description:<40} cad: {keys}", highlight=False)  # fmt: skip
+        say(
+            f"  {entry.kind:<5} {name:<4} {entry.size:10.2f} {unit[entry.kind]:<3}  "
+            f"{entry.description:<40} cad: {keys}",
+            highlight=False,
+        )
     part = Path(part)
     out = Path(out) if out is not None else part.with_name(f"{part.stem}_seams.html")
     out.write_text(seams_html(catalog))

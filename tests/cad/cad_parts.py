@@ -125,8 +125,10 @@ def cad_cell(tmp_path: Path, model: str, seams: list[dict], **part) -> Path:
     100 mm below the flange) whose part is ``model`` and whose seams are ``seams``
     (each a dict with a ``cad`` block)."""
     part = {"model": model, **part}
-    seams = [{"name": f"s{k}", "fit_tolerance_mm": 0.005, "normal_tolerance_deg": 0.05, **s}
-             for k, s in enumerate(seams)]  # fmt: skip
+    seams = [
+        {"name": f"s{k}", "fit_tolerance_mm": 0.005, "normal_tolerance_deg": 0.05, **s}
+        for k, s in enumerate(seams)
+    ]
     text = (
         PLACEMENT
         + "part:\n  X_PE: {translation: [0, 0, 0.1], rotation: !Rpy {deg: [180, 0, 0]}}\n"

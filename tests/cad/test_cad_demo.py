@@ -31,8 +31,9 @@ def test_the_seams_are_the_model_edges():
     np.testing.assert_allclose(rim.normals_P, [[0, 0, 1]] * len(rim.normals_P), atol=1e-12)
     # the chamfer's normal, into the part: up and inwards at 45° on the straight part
     middle = np.abs(bead.p_PR[:, 0]) < 0.1
-    np.testing.assert_allclose(bead.normals_P[middle], [[0, 2**-0.5, 2**-0.5]] * middle.sum(),
-                               atol=1e-9)  # fmt: skip
+    np.testing.assert_allclose(
+        bead.normals_P[middle], [[0, 2**-0.5, 2**-0.5]] * middle.sum(), atol=1e-9
+    )
     assert rim.exact.corners == () and bead.exact.corners == ()  # one G1 seam each
 
 
@@ -56,8 +57,11 @@ def test_the_demo_plans_exports_and_previews(tmp_path):
     out = tmp_path / "plan"
     done = subprocess.run(
         [sys.executable, "-m", "offline_prog", "plan", str(CELL), "--out", str(out)],
-        capture_output=True, text=True, cwd=REPO, timeout=900,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=900,
+    )
     assert done.returncode == 0, done.stderr
     report = json.loads((out / "report.json").read_text())
     assert report["feasible"]
@@ -69,10 +73,22 @@ def test_the_demo_plans_exports_and_previews(tmp_path):
         assert seam["path"]["cad"]["corners"] == []
     assert (out / "preview.html").stat().st_size > 100_000  # the scene, robot and part
     exported = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "export", str(out), "--format", "csv",
-         "--out", str(tmp_path / "csv")],
-        capture_output=True, text=True, cwd=REPO, timeout=300,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "export",
+            str(out),
+            "--format",
+            "csv",
+            "--out",
+            str(tmp_path / "csv"),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=300,
+    )
     assert exported.returncode == 0, exported.stderr
     assert (tmp_path / "csv" / "joint_trajectory.csv").is_file()
 

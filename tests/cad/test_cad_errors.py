@@ -73,8 +73,12 @@ def test_a_chain_whose_edges_do_not_connect(tmp_path):
     builder.Add(compound, BRepPrimAPI_MakeBox(100, 100, 10).Shape())
     builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(200, 0, 0), 100, 100, 10).Shape())
     write_step(compound, tmp_path / "two.step")
-    seam = {"cad": {"chain": {"near_mm": [[50, 0, 10], [250, 0, 10]]},
-                    "normal": {"face_near_mm": [50, 50, 10]}}}  # fmt: skip
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[50, 0, 10], [250, 0, 10]]},
+            "normal": {"face_near_mm": [50, 50, 10]},
+        }
+    }
     error = seam_error(tmp_path, "two.step", seam)
     assert error.key == "seams[0].cad.chain.near_mm"
     assert "do not connect" in error.reason

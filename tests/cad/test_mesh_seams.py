@@ -58,8 +58,12 @@ def test_plate_top_loop_from_the_mesh_is_the_step_loop(parts):
 def test_bracket_chain_from_the_mesh_runs_between_the_same_corners(parts):
     """A mesh keeps no tangent edge boundaries: the chain is the whole run of feature
     edges between corners, which here is the STEP chain's three edges."""
-    seam = {"cad": {"chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
-                    "normal": {"face_near_mm": [20 - 7.0711, 30, 20 - 7.0711]}}}  # fmt: skip
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
+            "normal": {"face_near_mm": [20 - 7.0711, 30, 20 - 7.0711]},
+        }
+    }
     (exact, mesh), (_, step) = (
         fitted(parts, "bracket.stl", seam),
         fitted(parts, "bracket.step", seam),
@@ -74,8 +78,12 @@ def test_bracket_chain_from_the_mesh_runs_between_the_same_corners(parts):
 
 def test_a_mesh_without_the_chosen_feature(tmp_path):
     trimesh.creation.icosphere(subdivisions=4, radius=50.0).export(tmp_path / "ball.stl")
-    seam = {"cad": {"chain": {"near_mm": [[50, 0, 0], [0, 50, 0]]},
-                    "normal": {"face_near_mm": [50, 0, 0]}}}  # fmt: skip
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[50, 0, 0], [0, 50, 0]]},
+            "normal": {"face_near_mm": [50, 0, 0]},
+        }
+    }
     file = cad_cell(tmp_path, "ball.stl", [seam], mesh_units="mm")
     with pytest.raises(InputError) as error:
         seam_inputs(load_inputs(file, ROBOTS_DIR), 0)

@@ -56,8 +56,16 @@ def test_a_listed_loop_plans_as_listed(plate, capsys, tmp_path):
 
 
 def test_a_mesh_lists_its_regions_and_feature_runs(plate, capsys, tmp_path):
-    code = main(["seams", str(plate.with_suffix(".stl")), "--mesh-units", "mm",
-                 "--out", str(tmp_path / "mesh.html")])  # fmt: skip
+    code = main(
+        [
+            "seams",
+            str(plate.with_suffix(".stl")),
+            "--mesh-units",
+            "mm",
+            "--out",
+            str(tmp_path / "mesh.html"),
+        ]
+    )
     lines = capsys.readouterr().out.splitlines()
     assert code == 0
     # top, bottom, 4 sides and 4 fillets form 2 + 1 regions (sides and fillets join

@@ -28,8 +28,11 @@ LENGTH_TOL_REL = 1e-4
 @pytest.fixture(scope="module")
 def parts(tmp_path_factory):
     folder = tmp_path_factory.mktemp("parts")
-    for name, build in (("plate", filleted_plate), ("bracket", l_bracket),
-                        ("cylinder", chamfered_cylinder)):  # fmt: skip
+    for name, build in (
+        ("plate", filleted_plate),
+        ("bracket", l_bracket),
+        ("cylinder", chamfered_cylinder),
+    ):
         write_step(build(), folder / f"{name}.step")
     return folder
 
@@ -84,8 +87,12 @@ def test_plate_top_loop_with_the_top_face_normal(parts):
 def test_plate_bottom_chain_round_a_fillet_keeps_the_side_normal(parts):
     """Three edges (line, fillet arc, line) joined G1: one seam; the side face's
     normal follows the fillet (the faces tangent to it)."""
-    seam = {"cad": {"chain": {"near_mm": [[100, 0, 0], [300, 100, 0]]},
-                    "normal": {"face_near_mm": [150, 0, 5]}}}  # fmt: skip
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[100, 0, 0], [300, 100, 0]]},
+            "normal": {"face_near_mm": [150, 0, 5]},
+        }
+    }
     (fit,) = fitted_seams(parts, "plate.step", [seam])
     p, n = sampled(fit)
     distance, outward = rounded_rectangle(p, 0.0)
@@ -119,8 +126,12 @@ def bracket_profile(p_mm):
 
 
 def test_bracket_chain_across_the_fillet_between_its_legs(parts):
-    seam = {"cad": {"chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
-                    "normal": {"face_near_mm": [20 - 7.0711, 30, 20 - 7.0711]}}}  # fmt: skip
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[60, 0, 10], [10, 0, 60]]},
+            "normal": {"face_near_mm": [20 - 7.0711, 30, 20 - 7.0711]},
+        }
+    }
     (fit,) = fitted_seams(parts, "bracket.step", [seam])
     p, n = sampled(fit)
     distance, outward = bracket_profile(p)
@@ -135,10 +146,14 @@ def test_cylinder_rim_loop_with_the_chamfer_normal(parts):
     on_chamfer = (radius - chamfer / 2) * np.array([np.cos(0.8), np.sin(0.8), 0.0])
     on_chamfer[2] = height - chamfer / 2
     seams = [
-        {"cad": {"loop": {"face_near_mm": [0, 10, height]},
-                 "normal": {"face_near_mm": on_chamfer.tolist()}}},
+        {
+            "cad": {
+                "loop": {"face_near_mm": [0, 10, height]},
+                "normal": {"face_near_mm": on_chamfer.tolist()},
+            }
+        },
         {"cad": {"loop": {"face_near_mm": [0, 10, height]}}},
-    ]  # fmt: skip
+    ]
     chamfered, top = fitted_seams(parts, "cylinder.step", seams)
     for fit in (chamfered, top):
         p, n = sampled(fit)
@@ -166,7 +181,11 @@ def test_a_sharp_corner_is_a_corner_and_a_cusp_as_for_any_path(tmp_path):
     inputs = load_inputs(file, ROBOTS_DIR)
     corners = inputs.points.exact.corners
     assert sorted(tuple(np.round(p * 1e3, 6)) for p, _ in corners) == [
-        (0, 0, 10), (0, 200, 10), (300, 0, 10), (300, 200, 10)]  # fmt: skip
+        (0, 0, 10),
+        (0, 200, 10),
+        (300, 0, 10),
+        (300, 200, 10),
+    ]
     assert [turn for _, turn in corners] == pytest.approx([90.0] * 4)
     fit = fit_path(inputs)
     cusps = flange_paths(inputs, fit).cusps
@@ -184,9 +203,14 @@ def test_offset_moves_the_seam_along_the_normal(parts):
     exact reference moves with it (the fit error is still against the moved edge)."""
     seams = [
         {"cad": {"loop": {"face_near_mm": [150, 100, 10]}, "offset_mm": -1.0}},
-        {"cad": {"chain": {"near_mm": [[100, 0, 0], [100, 0, 0]]},
-                 "normal": {"face_near_mm": [150, 0, 5]}, "offset_mm": 2.0}},
-    ]  # fmt: skip
+        {
+            "cad": {
+                "chain": {"near_mm": [[100, 0, 0], [100, 0, 0]]},
+                "normal": {"face_near_mm": [150, 0, 5]},
+                "offset_mm": 2.0,
+            }
+        },
+    ]
     lifted, inside = fitted_seams(parts, "plate.step", seams)
     p, _ = sampled(lifted)
     assert rounded_rectangle(p, PLATE[2] + 1.0)[0].max() < PATH_TOL_MM
