@@ -89,3 +89,23 @@ def test_a_mesh_without_the_chosen_feature(tmp_path):
         seam_inputs(load_inputs(file, ROBOTS_DIR), 0)
     assert error.value.key == "seams[0].cad.chain.near_mm"
     assert "no feature edges" in error.value.reason
+
+
+def test_a_chain_on_a_closed_run_of_a_mesh_asks_for_closed(parts):
+    """The plate's bottom outline is one run of feature edges with no corner (a mesh
+    keeps no tangent edge ends): as a chain it is the whole outline, closed."""
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[100, 0, 0], [300, 100, 0]]},
+            "normal": {"face_near_mm": [150, 0, 5]},
+        }
+    }
+    file = cad_cell(parts, "plate.stl", [seam], mesh_units="mm")
+    with pytest.raises(InputError) as error:
+        seam_inputs(load_inputs(file, ROBOTS_DIR), 0)
+    assert error.value.key == "seams[0].closed" and "closed run" in error.value.reason
+    exact, fit = fitted(parts, "plate.stl", {**seam, "closed": True})
+    perimeter = 2 * (PLATE[0] + PLATE[1] - 4 * 20.0) + 2 * np.pi * 20.0
+    assert exact.closed and fit.path.length * 1e3 == pytest.approx(perimeter, rel=1e-4)
+    p, _ = sampled(fit)
+    assert rounded_rectangle(p, 0.0)[0].max() < exact.tolerance_m * 1e3 + FIT_MM
