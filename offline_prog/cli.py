@@ -202,6 +202,11 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "robots":
             _run_robots(args, console)
             return 0
+        if args.command == "seams":
+            from offline_prog.viz.seams_page import run_seams
+
+            run_seams(args.part, args.out, args.mesh_units, say=console.print)
+            return 0
         if args.command == "session":
             from offline_prog.session.launch import run_session
 

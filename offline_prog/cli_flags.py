@@ -101,6 +101,7 @@ def parser() -> argparse.ArgumentParser:
     )
     _session_flags(commands)
     _place_flags(commands)
+    _seams_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
@@ -244,3 +245,17 @@ def _import_flags(robot_commands) -> None:
         default=10_000, help="self-collision configurations (10000)",
     )  # fmt: skip
     imp.add_argument("--force", action="store_true", help="replace an existing robot folder")
+
+
+def _seams_flags(commands) -> None:
+    """``seams PART.step|PART.stl [--out seams.html] [--mesh-units m|mm]``."""
+    seams = commands.add_parser(
+        "seams", help="list a part model's faces, loops and edge chains; write a 3D page"
+    )
+    seams.add_argument("part", type=Path, help="STEP (.step, .stp) or mesh (.stl, .obj, .ply)")
+    seams.add_argument(
+        "--out", type=Path, default=None, help="the page (default: <part>_seams.html beside it)"
+    )
+    seams.add_argument(
+        "--mesh-units", choices=("m", "mm"), default="m", help="a mesh file's unit (default m)"
+    )

@@ -15,6 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform
 
 from offline_prog.config import safe_yaml
+from offline_prog.config.cad_keys import CadSeamConfig
 from offline_prog.config.typed_check import check_mapping
 from offline_prog.errors import InputError
 
@@ -99,7 +100,8 @@ class PartConfig:
     X_PE: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
     name: str = "part"
     mesh: str | None = None  # STL/OBJ/PLY in P, relative to the cell file
-    mesh_units: str = "m"
+    mesh_units: str = "m"  # of mesh, and of model when it is a mesh
+    model: str | None = None  # STEP or STL/OBJ/PLY: seams (cad:), collision and visual
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
     mass_kg: float | None = None  # payload: the part's mass ...
     center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
@@ -131,7 +133,7 @@ class AnalyticPath:
 
 @dataclasses.dataclass
 class PathConfig:
-    units: str = required()  # m | mm
+    units: str | None = None  # m | mm; required except for cad: (config.cad_keys)
     closed: bool = False  # a closed contour (periodic spline); its ends: path.closing
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
@@ -139,6 +141,7 @@ class PathConfig:
     dxf_entity: int | None = None  # which path entity (0-based) when the DXF has several
     csv_seam: str | None = None  # rows of this seam (CSV seam column); seams: its name
     analytic: AnalyticPath | None = None
+    cad: CadSeamConfig | None = None  # edges and faces of part.model (config.cad_keys)
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5

@@ -28,15 +28,19 @@ from offline_prog.path.process_frames import (
 class NormalFit:
     """How far the fitted normal field is from the given normals [deg].
 
-    source: "points" (CSV nx,ny,nz: measured), "constant" (path.normal: exact, 0) or
-    "mesh" (part.mesh: not measured, None). worst_row: 1-based CSV data row of the
-    largest angle (row 1 is the first point after the header), or None.
+    source: "points" (CSV nx,ny,nz: measured), "constant" (path.normal: exact, 0),
+    "mesh" (part.mesh: not measured, None) or "cad" (the model's faces at the fit's
+    points: measured). worst_row: 1-based CSV data row of the largest angle (row 1 is
+    the first point after the header), or None. edge_max_error_mm, edge_rms_error_mm:
+    for a cad: seam, the fitted path's distance from the model's exact seam [mm].
     """
 
     source: str
     max_error_deg: float | None
     rms_error_deg: float | None
     worst_row: int | None = None
+    edge_max_error_mm: float | None = None
+    edge_rms_error_mm: float | None = None
 
 
 def _error(file, key, reason) -> InputError:
@@ -85,6 +89,10 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     path = cell.path
     if path.analytic is not None:
         return _analytic_points(file, cell)
+    if path.cad is not None:  # Open CASCADE (seconds to import) only for these
+        from offline_prog.path.cad_source import cad_points
+
+        return cad_points(file, cell)
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
     close_tolerance_m = path.fit_tolerance_mm * 1e-3
     try:
@@ -137,6 +145,10 @@ def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
         )
     if cell.path.normal is not None:
         return constant_normal(np.asarray(cell.path.normal, float))
+    if points.exact is not None:  # a cad: seam: exact normals, fitted to tolerance
+        from offline_prog.path.cad_normal import model_normal
+
+        return model_normal(path, points.normals_P, np.deg2rad(cell.path.normal_tolerance_deg))
     if points.normals_P is not None:
         return spline_normal(path, points.normals_P)
     import trimesh
@@ -157,6 +169,8 @@ def check_normal_fit(file: Path, cell: Cell, points, path: ArcLengthPath, field)
     if points.normals_P is None:
         return NormalFit("mesh", None, None)
     angles = np.rad2deg(normal_fit_angles(path, points.normals_P, field))
+    if points.exact is not None:
+        return _check_cad_fit(file, cell, points, path, angles)
     worst = int(np.argmax(angles))
     row = int(points.rows[worst] if points.rows is not None else worst) + 1
     fit = NormalFit("points", float(angles[worst]), float(np.sqrt(np.mean(angles**2))), row)
@@ -168,5 +182,32 @@ def check_normal_fit(file: Path, cell: Cell, points, path: ArcLengthPath, field)
             f"the fitted surface normal is {fit.max_error_deg:.2f}° off the normal given at "
             f"row {row} of {cell.path.points} (file line {row + 1}), more than {tolerance:g}° "
             f"(RMS {fit.rms_error_deg:.2f}°): check the normals near that row",
+        )
+    return fit
+
+
+def _check_cad_fit(file: Path, cell: Cell, points, path: ArcLengthPath, angles) -> NormalFit:
+    """A cad: seam's fit: normals against the model's, the path against the exact seam."""
+    from offline_prog.path.exact_seam import path_to_reference
+
+    worst = int(np.argmax(angles))
+    edge_max, edge_rms = path_to_reference(points.exact, path)
+    fit = NormalFit(
+        "cad",
+        float(angles[worst]),
+        float(np.sqrt(np.mean(angles**2))),
+        None,
+        edge_max * 1e3,
+        edge_rms * 1e3,
+    )
+    tolerance = cell.path.normal_tolerance_deg
+    if fit.max_error_deg > tolerance:
+        at = np.round(points.p_PR[worst] * 1e3, 2).tolist()
+        raise _error(
+            file,
+            "path.normal_tolerance_deg",
+            f"the fitted surface normal is {fit.max_error_deg:.2f}° off the model's at "
+            f"{at} mm, more than {tolerance:g}°: the normal turns faster than the fit "
+            "follows (lower path.fit_tolerance_mm, or pick another normal face)",
         )
     return fit

@@ -24,12 +24,14 @@ CURVE_SAMPLE_SPACING_M = 1e-3
 @dataclasses.dataclass(frozen=True)
 class PathPoints:
     """Points on the part: p_PR (N, 3) in P [m]; normals_P (N, 3) unit or None;
-    rows (N,) each point's 0-based data row in its source (repeats dropped)."""
+    rows (N,) each point's 0-based data row in its source (repeats dropped); exact: the
+    seam on the part's model (path.exact_seam.ExactSeam) for a cad: seam, else None."""
 
     p_PR: np.ndarray
     normals_P: np.ndarray | None
     closed: bool
     rows: np.ndarray | None = None
+    exact: object | None = None
 
 
 def clean_points(p, normals, *, closed: bool) -> PathPoints:

@@ -8,7 +8,10 @@ from), the controls and the status line on the right. The API:
 - ``GET /status``: :meth:`Session.snapshot` (the page polls it);
 - ``POST /set`` ``{"key": ..., "value": "typed text"}``: a control's new value;
 - ``POST /action`` ``{"name": "plan" | "save" | "export" | "play" | "pause" | "seek" |
-  "auto", "value": ...}``.
+  "auto", "value": ...}``;
+- ``GET /seams``: for a cell with ``part.model``, the page of ``offline-prog seams`` on
+  it (the model's faces, loops and chains with the numbers its ``cad:`` seams pick by),
+  linked from the panel.
 
 Every request passes the :mod:`~offline_prog.session.guard` checks first (403 if not:
 Host, Origin, token; 415 for a POST that is not ``application/json``); a body or value
@@ -37,15 +40,38 @@ PAGES = ("/", "/index.html")
 KEYS = {"/set": ("key", "value"), "/action": ("name", "value")}  # what each POST takes
 
 
-def page(meshcat_port: int) -> bytes:
+SEAMS_LINK = (
+    '<a id="seams" href="/seams" target="_blank" title="the part model\'s faces (F), loops '
+    '(L) and edge chains (C) by the numbers offline-prog seams lists">model seams</a>'
+)
+
+
+def page(meshcat_port: int, *, seams: bool = False) -> bytes:
+    """The panel page; with a link to the model's seams page when ``seams``."""
     text = resources.files("offline_prog.session").joinpath("assets/panel.html").read_text()
+    text = text.replace("__SEAMS_LINK__", SEAMS_LINK if seams else "")
     return text.replace("__MESHCAT_PORT__", str(int(meshcat_port))).encode()
+
+
+def seams_page_of(cell_file) -> bytes | None:
+    """The seams page of the cell's ``part.model`` (None without one)."""
+    from pathlib import Path
+
+    from offline_prog.config.cell import load_cell
+    from offline_prog.viz.seams_page import model_catalog, seams_html
+
+    cell = load_cell(cell_file)
+    if cell.part.model is None:
+        return None
+    model = Path(cell_file).parent / cell.part.model
+    return seams_html(model_catalog(model, cell.part.mesh_units)).encode()
 
 
 class _Handler(BaseHTTPRequestHandler):
     session = None  # set on the subclass made by serve_panel
     guard: Guard | None = None
     html = b""
+    seams: bytes | None = None  # the model's seams page, made at start
 
     def log_message(self, format, *args):  # noqa: A002  (quiet: the terminal is the user's)
         pass
@@ -69,7 +95,7 @@ class _Handler(BaseHTTPRequestHandler):
     def _checked(self) -> bool:
         """Host, Origin and token (see guard); False after a 403."""
         reason = self.guard.refusal(self.path, self.headers)
-        if reason is not None and urlsplit(self.path).path in PAGES:  # a person reads it
+        if reason is not None and urlsplit(self.path).path in (*PAGES, "/seams"):  # a person
             self._send(HTTPStatus.FORBIDDEN, f"refused: {reason}\n".encode(), "text/plain")
         elif reason is not None:
             self._refuse(HTTPStatus.FORBIDDEN, f"refused: {reason}")
@@ -84,6 +110,8 @@ class _Handler(BaseHTTPRequestHandler):
                 self._send(HTTPStatus.OK, self.html, "text/html; charset=utf-8")
             elif path == "/status":
                 self._json(self.session.snapshot())
+            elif path == "/seams" and self.seams is not None:
+                self._send(HTTPStatus.OK, self.seams, "text/html; charset=utf-8")
             else:
                 self._refuse(HTTPStatus.NOT_FOUND, "not found")
         except Exception as error:  # one line to the page, never a traceback here
@@ -145,7 +173,9 @@ def serve_panel(session, host: str, port: int, meshcat_port: int, *, guard: Guar
     Raises:
         OSError: the port is taken or the host unknown.
     """
-    attributes = {"session": session, "guard": guard, "html": page(meshcat_port)}
+    seams = seams_page_of(session.file)
+    html = page(meshcat_port, seams=seams is not None)
+    attributes = {"session": session, "guard": guard, "html": html, "seams": seams}
     handler = type("Handler", (_Handler,), attributes)
     server_class = type(
         "PanelServer",
