@@ -26,7 +26,7 @@ import numpy as np
 
 from offline_prog.atomic import atomic_stream
 from offline_prog.export.program import PLAN_FILE, ProgramData
-from offline_prog.io_events import IoEvent, ProcessIo
+from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 JOB_FILE = "job.npz"
 
@@ -89,6 +89,10 @@ class JobProgramData:
     @property
     def language(self) -> str | None:
         return self.job.language
+
+    def seam_events(self, seam: str, signal: Signal = Signal.DIGITAL) -> list[IoEvent]:
+        """The events of one seam and output kind, in time order."""
+        return [e for e in self.events if e.seam == seam and e.signal is signal]
 
     def load_robot(self):
         """The job's RobotModel (ProgramData.load_robot)."""
