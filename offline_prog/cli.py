@@ -85,7 +85,7 @@ def _serve_preview(plan, args, console: Console) -> None:
     """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
     from pydrake.geometry import Meshcat, MeshcatParams
 
-    from offline_prog.plan import JobPlan
+    from offline_prog.job.records import JobPlan
     from offline_prog.viz.job_preview import show_job
     from offline_prog.viz.preview import near_collision_mask, show_plan
 
@@ -197,12 +197,10 @@ def main(argv: list[str] | None = None) -> int:
         return code
 
     try:
-        from offline_prog.config.cell import load_cell
-        from offline_prog.job.seams import is_job as job_cell
-        from offline_prog.plan import plan_cell, plan_job
+        from offline_prog.plan import plan_job
         from offline_prog.results.job_folder import write_job_outputs
-        from offline_prog.results.plan_folder import check_out_dir, write_outputs
-        from offline_prog.results.summary import print_job_summary, print_summary
+        from offline_prog.results.plan_folder import check_out_dir
+        from offline_prog.results.summary import print_job_summary
 
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
@@ -228,17 +226,13 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
-        is_job = job_cell(load_cell(args.cell))  # seams:, or path: with job:
-        with errors.status("planning") as status:
-            plan = (plan_job if is_job else plan_cell)(
-                args.cell, progress=lambda stage: status.update(stage)
-            )
+        with errors.status("planning") as status:  # every cell is a job (path: one seam)
+            plan = plan_job(args.cell, progress=lambda stage: status.update(stage))
             status.update("writing outputs")
             if args.command == "plan":
-                files, report = (write_job_outputs if is_job else write_outputs)(plan, out)
+                files, report = write_job_outputs(plan, out)
         if args.command == "plan":
-            summary = print_job_summary if is_job else print_summary
-            summary(console, report, files, time.perf_counter() - started)
+            print_job_summary(console, report, files, time.perf_counter() - started)
         if args.preview:
             _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs

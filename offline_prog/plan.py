@@ -20,20 +20,16 @@ still written).
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
-
 from offline_prog.collision.avoidance import Attempt
-from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
-from offline_prog.config.cell import Cell
-from offline_prog.errors import Failure, InputError, PlanFailedError
-from offline_prog.job.assemble import JobSamples, lay_out
-from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
+from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.job.assemble import lay_out
+from offline_prog.job.process_io import IoPlacementError, io_columns
+from offline_prog.job.records import JobPlan, Plan
 from offline_prog.job.stages import (
     check_job,
     choose_order,
@@ -42,15 +38,8 @@ from offline_prog.job.stages import (
     seam_options,
     tool_speed,
 )
-from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.joints.path_timing import without_joint_limits
-from offline_prog.path.arc_length import ArcLengthPath
-from offline_prog.path.bspline_fit import FittedSpline
-from offline_prog.path.cusps import Cusp, SmoothedFlangePath
-from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.path.inputs import NormalFit
-from offline_prog.path.sources import PathPoints
-from offline_prog.robot.model import ROBOTS_DIR, RobotModel
+from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import (
     FittedPath,
@@ -64,47 +53,6 @@ from offline_prog.stages import (
     load_inputs,
     with_normal_hint,
 )
-from offline_prog.timing.trajectory import WorkspaceTrajectory
-
-
-@dataclasses.dataclass
-class Plan:
-    """Everything a plan produced, for the writers and the tests."""
-
-    cell_file: Path
-    cell: Cell
-    points: PathPoints
-    fitted: FittedSpline
-    path: ArcLengthPath
-    flange: FlangePath | SmoothedFlangePath
-    trajectory: WorkspaceTrajectory
-    cusps: list[Cusp]
-    timings_s: dict[str, float]
-    robot: RobotModel
-    joints: JointTrajectory
-    nominal_duration_s: float
-    tool_rotation_rad: float
-    collisions: CollisionResult
-    avoidance: dict | None = None  # what the collision avoidance tried and changed
-    # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
-    clearance_profile: tuple | None = None
-    normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
-
-    @property
-    def feasible(self) -> bool:
-        """Every check passed (collision-free at the clearance)."""
-        return self.collisions.collision_free
-
-    @property
-    def failure(self) -> str:
-        """Why the plan failed, one line ("" if it did not)."""
-        return self.collisions.message
-
-    @property
-    def failure_kind(self) -> Failure | None:
-        """The Failure of a finished plan that fails a check (a collision), or None.
-        Failures that leave no plan (reach, limits, singularities) are PlanFailedErrors."""
-        return None if self.feasible else Failure.COLLISION
 
 
 def plan_cell(
@@ -146,12 +94,14 @@ class StageTimer:
         return result
 
 
-def plan_seam(inputs: Inputs, scene: DrakeCell, stage: StageTimer) -> Plan:
+def plan_seam(
+    inputs: Inputs, scene: DrakeCell, stage: StageTimer, *, clearance_profile: bool = True
+) -> Plan:
     """The single-seam pipeline on loaded inputs and a built scene: fit, frames, joints,
-    collision avoidance, clearance profile (paper §§2–4)."""
+    collision avoidance, clearance profile unless told not to (paper §§2–4)."""
     fit = stage("fit", "fitting the B-spline", fit_path, inputs)
     flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
-    return plan_flanges(inputs, scene, fit, flanges, stage)
+    return plan_flanges(inputs, scene, fit, flanges, stage, clearance_profile=clearance_profile)
 
 
 def plan_flanges(
@@ -200,56 +150,6 @@ def plan_flanges(
     )
 
 
-@dataclasses.dataclass
-class JobPlan:
-    """A whole job: the seams as run (each a :class:`Plan`), the links, and the job's
-    samples with named segments, process I/O and the whole job's collision check."""
-
-    cell_file: Path
-    cell: Cell
-    robot: RobotModel
-    q_home: np.ndarray  # (6,) [rad]
-    options: list  # every seam option planned (job.stages.SeamOption), by seam
-    chosen: list  # the options run, in order
-    order: object  # job.order.JobOrder
-    links: list  # job.links.LinkMotion, in order (home → first, …, last → home)
-    samples: JobSamples
-    tcp_speed: np.ndarray  # (N,) speed of the tool along the part [m/s]
-    io: IoColumns
-    collisions: CollisionResult
-    timings_s: dict[str, float]
-
-    avoidance = None  # per seam, in each seam's report
-
-    @property
-    def seams(self) -> list[Plan]:
-        return [option.plan for option in self.chosen]
-
-    @property
-    def feasible(self) -> bool:
-        return (
-            self.collisions.collision_free
-            and all(p.feasible for p in self.seams)
-            and all(link.ok for link in self.links)
-        )
-
-    @property
-    def failure(self) -> str:
-        failed = next((link for link in self.links if not link.ok), None)
-        if failed is not None:
-            return failed.failure.reason
-        if self.collisions.collision_free:
-            failed = (o for o in self.chosen if not o.plan.feasible)
-            return next((f"seam {o.name}: {o.plan.failure}" for o in failed), "")
-        at = self.collisions.first_contact or self.collisions.closest
-        where = "" if at is None else f"{self.samples.segment_at(at.t_s).label}: "
-        return where + self.collisions.message
-
-    @property
-    def failure_kind(self) -> Failure | None:
-        return None if self.feasible else Failure.COLLISION
-
-
 def plan_job(
     cell_file: str | Path,
     *,
@@ -269,14 +169,37 @@ def plan_job(
     return plan_loaded_job(inputs, stage)
 
 
-def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
-    """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory)."""
+def plan_loaded_job(
+    inputs: Inputs,
+    stage: StageTimer,
+    *,
+    clearance_profile: bool = True,
+    fits: dict[tuple[int, bool], FittedPath] | None = None,
+) -> JobPlan:
+    """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory).
+
+    Args:
+        clearance_profile: compute the whole job's clearance profile (clearance.csv).
+        fits: (seam index, reversed) ↦ the seam's fitted path, kept by the caller: a
+            fit found here is used, one computed here is added (a path on the part does
+            not change with the placement).
+    """
     progress = stage.progress
     scene = stage("scene", "building the Drake cell", build_scene, inputs)
     q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
+    fits = {} if fits is None else fits
 
-    def one_seam(seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
-        return plan_seam(seam_inputs, seam_scene, StageTimer(progress))
+    def one_seam(k: int, reverse: bool, seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
+        seam_stage = StageTimer(progress)
+        if (k, reverse) not in fits:
+            fits[k, reverse] = seam_stage("fit", "fitting the B-spline", fit_path, seam_inputs)
+        fit = fits[k, reverse]
+        flanges = seam_stage(
+            "frames", "process frames and flange path", flange_paths, seam_inputs, fit
+        )
+        return plan_flanges(
+            seam_inputs, seam_scene, fit, flanges, seam_stage, clearance_profile=False
+        )
 
     options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
     order = stage("order", "choosing the seam order", choose_order, inputs, options, q_home)
@@ -292,9 +215,15 @@ def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
         io = io_columns(samples, inputs.cell.tool.process_io, lengths, tcp_speed)
     except IoPlacementError as error:
         raise InputError(inputs.file, error.key, error.reason) from None
-    collisions = stage("check", "collision check of the whole job", check_job, inputs, scene,
-                       samples)  # fmt: skip
+    collisions = stage(
+        "check", "collision check of the whole job", check_job, inputs, scene, samples
+    )
+    profile = None
+    if clearance_profile:
+        profile = stage(
+            "clearance", "clearance profile", distance_profile, scene, samples.q, samples.t
+        )
     return JobPlan(
         inputs.file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
-        tcp_speed, io, collisions, stage.timings_s,
+        tcp_speed, io, collisions, stage.timings_s, profile,
     )  # fmt: skip

@@ -59,7 +59,7 @@ def main() -> None:
         q_home = home_pose(inputs, scene)
         start = time.perf_counter()
         options = seam_options(
-            inputs, scene, lambda i, s: plan_seam(i, s, StageTimer(lambda _: None)),
+            inputs, scene, lambda k, r, i, s: plan_seam(i, s, StageTimer(lambda _: None)),
             lambda _: None,
         )  # fmt: skip
         planning = time.perf_counter() - start

@@ -18,6 +18,7 @@ from offline_prog.job.approach import CartesianMove, cartesian_move
 from offline_prog.job.assemble import JobSamples, Piece
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.order import JobOrder, order_job
+from offline_prog.job.records import SeamOption
 from offline_prog.job.seams import (
     errors_named_for,
     job_config,
@@ -30,32 +31,6 @@ from offline_prog.stages import Inputs, attempt_motion
 
 MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
-
-
-@dataclasses.dataclass
-class SeamOption:
-    """One way to run a seam: its plan (a :class:`~offline_prog.plan.Plan`) in one
-    direction, the approach and retract, and the link ends q_in / q_out (6,) [rad]."""
-
-    seam: int
-    name: str
-    reverse: bool
-    plan: object
-    approach: CartesianMove | None
-    retract: CartesianMove | None
-
-    @property
-    def q_in(self) -> np.ndarray:
-        return self.approach.q[0] if self.approach else self.plan.joints.q[0]
-
-    @property
-    def q_out(self) -> np.ndarray:
-        return self.retract.q[-1] if self.retract else self.plan.joints.q[-1]
-
-    @property
-    def label(self) -> str:
-        direction = "reverse" if self.reverse else "forward"
-        return f"{self.name} {direction} branch {self.plan.joints.branch}"
 
 
 def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
@@ -90,13 +65,15 @@ def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
     )  # fmt: skip
     if not check.collision_free:
         where = "job.home" if home is None else key
-        raise InputError(inputs.file, where, f"the home pose collides: {check.message}")
+        hint = "; give job.home.joints_deg" if home is None else ""
+        raise InputError(inputs.file, where, f"the home pose collides: {check.message}{hint}")
     return q
 
 
 def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[list[SeamOption]]:
     """Each seam planned in each direction it may run (``direction``), with approach and
     retract. A direction the robot cannot do is dropped when the other one works.
+    ``plan_seam(k, reverse, seam_inputs, scene)`` plans seam k in one direction.
 
     Raises:
         InputError: naming ``seams[k].<key>``.
@@ -111,7 +88,7 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
             try:
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
-                    plan = plan_seam(seam_in, scene)
+                    plan = plan_seam(k, reverse, seam_in, scene)
                     for variant in [plan, *_other_branches(seam_in, scene, plan)]:
                         try:
                             approach, retract = _ends(seam_in, variant, seam)
@@ -124,9 +101,9 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
                 errors.append(error)
         if not found:
             failure = errors[0].failure
-            raise PlanFailedError(
-                dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
-            )
+            if inputs.cell.seams:  # name the seam (a path: cell has only the one)
+                failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
+            raise PlanFailedError(failure)
         options.append(found)
     return options
 

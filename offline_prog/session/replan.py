@@ -30,12 +30,12 @@ from pathlib import Path
 
 from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.check import check_trajectory
-from offline_prog.collision.profile import distance_profile
 from offline_prog.config.cell import Cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.errors import InputError, PlanFailedError, PlanFailure
-from offline_prog.job.seams import is_job, job_seams, seam_inputs
-from offline_prog.plan import Plan, StageTimer, plan_flanges
+from offline_prog.job.records import Plan
+from offline_prog.job.seams import job_seams, seam_inputs
+from offline_prog.plan import StageTimer, plan_flanges
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.session.state import SessionState, apply, initial_state
 from offline_prog.stages import (
@@ -88,7 +88,6 @@ class Replanner:
         self.file, self.robots_dir = Path(cell_file), robots_dir
         start = time.perf_counter()
         self.base = load_inputs(self.file, robots_dir)
-        self.is_job = is_job(self.base.cell)
         self.seam_names = [seam.name for seam in job_seams(self.base.cell)]
         self.initial = initial_state(self.base.cell)
         # Each stage's last run [s] (report.json of an export lists them).
@@ -109,8 +108,6 @@ class Replanner:
         cell = self.cell(state)
         check_cell(self.file, cell, self.robots_dir)
         poses = {"X_IT": transform(cell.tool.X_IT), "X_PE": transform(cell.part.X_PE)}
-        if not self.is_job:
-            return dataclasses.replace(self.base, cell=cell, **poses)
         k = state.seam
         if k not in self._seams:  # the seam's points are read once
             self._seams[k] = seam_inputs(self.base, k)
@@ -207,16 +204,3 @@ def recheck(inputs: Inputs, scene, attempt: Attempt) -> Attempt:
         self_clearance=motion.self_clearance,
     )
     return dataclasses.replace(attempt, collisions=collisions)
-
-
-def with_clearance_profile(result: SessionPlan, cell_file: Path, timings_s: dict) -> Plan:
-    """The result's plan as ``plan`` makes it: its clearance profile, the stage timings
-    and ``cell_file`` (the saved cell) in place of the original."""
-    plan = result.plan
-    timings = dict(timings_s)
-    start = time.perf_counter()
-    profile = distance_profile(result.scene, plan.joints.q, plan.trajectory.t)
-    timings["clearance"] = time.perf_counter() - start
-    return dataclasses.replace(
-        plan, cell_file=Path(cell_file), clearance_profile=profile, timings_s=timings
-    )

@@ -189,9 +189,8 @@ class Session:
             self.saved[state] = saved
         if kind == "save":
             return saved
-        result = self.replanner.plan(state, progress)
         out = self.out_root / saved.stem
-        return saved, *outputs.export(self.replanner, result, saved, out, progress)
+        return saved, *outputs.export(saved, out, progress)
 
     # --- the main thread: MeshCat -------------------------------------------------------
 
@@ -254,7 +253,9 @@ class Session:
                 return  # stale: the controls moved on while it was planned
         self.view.show(answer)
         planner = self.replanner
-        line = plan_status(answer, planner.seam_names[answer.state.seam] if planner.is_job else "")
+        line = plan_status(
+            answer, planner.seam_names[answer.state.seam] if len(planner.seam_names) > 1 else ""
+        )
         with self.lock:
             self.shown_generation, self.plan_line = generation, line
         plan = answer.plan
