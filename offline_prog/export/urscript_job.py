@@ -19,7 +19,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.header import header_lines
@@ -32,6 +31,7 @@ from offline_prog.export.urscript import (
     SERVOJ_GAIN,
     SERVOJ_LOOKAHEAD_S,
     _list,
+    joints_on_steps,
 )
 from offline_prog.robot.model import load_robot
 
@@ -103,10 +103,9 @@ def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> li
     """servoj lines over the job's rows of one seam (approach to retract), with I/O."""
     job, io = data.job, data.process_io
     t = job.t[rows] - job.t[rows][0]
-    spline = CubicHermiteSpline(t, job.q[rows], job.qd[rows], axis=0)
     grid = np.arange(0.0, t[-1], period_s)
     grid = np.append(grid, t[-1]) if t[-1] - grid[-1] > 1e-9 else grid
-    q = spline(grid)
+    q = joints_on_steps(t, job.q[rows], grid)
     position = np.interp(grid, t, job.sigma[rows])  # along the seam's path [m]
     switches = {}
     if (where := data.switch_positions(seam)) is not None:
