@@ -16,11 +16,11 @@ import numpy as np
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from offline_prog.config.cell import Cell, transform
+from offline_prog.config.edits import CellValues, apply, initial_values, schema_transform
 from offline_prog.job.seams import job_seams, seam_inputs
 from offline_prog.placement.payload import CellPayload, unpack
 from offline_prog.placement.space import Candidate, Pose
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.session.state import SessionState, apply, initial_state, schema_transform
 from offline_prog.stages import FittedPath, Inputs, fit_path, load_inputs
 
 SCREEN_SAMPLES = 1000  # σ samples of a seam's path-IK screen (corners need ~10 each)
@@ -50,7 +50,7 @@ class Context:
 
     inputs: Inputs
     seams: list[SeamView]
-    initial: SessionState
+    initial: CellValues
     carried: tuple[int, ...]
     fits: dict[tuple[int, bool], FittedPath] = dataclasses.field(default_factory=dict)
 
@@ -75,7 +75,7 @@ def load_context(cell_file: Path) -> Context:
     names = set(cell.place.moves_with_tool) if cell.place else set()
     carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
     fits = {(k, False): seam.fit for k, seam in enumerate(seams)}
-    return Context(inputs, seams, initial_state(cell), carried, fits)
+    return Context(inputs, seams, initial_values(cell), carried, fits)
 
 
 def context(payload: CellPayload) -> Context:

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cell import Cell, PlaceConfig
+from offline_prog.config.edits import rpy_deg_of
 from offline_prog.errors import InputError
-from offline_prog.session.state import rpy_deg_of
 
 MAX_BUDGET = 100_000  # full evaluations: 10⁵ × ~0.5 s is a day on one core
 MAX_SCREEN_POINTS = 100_000  # per grasp

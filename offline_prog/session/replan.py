@@ -32,12 +32,12 @@ from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import Cell, transform
 from offline_prog.config.checks import check_cell
+from offline_prog.config.edits import CellValues, apply, initial_values
 from offline_prog.errors import InputError, PlanFailedError, PlanFailure
 from offline_prog.job.records import Plan
 from offline_prog.job.seams import job_seams, seam_inputs
 from offline_prog.plan import StageTimer, plan_flanges
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.session.state import SessionState, apply, initial_state
 from offline_prog.stages import (
     Inputs,
     attempt_motion,
@@ -68,7 +68,7 @@ class SessionPlan:
         scene: the Drake cell the plan was checked in (None without a plan).
     """
 
-    state: SessionState
+    state: CellValues
     cell: Cell
     plan: Plan | None
     failure: PlanFailure | None
@@ -89,17 +89,17 @@ class Replanner:
         start = time.perf_counter()
         self.base = load_inputs(self.file, robots_dir)
         self.seam_names = [seam.name for seam in job_seams(self.base.cell)]
-        self.initial = initial_state(self.base.cell)
+        self.initial = initial_values(self.base.cell)
         # Each stage's last run [s] (report.json of an export lists them).
         self.timings_s = {"load": time.perf_counter() - start}
         self._seams: dict[int, Inputs] = {}  # the original cell's seam inputs
         self._fits: dict[int, object] = {}
         self._cache: dict[str, tuple] = {}  # stage -> (key, value)
 
-    def cell(self, state: SessionState) -> Cell:
+    def cell(self, state: CellValues) -> Cell:
         return apply(self.base.cell, self.initial, state)
 
-    def inputs(self, state: SessionState) -> Inputs:
+    def inputs(self, state: CellValues) -> Inputs:
         """The active seam's Inputs for ``state`` (the cell's checks run again).
 
         Raises:
@@ -130,7 +130,7 @@ class Replanner:
         return kept[1]
 
     def plan(
-        self, state: SessionState, progress: Callable[[str], None] = lambda stage: None
+        self, state: CellValues, progress: Callable[[str], None] = lambda stage: None
     ) -> SessionPlan:
         """Plan the state's active seam, reusing every stage whose inputs did not change.
 
@@ -155,7 +155,7 @@ class Replanner:
         seconds = time.perf_counter() - start
         return SessionPlan(state, cell, plan, failure, error, ran, seconds, scene)
 
-    def _plan(self, state: SessionState, stage: StageTimer) -> tuple[Plan, object]:
+    def _plan(self, state: CellValues, stage: StageTimer) -> tuple[Plan, object]:
         inputs = self.inputs(state)
         k = state.seam
         if k not in self._fits:

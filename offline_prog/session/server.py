@@ -23,6 +23,7 @@ import threading
 import time
 from pathlib import Path
 
+from offline_prog.config import cell_text
 from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
 from offline_prog.scene.drake_cell import build_cell_model
@@ -185,7 +186,7 @@ class Session:
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
             planner = self.replanner
-            saved = outputs.save_cell(planner.file, planner.initial, state, planner.cell(state))
+            saved = cell_text.save_cell(planner.file, planner.initial, state, planner.cell(state))
             self.saved[state] = saved
         if kind == "save":
             return saved

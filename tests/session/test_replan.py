@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from offline_prog.config.cell import load_cell
+from offline_prog.config.edits import apply
 from offline_prog.session.replan import Replanner
-from offline_prog.session.state import apply, with_value
+from offline_prog.session.state import with_value
 from offline_prog.session.status import plan_status
 
 from conftest import CELLS
@@ -48,8 +49,8 @@ def test_a_tool_move_does_not_refit(replanner):
 
 def test_the_session_plan_is_the_plan_of_the_same_cell(replanner, tmp_path):
     """Reused stages give the plan a fresh `plan` run gives of the changed cell."""
+    from offline_prog.config.cell_text import save_cell
     from offline_prog.plan import plan_cell
-    from offline_prog.session.outputs import save_cell
 
     moved = with_value(with_value(replanner.initial, "X_IT.x", 705), "speed", 140)
     result = replanner.plan(moved)
