@@ -1,21 +1,27 @@
-"""The planning pipeline: cell file → processing path → flange path → joints → checks.
+"""The planning pipeline: cell file → processing path → flange path → joints → checks,
+and the whole job around the seams.
 
-:func:`plan_cell` reads as the paper's method, one named stage per line (Drake's
-``hardware_sim.run`` is the model); each stage is a function with typed inputs and
-outputs, and the stage timings in report.json fall out of that list:
+Every cell is planned by :func:`plan_job` (a ``path:`` cell is a one-seam job), whose
+stages read as the method, one named stage per line (Drake's ``hardware_sim.run`` is
+the model), and whose stage timings in report.json fall out of that list:
 
 1. ``load``: the cell file, its semantic checks, the path points, the robot (§2).
-2. ``fit``: B-spline fit (degree ≥ 5) re-parameterized by true arc length (§2, §4).
-3. ``frames``: process frames [t n b] and the flange path X_IE = X_IT · X_PF⁻¹ · X_PE,
-   for each free tool rotation; cusps (§3, §4).
-4. ``scene``: robot, part, tool and obstacles as a Drake MultibodyPlant.
-5. ``joints``: time law, path IK, joint-limit retiming and the collision check.
-6. ``collision``: collision avoidance where the first plan collides; clearance profile.
+2. ``scene``: robot, part, tool and obstacles as a Drake MultibodyPlant.
+3. ``home``: the home pose, inside the limits and collision-free.
+4. ``seams``: each seam in each direction by :func:`plan_seam`, i.e. the stages of
+   :data:`~offline_prog.pipeline.SEAM_STAGES` (fit §2, §4; frames and flange path
+   X_IE = X_IT · X_PF⁻¹ · X_PE §3; joints: time law, path IK, retiming §4; the
+   collision check; collision avoidance), with approach and retract.
+5. ``order``, ``links``: the seam order; collision-free links from home and back.
+6. ``check``: the whole job's collision check; ``clearance``: its clearance profile.
+
+:func:`plan_cell` runs one seam alone (no home, approach or links): the session's
+preview and the tests of the seam's method.
 
 Bad input is an :class:`~offline_prog.errors.InputError` naming the file and key; a
 valid cell the robot cannot do is a :class:`~offline_prog.errors.PlanFailedError`
-(joints) or a :class:`Plan` whose ``failure`` says why (a collision: the reports are
-still written).
+(joints) or a plan whose ``failure`` says why (a collision: the reports are still
+written).
 """
 
 from __future__ import annotations
@@ -24,8 +30,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.profile import distance_profile
+from offline_prog.config.edits import CellValues
 from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.job.assemble import lay_out
 from offline_prog.job.process_io import IoPlacementError, io_columns
@@ -39,20 +45,10 @@ from offline_prog.job.stages import (
     tool_speed,
 )
 from offline_prog.joints.path_timing import without_joint_limits
+from offline_prog.pipeline import SEAM_STAGES, StageCache, run_stages, with_normal_hint
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.stages import (
-    FittedPath,
-    FlangePaths,
-    Inputs,
-    attempt_motion,
-    avoid,
-    build_scene,
-    fit_path,
-    flange_paths,
-    load_inputs,
-    with_normal_hint,
-)
+from offline_prog.stages import FittedPath, Inputs, build_scene, load_inputs
 
 
 def plan_cell(
@@ -72,11 +68,9 @@ def plan_cell(
         InputError: bad input or geometry the method cannot handle (one line).
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
-    file = Path(cell_file)
     stage = StageTimer(progress)
-    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
-    scene = stage("scene", "building the Drake cell", build_scene, inputs)
-    return plan_seam(inputs, scene, stage)
+    inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir)
+    return plan_seam(inputs, stage)
 
 
 class StageTimer:
@@ -95,34 +89,38 @@ class StageTimer:
 
 
 def plan_seam(
-    inputs: Inputs, scene: DrakeCell, stage: StageTimer, *, clearance_profile: bool = True
+    inputs: Inputs,
+    stage: StageTimer,
+    *,
+    results: dict[str, object] | None = None,
+    cache: StageCache | None = None,
+    values: CellValues | None = None,
+    clearance_profile: bool = True,
 ) -> Plan:
-    """The single-seam pipeline on loaded inputs and a built scene: fit, frames, joints,
-    collision avoidance, clearance profile unless told not to (paper §§2–4)."""
-    fit = stage("fit", "fitting the B-spline", fit_path, inputs)
-    flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
-    return plan_flanges(inputs, scene, fit, flanges, stage, clearance_profile=clearance_profile)
+    """The single-seam pipeline (paper §§2–4): :data:`~offline_prog.pipeline.SEAM_STAGES`
+    (fit, frames, scene, joints, check, collision avoidance), then the clearance profile
+    unless told not to.
 
+    Args:
+        results: results the caller holds (a built ``scene``, a kept ``fit``); every
+            stage's result is added to it.
+        cache, values: the session's: reuse each stage while the values it depends on
+            are unchanged (:func:`~offline_prog.pipeline.run_stages`).
 
-def plan_flanges(
-    inputs: Inputs, scene: DrakeCell, fit: FittedPath, flanges: FlangePaths, stage: StageTimer,
-    *, first: Attempt | None = None, clearance_profile: bool = True,
-) -> Plan:  # fmt: skip
-    """:func:`plan_seam` after the flange paths: joints (or the caller's ``first`` joint
-    plan), collision avoidance, and the clearance profile unless told not to."""
-    file = inputs.file
-    rotation, flange = flanges.rotations[0]
+    Raises:
+        PlanFailedError: the robot cannot follow the path (σ, t and why; with a hint
+            when the path's normals reversed would work).
+    """
+    results = {} if results is None else results
+    results.update(inputs=inputs, progress=stage.progress)
     try:
-        first = first or stage(
-            "joints", "joint trajectory and collision check", attempt_motion, inputs, scene,
-            rotation, flange,
-        )  # fmt: skip
+        run_stages(SEAM_STAGES, results, stage, cache=cache, values=values)
     except PlanFailedError as error:
-        raise with_normal_hint(error, inputs, fit, scene) from None
-    chosen, avoidance = stage(
-        "collision", "collision avoidance", avoid, inputs, fit, flanges, scene, first,
-        stage.progress,
-    )  # fmt: skip
+        if "joints" in results or "scene" not in results:
+            raise
+        raise with_normal_hint(error, inputs, results["fit"], results["scene"]) from None
+    fit, flanges, scene = results["fit"], results["frames"], results["scene"]
+    chosen, avoidance = results["collision"]
     traj = chosen.joints.trajectory
     profile = None
     if clearance_profile:
@@ -130,7 +128,7 @@ def plan_flanges(
             "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
         )
     return Plan(
-        file,
+        inputs.file,
         inputs.cell,
         inputs.points,
         fit.fitted,
@@ -190,16 +188,14 @@ def plan_loaded_job(
     fits = {} if fits is None else fits
 
     def one_seam(k: int, reverse: bool, seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
-        seam_stage = StageTimer(progress)
-        if (k, reverse) not in fits:
-            fits[k, reverse] = seam_stage("fit", "fitting the B-spline", fit_path, seam_inputs)
-        fit = fits[k, reverse]
-        flanges = seam_stage(
-            "frames", "process frames and flange path", flange_paths, seam_inputs, fit
+        results = {"scene": seam_scene}
+        if (k, reverse) in fits:
+            results["fit"] = fits[k, reverse]
+        plan = plan_seam(
+            seam_inputs, StageTimer(progress), results=results, clearance_profile=False
         )
-        return plan_flanges(
-            seam_inputs, seam_scene, fit, flanges, seam_stage, clearance_profile=False
-        )
+        fits[k, reverse] = results["fit"]
+        return plan
 
     options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
     order = stage("order", "choosing the seam order", choose_order, inputs, options, q_home)

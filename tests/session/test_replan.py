@@ -18,7 +18,7 @@ def replanner():
     """The tape cell (the fastest demo plan); its first plan made."""
     planner = Replanner(CELLS / "tape_cylinder_ur10e.yaml")
     first = planner.plan(planner.initial)
-    assert first.ran == ["fit", "frames", "scene", "joints"] and first.plan.feasible
+    assert first.ran == ["fit", "frames", "scene", "joints", "check"] and first.plan.feasible
     planner.first_duration_s = first.plan.trajectory.duration
     return planner
 
@@ -26,7 +26,7 @@ def replanner():
 def test_a_speed_change_keeps_the_fit_the_frames_and_the_scene(replanner):
     slower = with_value(replanner.initial, "speed", 120)
     result = replanner.plan(slower)
-    assert result.ran == ["joints"]
+    assert result.ran == ["joints", "check"]
     assert result.plan.trajectory.duration > replanner.first_duration_s
 
 
@@ -41,7 +41,7 @@ def test_a_clearance_change_only_checks_again(replanner):
 def test_a_tool_move_does_not_refit(replanner):
     moved = with_value(replanner.initial, "X_IT.z", 310)
     result = replanner.plan(moved)
-    assert result.ran == ["frames", "scene", "joints"]
+    assert result.ran == ["frames", "scene", "joints", "check"]
     assert result.scene.X_IT.translation()[2] == pytest.approx(0.31)
     # The same answer again: nothing re-runs.
     assert replanner.plan(moved).ran == []
@@ -82,7 +82,7 @@ def test_a_tool_turn_smoothing_change_re_runs_the_frames_and_joints(replanner):
     replanner.plan(free)
     turning = with_value(free, "turn_smoothing", 20)
     result = replanner.plan(turning)
-    assert result.ran == ["frames", "joints"] and result.plan.feasible
+    assert result.ran == ["frames", "joints", "check"] and result.plan.feasible
     phi = result.plan.flange.tool_turn(np.linspace(0.0, result.plan.path.length, 200))[0]
     assert np.ptp(phi) > np.deg2rad(1.0)  # it turns along the path
     refused = replanner.plan(with_value(replanner.initial, "turn_smoothing", 20))
