@@ -1,4 +1,7 @@
-"""A seam's stages as data, declared once: ``plan``, the session and placement run them.
+"""The stages as data, declared once: ``plan``, the session and placement run them.
+
+:data:`JOB_STAGES` plan a whole job (scene, home, seams, order, links, I/O, the whole
+job's check; every cell is a job), :data:`SEAM_STAGES` each of its seams.
 
 Each :class:`Stage` names its function, the results it reads (by stage name, or
 ``inputs``: the seam's :class:`~offline_prog.stages.Inputs`) and the editable cell
@@ -29,6 +32,15 @@ from collections.abc import Callable
 
 from offline_prog.config.edits import CellValues
 from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.job.home import home_pose
+from offline_prog.job.stages import (
+    check_job,
+    choose_order,
+    job_clearance,
+    job_io,
+    link_job,
+    seam_options,
+)
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.process_frames import NormalTangentError
 from offline_prog.stages import (
@@ -78,6 +90,30 @@ SEAM_STAGES = (
         ("inputs", "fit", "frames", "scene", "check", "progress"),
     ),
 )
+
+
+# The job around its seams (``plan.plan_loaded_job``): ``seam_planner`` is the caller's
+# plan of one seam in one direction (``plan.plan_seam`` on SEAM_STAGES).
+JOB_STAGES = (
+    Stage("scene", "building the Drake cell", build_scene, ("inputs",)),
+    Stage("home", "checking the home pose", home_pose, ("inputs", "scene")),
+    Stage(
+        "seams",
+        "planning the seams",
+        seam_options,
+        ("inputs", "scene", "seam_planner", "progress"),
+    ),
+    Stage("order", "choosing the seam order", choose_order, ("inputs", "seams", "home")),
+    Stage(
+        "links",
+        "linking moves",
+        link_job,
+        ("inputs", "scene", "seams", "order", "home", "progress"),
+    ),
+    Stage("io", "process I/O", job_io, ("inputs", "links")),
+    Stage("check", "collision check of the whole job", check_job, ("inputs", "scene", "links")),
+)
+JOB_CLEARANCE = Stage("clearance", "clearance profile", job_clearance, ("scene", "links"))
 
 
 class StageCache:

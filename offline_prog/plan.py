@@ -32,23 +32,20 @@ from pathlib import Path
 
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.edits import CellValues
-from offline_prog.errors import InputError, PlanFailedError
-from offline_prog.job.assemble import lay_out
-from offline_prog.job.process_io import IoPlacementError, io_columns
+from offline_prog.errors import PlanFailedError
 from offline_prog.job.records import JobPlan, Plan
-from offline_prog.job.stages import (
-    check_job,
-    choose_order,
-    home_pose,
-    job_pieces,
-    seam_options,
-    tool_speed,
-)
 from offline_prog.joints.path_timing import without_joint_limits
-from offline_prog.pipeline import SEAM_STAGES, StageCache, run_stages, with_normal_hint
+from offline_prog.pipeline import (
+    JOB_CLEARANCE,
+    JOB_STAGES,
+    SEAM_STAGES,
+    StageCache,
+    run_stages,
+    with_normal_hint,
+)
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.stages import FittedPath, Inputs, build_scene, load_inputs
+from offline_prog.stages import FittedPath, Inputs, load_inputs
 
 
 def plan_cell(
@@ -182,9 +179,6 @@ def plan_loaded_job(
             fit found here is used, one computed here is added (a path on the part does
             not change with the placement).
     """
-    progress = stage.progress
-    scene = stage("scene", "building the Drake cell", build_scene, inputs)
-    q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
     fits = {} if fits is None else fits
 
     def one_seam(k: int, reverse: bool, seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
@@ -192,34 +186,28 @@ def plan_loaded_job(
         if (k, reverse) in fits:
             results["fit"] = fits[k, reverse]
         plan = plan_seam(
-            seam_inputs, StageTimer(progress), results=results, clearance_profile=False
+            seam_inputs, StageTimer(stage.progress), results=results, clearance_profile=False
         )
         fits[k, reverse] = results["fit"]
         return plan
 
-    options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
-    order = stage("order", "choosing the seam order", choose_order, inputs, options, q_home)
-    flat = [option for seam in options for option in seam]
-    chosen = [flat[i] for i in order.sequence]
-    pieces, links = stage(
-        "links", "linking moves", job_pieces, inputs, scene, chosen, q_home, progress
-    )
-    samples = lay_out(pieces)
-    tcp_speed = tool_speed(inputs, samples, chosen)
-    lengths = {option.name: option.plan.path.length for option in chosen}
-    try:
-        io = io_columns(samples, inputs.cell.tool.process_io, lengths, tcp_speed)
-    except IoPlacementError as error:
-        raise InputError(inputs.file, error.key, error.reason) from None
-    collisions = stage(
-        "check", "collision check of the whole job", check_job, inputs, scene, samples
-    )
-    profile = None
-    if clearance_profile:
-        profile = stage(
-            "clearance", "clearance profile", distance_profile, scene, samples.q, samples.t
-        )
+    stages = JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ())
+    results = {"inputs": inputs, "progress": stage.progress, "seam_planner": one_seam}
+    run_stages(stages, results, stage)
+    linked = results["links"]
     return JobPlan(
-        inputs.file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
-        tcp_speed, io, collisions, stage.timings_s, profile,
-    )  # fmt: skip
+        inputs.file,
+        inputs.cell,
+        inputs.robot,
+        results["home"],
+        results["seams"],
+        linked.chosen,
+        results["order"],
+        linked.links,
+        linked.samples,
+        linked.tcp_speed,
+        results["io"],
+        results["check"],
+        stage.timings_s,
+        results.get("clearance"),
+    )

@@ -22,8 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.job.home import home_pose
 from offline_prog.job.order import _Costs, _held_karp, _local_search, brute_force_order, order_job
-from offline_prog.job.stages import home_pose, seam_options
+from offline_prog.job.stages import seam_options
 from offline_prog.plan import StageTimer, plan_seam
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import build_scene, load_inputs
