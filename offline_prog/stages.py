@@ -27,7 +27,7 @@ from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
-from offline_prog.path.process_frames import NormalTangentError
+from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn
 from offline_prog.robot.model import RobotModel, load_robot
@@ -64,7 +64,7 @@ class FittedPath:
 
     fitted: FittedSpline
     path: ArcLengthPath
-    normal: object  # normal field n(σ) in P, see offline_prog.path.process_frames
+    normal: NormalField  # normal field n(σ) in P
     normal_fit: NormalFit  # the angle from each given normal to the fitted field
 
 
