@@ -54,7 +54,10 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
                     plan = plan_seam(k, reverse, seam_in, scene)
-                    for variant in [plan, *_other_branches(seam_in, scene, plan)]:
+                    # A path: cell's one seam keeps the branch its pipeline chose (the
+                    # plan as before issue 24, not planned again on other branches).
+                    others = _other_branches(seam_in, scene, plan) if inputs.cell.seams else []
+                    for variant in [plan, *others]:
                         try:
                             approach, retract = _ends(seam_in, variant, seam)
                         except PlanFailedError:
