@@ -71,7 +71,7 @@ def _run_export(args, console: Console) -> None:
 
 def _serve_preview(plan, args, console: Console) -> None:
     """Show the plan in a MeshCat server on --host (localhost) until Ctrl-C (or --seconds)."""
-    from offline_prog.plan import JobPlan
+    from offline_prog.job.records import JobPlan
     from offline_prog.viz.job_preview import show_job
     from offline_prog.viz.local_server import open_meshcat, url
     from offline_prog.viz.preview import near_collision_mask, show_plan
@@ -185,12 +185,10 @@ def main(argv: list[str] | None = None) -> int:
         return code
 
     try:
-        from offline_prog.config.cell import load_cell
-        from offline_prog.job.seams import is_job as job_cell
-        from offline_prog.plan import plan_cell, plan_job
+        from offline_prog.plan import plan_job
         from offline_prog.results.job_folder import write_job_outputs
-        from offline_prog.results.plan_folder import check_out_dir, write_outputs
-        from offline_prog.results.summary import print_job_summary, print_summary
+        from offline_prog.results.plan_folder import check_out_dir
+        from offline_prog.results.summary import print_job_summary
 
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
@@ -225,16 +223,15 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
-        is_job = job_cell(load_cell(args.cell))  # seams:, or path: with job:
-        # Progress on stderr only while stdout is a terminal: logs and pipes stay clean.
+        # Every cell is a job (path: one seam). Progress on stderr only while stdout is
+        # a terminal: logs and pipes stay clean.
         with PlanProgress(errors, enabled=console.is_terminal) as progress:
-            plan = (plan_job if is_job else plan_cell)(args.cell, progress=progress)
+            plan = plan_job(args.cell, progress=progress)
             progress("writing outputs")
             if args.command == "plan":
-                files, report = (write_job_outputs if is_job else write_outputs)(plan, out)
+                files, report = write_job_outputs(plan, out)
         if args.command == "plan":
-            summary = print_job_summary if is_job else print_summary
-            summary(console, report, files, time.perf_counter() - started)
+            print_job_summary(console, report, files, time.perf_counter() - started)
         if args.preview:
             _serve_preview(plan, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs

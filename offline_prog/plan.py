@@ -1,110 +1,51 @@
-"""The planning pipeline: cell file → processing path → flange path → joints → checks.
+"""The planning pipeline: cell file → processing path → flange path → joints → checks,
+and the whole job around the seams.
 
-:func:`plan_cell` reads as the paper's method, one named stage per line (Drake's
-``hardware_sim.run`` is the model); each stage is a function with typed inputs and
-outputs, and the stage timings in report.json fall out of that list:
+Every cell is planned by :func:`plan_job` (a ``path:`` cell is a one-seam job), whose
+stages read as the method, one named stage per line (Drake's ``hardware_sim.run`` is
+the model), and whose stage timings in report.json fall out of that list:
 
 1. ``load``: the cell file, its semantic checks, the path points, the robot (§2).
-2. ``fit``: B-spline fit (degree ≥ 5) re-parameterized by true arc length (§2, §4).
-3. ``frames``: process frames [t n b] and the flange path X_IE = X_IT · X_PF⁻¹ · X_PE,
-   for each free tool rotation; cusps (§3, §4).
-4. ``scene``: robot, part, tool and obstacles as a Drake MultibodyPlant.
-5. ``joints``: time law, path IK, joint-limit retiming and the collision check.
-6. ``collision``: collision avoidance where the first plan collides; clearance profile.
+2. ``scene``: robot, part, tool and obstacles as a Drake MultibodyPlant.
+3. ``home``: the home pose, inside the limits and collision-free.
+4. ``seams``: each seam in each direction by :func:`plan_seam`, i.e. the stages of
+   :data:`~offline_prog.pipeline.SEAM_STAGES` (fit §2, §4; frames and flange path
+   X_IE = X_IT · X_PF⁻¹ · X_PE §3; joints: time law, path IK, retiming §4; the
+   collision check; collision avoidance), with approach and retract.
+5. ``order``, ``links``: the seam order; collision-free links from home and back.
+6. ``check``: the whole job's collision check; ``clearance``: its clearance profile.
+
+:func:`plan_cell` runs one seam alone (no home, approach or links): the session's
+preview and the tests of the seam's method.
 
 Bad input is an :class:`~offline_prog.errors.InputError` naming the file and key; a
 valid cell the robot cannot do is a :class:`~offline_prog.errors.PlanFailedError`
-(joints) or a :class:`Plan` whose ``failure`` says why (a collision: the reports are
-still written).
+(joints) or a plan whose ``failure`` says why (a collision: the reports are still
+written).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
-
-from offline_prog.collision.avoidance import Attempt
-from offline_prog.collision.check import CollisionResult
 from offline_prog.collision.profile import distance_profile
-from offline_prog.config.cell import Cell
-from offline_prog.errors import Failure, InputError, PlanFailedError
-from offline_prog.job.assemble import JobSamples, lay_out
-from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
-from offline_prog.job.stages import (
-    check_job,
-    choose_order,
-    home_pose,
-    job_pieces,
-    seam_options,
-    tool_speed,
-)
-from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.config.edits import CellValues
+from offline_prog.errors import PlanFailedError
+from offline_prog.job.records import JobPlan, Plan
 from offline_prog.joints.path_timing import without_joint_limits
-from offline_prog.path.arc_length import ArcLengthPath
-from offline_prog.path.bspline_fit import FittedSpline
-from offline_prog.path.cusps import Cusp, SmoothedFlangePath
-from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.path.inputs import NormalFit
-from offline_prog.path.sources import PathPoints
-from offline_prog.robot.model import ROBOTS_DIR, RobotModel
-from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.stages import (
-    FittedPath,
-    FlangePaths,
-    Inputs,
-    attempt_motion,
-    avoid,
-    build_scene,
-    fit_path,
-    flange_paths,
-    load_inputs,
+from offline_prog.pipeline import (
+    JOB_CLEARANCE,
+    JOB_STAGES,
+    SEAM_STAGES,
+    StageCache,
+    run_stages,
     with_normal_hint,
 )
-from offline_prog.timing.trajectory import WorkspaceTrajectory
-
-
-@dataclasses.dataclass
-class Plan:
-    """Everything a plan produced, for the writers and the tests."""
-
-    cell_file: Path
-    cell: Cell
-    points: PathPoints
-    fitted: FittedSpline
-    path: ArcLengthPath
-    flange: FlangePath | SmoothedFlangePath
-    trajectory: WorkspaceTrajectory
-    cusps: list[Cusp]
-    timings_s: dict[str, float]
-    robot: RobotModel
-    joints: JointTrajectory
-    nominal_duration_s: float
-    tool_rotation_rad: float
-    collisions: CollisionResult
-    avoidance: dict | None = None  # what the collision avoidance tried and changed
-    # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
-    clearance_profile: tuple | None = None
-    normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
-
-    @property
-    def feasible(self) -> bool:
-        """Every check passed (collision-free at the clearance)."""
-        return self.collisions.collision_free
-
-    @property
-    def failure(self) -> str:
-        """Why the plan failed, one line ("" if it did not)."""
-        return self.collisions.message
-
-    @property
-    def failure_kind(self) -> Failure | None:
-        """The Failure of a finished plan that fails a check (a collision), or None.
-        Failures that leave no plan (reach, limits, singularities) are PlanFailedErrors."""
-        return None if self.feasible else Failure.COLLISION
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.scene.drake_cell import DrakeCell
+from offline_prog.stages import FittedPath, Inputs, load_inputs
 
 
 def plan_cell(
@@ -124,11 +65,9 @@ def plan_cell(
         InputError: bad input or geometry the method cannot handle (one line).
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
-    file = Path(cell_file)
     stage = StageTimer(progress)
-    inputs = stage("load", "reading the cell", load_inputs, file, robots_dir)
-    scene = stage("scene", "building the Drake cell", build_scene, inputs)
-    return plan_seam(inputs, scene, stage)
+    inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir)
+    return plan_seam(inputs, stage)
 
 
 class StageTimer:
@@ -146,33 +85,39 @@ class StageTimer:
         return result
 
 
-def plan_seam(inputs: Inputs, scene: DrakeCell, stage: StageTimer) -> Plan:
-    """The single-seam pipeline on loaded inputs and a built scene: fit, frames, joints,
-    collision avoidance, clearance profile (paper §§2–4)."""
-    fit = stage("fit", "fitting the B-spline", fit_path, inputs)
-    flanges = stage("frames", "process frames and flange path", flange_paths, inputs, fit)
-    return plan_flanges(inputs, scene, fit, flanges, stage)
+def plan_seam(
+    inputs: Inputs,
+    stage: StageTimer,
+    *,
+    results: dict[str, object] | None = None,
+    cache: StageCache | None = None,
+    values: CellValues | None = None,
+    clearance_profile: bool = True,
+) -> Plan:
+    """The single-seam pipeline (paper §§2–4): :data:`~offline_prog.pipeline.SEAM_STAGES`
+    (fit, frames, scene, joints, check, collision avoidance), then the clearance profile
+    unless told not to.
 
+    Args:
+        results: results the caller holds (a built ``scene``, a kept ``fit``); every
+            stage's result is added to it.
+        cache, values: the session's: reuse each stage while the values it depends on
+            are unchanged (:func:`~offline_prog.pipeline.run_stages`).
 
-def plan_flanges(
-    inputs: Inputs, scene: DrakeCell, fit: FittedPath, flanges: FlangePaths, stage: StageTimer,
-    *, first: Attempt | None = None, clearance_profile: bool = True,
-) -> Plan:  # fmt: skip
-    """:func:`plan_seam` after the flange paths: joints (or the caller's ``first`` joint
-    plan), collision avoidance, and the clearance profile unless told not to."""
-    file = inputs.file
-    rotation, flange = flanges.rotations[0]
+    Raises:
+        PlanFailedError: the robot cannot follow the path (σ, t and why; with a hint
+            when the path's normals reversed would work).
+    """
+    results = {} if results is None else results
+    results.update(inputs=inputs, progress=stage.progress)
     try:
-        first = first or stage(
-            "joints", "joint trajectory and collision check", attempt_motion, inputs, scene,
-            rotation, flange,
-        )  # fmt: skip
+        run_stages(SEAM_STAGES, results, stage, cache=cache, values=values)
     except PlanFailedError as error:
-        raise with_normal_hint(error, inputs, fit, scene) from None
-    chosen, avoidance = stage(
-        "collision", "collision avoidance", avoid, inputs, fit, flanges, scene, first,
-        stage.progress,
-    )  # fmt: skip
+        if "joints" in results or "scene" not in results:
+            raise
+        raise with_normal_hint(error, inputs, results["fit"], results["scene"]) from None
+    fit, flanges, scene = results["fit"], results["frames"], results["scene"]
+    chosen, avoidance = results["collision"]
     traj = chosen.joints.trajectory
     profile = None
     if clearance_profile:
@@ -180,7 +125,7 @@ def plan_flanges(
             "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
         )
     return Plan(
-        file,
+        inputs.file,
         inputs.cell,
         inputs.points,
         fit.fitted,
@@ -198,56 +143,6 @@ def plan_flanges(
         profile,
         fit.normal_fit,
     )
-
-
-@dataclasses.dataclass
-class JobPlan:
-    """A whole job: the seams as run (each a :class:`Plan`), the links, and the job's
-    samples with named segments, process I/O and the whole job's collision check."""
-
-    cell_file: Path
-    cell: Cell
-    robot: RobotModel
-    q_home: np.ndarray  # (6,) [rad]
-    options: list  # every seam option planned (job.stages.SeamOption), by seam
-    chosen: list  # the options run, in order
-    order: object  # job.order.JobOrder
-    links: list  # job.links.LinkMotion, in order (home → first, …, last → home)
-    samples: JobSamples
-    tcp_speed: np.ndarray  # (N,) speed of the tool along the part [m/s]
-    io: IoColumns
-    collisions: CollisionResult
-    timings_s: dict[str, float]
-
-    avoidance = None  # per seam, in each seam's report
-
-    @property
-    def seams(self) -> list[Plan]:
-        return [option.plan for option in self.chosen]
-
-    @property
-    def feasible(self) -> bool:
-        return (
-            self.collisions.collision_free
-            and all(p.feasible for p in self.seams)
-            and all(link.ok for link in self.links)
-        )
-
-    @property
-    def failure(self) -> str:
-        failed = next((link for link in self.links if not link.ok), None)
-        if failed is not None:
-            return failed.failure.reason
-        if self.collisions.collision_free:
-            failed = (o for o in self.chosen if not o.plan.feasible)
-            return next((f"seam {o.name}: {o.plan.failure}" for o in failed), "")
-        at = self.collisions.first_contact or self.collisions.closest
-        where = "" if at is None else f"{self.samples.segment_at(at.t_s).label}: "
-        return where + self.collisions.message
-
-    @property
-    def failure_kind(self) -> Failure | None:
-        return None if self.feasible else Failure.COLLISION
 
 
 def plan_job(
@@ -269,32 +164,50 @@ def plan_job(
     return plan_loaded_job(inputs, stage)
 
 
-def plan_loaded_job(inputs: Inputs, stage: StageTimer) -> JobPlan:
-    """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory)."""
-    progress = stage.progress
-    scene = stage("scene", "building the Drake cell", build_scene, inputs)
-    q_home = stage("home", "checking the home pose", home_pose, inputs, scene)
+def plan_loaded_job(
+    inputs: Inputs,
+    stage: StageTimer,
+    *,
+    clearance_profile: bool = True,
+    fits: dict[tuple[int, bool], FittedPath] | None = None,
+) -> JobPlan:
+    """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory).
 
-    def one_seam(seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
-        return plan_seam(seam_inputs, seam_scene, StageTimer(progress))
+    Args:
+        clearance_profile: compute the whole job's clearance profile (clearance.csv).
+        fits: (seam index, reversed) ↦ the seam's fitted path, kept by the caller: a
+            fit found here is used, one computed here is added (a path on the part does
+            not change with the placement).
+    """
+    fits = {} if fits is None else fits
 
-    options = stage("seams", "planning the seams", seam_options, inputs, scene, one_seam, progress)
-    order = stage("order", "ordering the seams", choose_order, inputs, options, q_home, progress)
-    flat = [option for seam in options for option in seam]
-    chosen = [flat[i] for i in order.sequence]
-    pieces, links = stage(
-        "links", "linking moves", job_pieces, inputs, scene, chosen, q_home, progress
-    )
-    samples = lay_out(pieces)
-    tcp_speed = tool_speed(inputs, samples, chosen)
-    lengths = {option.name: option.plan.path.length for option in chosen}
-    try:
-        io = io_columns(samples, inputs.cell.tool.process_io, lengths, tcp_speed)
-    except IoPlacementError as error:
-        raise InputError(inputs.file, error.key, error.reason) from None
-    collisions = stage("check", "collision check of the whole job", check_job, inputs, scene,
-                       samples)  # fmt: skip
+    def one_seam(k: int, reverse: bool, seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
+        results = {"scene": seam_scene}
+        if (k, reverse) in fits:
+            results["fit"] = fits[k, reverse]
+        plan = plan_seam(
+            seam_inputs, StageTimer(stage.progress), results=results, clearance_profile=False
+        )
+        fits[k, reverse] = results["fit"]
+        return plan
+
+    stages = JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ())
+    results = {"inputs": inputs, "progress": stage.progress, "seam_planner": one_seam}
+    run_stages(stages, results, stage)
+    linked = results["links"]
     return JobPlan(
-        inputs.file, inputs.cell, inputs.robot, q_home, options, chosen, order, links, samples,
-        tcp_speed, io, collisions, stage.timings_s,
-    )  # fmt: skip
+        inputs.file,
+        inputs.cell,
+        inputs.robot,
+        results["home"],
+        results["seams"],
+        linked.chosen,
+        results["order"],
+        linked.links,
+        linked.samples,
+        linked.tcp_speed,
+        results["io"],
+        results["check"],
+        stage.timings_s,
+        results.get("clearance"),
+    )

@@ -21,14 +21,14 @@ from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
 from offline_prog.config.robot_search import find_robot, search_path
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
-from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.errors import InputError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
-from offline_prog.path.process_frames import NormalTangentError
+from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn
 from offline_prog.robot.model import RobotModel, load_robot
@@ -65,7 +65,7 @@ class FittedPath:
 
     fitted: FittedSpline
     path: ArcLengthPath
-    normal: object  # normal field n(σ) in P, see offline_prog.path.process_frames
+    normal: NormalField  # normal field n(σ) in P
     normal_fit: NormalFit  # the angle from each given normal to the fitted field
 
 
@@ -196,7 +196,24 @@ def attempt_motion(
     inputs: Inputs, scene: DrakeCell, rotation: float, flange, branch: int | None = None
 ) -> Attempt:
     """One joint plan for one flange path: time law (§4), path IK on a branch, joint
-    retiming, and the collision check of every sample and step.
+    retiming (:func:`plan_motion`), and the collision check of every sample and step
+    (:func:`check_attempt`).
+
+    Raises:
+        PlanFailedError: the robot cannot follow the path (σ, t and why).
+    """
+    return check_attempt(inputs, scene, plan_motion(inputs, rotation, flange, branch))
+
+
+def first_joints(inputs: Inputs, flanges: FlangePaths) -> Attempt:
+    """Stage ``joints``: :func:`plan_motion` on the first (best) tool rotation's path."""
+    rotation, flange = flanges.rotations[0]
+    return plan_motion(inputs, rotation, flange)
+
+
+def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = None) -> Attempt:
+    """Time law (§4), path IK on a branch and joint retiming for one flange path; the
+    attempt's collision check is not run yet (``collisions`` None).
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
@@ -231,16 +248,22 @@ def attempt_motion(
         time_law=motion.time_law,
         process=motion.process,
     )
-    traj = joints.trajectory
+    return Attempt(rotation, flange, nominal, joints, None)
+
+
+def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:
+    """Stage ``check``: the attempt with the collision check of every sample and step at
+    the cell's clearances."""
+    motion, joints = inputs.cell.motion, attempt.joints
     collisions = check_trajectory(
         scene,
         joints.q,
-        traj.t,
-        traj.s,
+        joints.trajectory.t,
+        joints.trajectory.s,
         clearance=motion.clearance,
         self_clearance=motion.self_clearance,
     )
-    return Attempt(rotation, flange, nominal, joints, collisions)
+    return dataclasses.replace(attempt, collisions=collisions)
 
 
 def avoid(
@@ -265,25 +288,3 @@ def avoid(
         progress("collision avoidance: Drake IK with a minimum-distance constraint")
         chosen = turn_tool_along_path(chosen, record, attempt, scene, fit.path, fit.normal, inputs)
     return chosen, record
-
-
-def with_normal_hint(error: PlanFailedError, inputs: Inputs, fit: FittedPath, scene):
-    """``error``, with a hint when the same path is feasible with the surface normal
-    reversed: a normal pointing out of the surface (not into it) turns the tool frame
-    over and reads as out of reach or a singularity. Costs one more joint plan, and
-    only on failure."""
-
-    def flipped(s):
-        return [-v for v in fit.normal(s)]
-
-    try:
-        flange = FlangePath(fit.path, flipped, X_IT=inputs.X_IT, X_PE=inputs.X_PE)
-        attempt_motion(inputs, scene, 0.0, flange)
-    except (PlanFailedError, NormalTangentError, InputError):
-        return error
-    failure = error.failure
-    hint = (
-        "; with the path's normals reversed the robot can follow it: check that they "
-        "point into the surface (path.normal, the CSV's nx,ny,nz or the mesh)"
-    )
-    return PlanFailedError(dataclasses.replace(failure, reason=failure.reason + hint))

@@ -23,10 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.job.home import home_pose
 from offline_prog.job.link_costs import LinkCosts
 from offline_prog.job.order import _held_karp, order_job
 from offline_prog.job.order_search import local_search
-from offline_prog.job.stages import home_pose, seam_options
+from offline_prog.job.stages import seam_options
 from offline_prog.plan import StageTimer, plan_seam
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import build_scene, load_inputs
@@ -66,7 +67,7 @@ def main() -> None:
         q_home = home_pose(inputs, scene)
         start = time.perf_counter()
         options = seam_options(
-            inputs, scene, lambda i, s: plan_seam(i, s, StageTimer(lambda _: None)),
+            inputs, scene, lambda k, r, i, s: plan_seam(i, s, StageTimer(lambda _: None)),
             lambda _: None,
         )  # fmt: skip
         planning = time.perf_counter() - start

@@ -31,7 +31,7 @@ from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.payload import cell_payload
 from offline_prog.placement.run import place_cell
 from offline_prog.placement.space import check_place
-from offline_prog.plan import plan_cell, plan_job
+from offline_prog.plan import plan_job
 
 ROOT = Path(__file__).resolve().parents[1]
 CELLS = ROOT / "cells"
@@ -139,9 +139,9 @@ def main() -> None:
         print(f"== place: budget {args.budget}, 2-worker LocalCluster ==")
         data = search(OUT_OF_REACH, folder / "oor", args.budget)
         show("seal_out_of_reach_kr16", data)
-        replan = plan_cell(folder / "oor" / "placed.yaml")
+        replan = plan_job(folder / "oor" / "placed.yaml")  # a path: cell: a one-seam job
         print(f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
-              f"cycle {replan.trajectory.duration:.2f} s")  # fmt: skip
+              f"cycle {replan.samples.t[-1]:.2f} s")  # fmt: skip
         show("seal_plate_kr16", search(seal_with_place(folder), folder / "seal", args.budget))
         data = search(JOB, folder / "job", min(args.budget, JOB_BUDGET))
         show("seal_job_far_kr16 (job)", data)

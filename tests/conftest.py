@@ -103,11 +103,10 @@ def planned_job(tmp_path_factory):
 
 def _one_seam(file: Path) -> bool:
     from offline_prog.config.cell import load_cell
-    from offline_prog.job.seams import is_job
 
-    return not is_job(load_cell(file))
+    return not load_cell(file).seams
 
 
-# The demo cells that plan one seam (path: without job:), and the whole jobs.
+# The demo cells of one seam (path:, a one-seam job), and those of several (seams:).
 ONE_SEAM_CELLS = [c for c in sorted(CELLS.glob("*.yaml")) if _one_seam(c)]
 JOB_CELLS = [c for c in sorted(CELLS.glob("*.yaml")) if not _one_seam(c)]

@@ -116,7 +116,7 @@ def test_ctrl_c_while_writing_is_exit_130_one_line_and_no_half_folder(
 ):
     """Ctrl-C during the writes: one line, exit 130, no traceback, and the folder
     holds the previous complete plan (nothing of the interrupted one)."""
-    import offline_prog.results.plan_folder as plan_folder
+    import offline_prog.results.job_folder as job_folder
 
     out = tmp_path / "out"
     assert run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", out)[0] == 0
@@ -125,7 +125,7 @@ def test_ctrl_c_while_writing_is_exit_130_one_line_and_no_half_folder(
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(plan_folder, "write_report_html", interrupted)
+    monkeypatch.setattr(job_folder, "write_job_report_html", interrupted)
     code, err = run(capsys, "plan", CELLS / "tape_cylinder_ur10e.yaml", "--out", out)
     assert code == 130 and err == ["interrupted"]
     assert sorted(p.relative_to(out) for p in out.rglob("*")) == before

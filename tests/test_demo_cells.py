@@ -1,6 +1,8 @@
-"""Every demo cell plans end to end from the command line, and its trajectory.csv
-alone shows the fixed-TCP properties: the part point under the tool is on the path,
-the tool axes are the process frame, the TCP speed is the commanded speed."""
+"""Every one-seam demo cell plans end to end from the command line as a one-seam job
+(home → link → approach → seam → retract → link → home), and its trajectory.csv alone
+shows the fixed-TCP properties on the seam's rows (segment ``process:seam``): the part
+point under the tool is on the path, the tool axes are the process frame, the TCP speed
+is the commanded speed; and on every row the joints drive the flange along the poses."""
 
 import json
 import subprocess
@@ -13,7 +15,6 @@ from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import load_cell, transform
 from offline_prog.path.inputs import load_points
-from offline_prog.results.plan_folder import csv_columns
 from offline_prog.robot.model import load_robot
 from offline_prog.scene.drake_cell import build_drake_cell
 from offline_prog.timing.trajectory import CSV_COLUMNS
@@ -24,7 +25,8 @@ DEMO_CELLS = ONE_SEAM_CELLS  # whole jobs (seams:) have their own tests in tests
 
 
 @pytest.fixture(scope="module", params=DEMO_CELLS, ids=lambda p: p.stem)
-def planned(request, tmp_path_factory):
+def planned_job_csv(request, tmp_path_factory):
+    """(cell, header without segment, (N, ·) every row, (N,) segment labels, report)."""
     out = tmp_path_factory.mktemp(request.param.stem)
     done = subprocess.run(
         [sys.executable, "-m", "offline_prog", "plan", str(request.param), "--out", str(out)],
@@ -36,18 +38,60 @@ def planned(request, tmp_path_factory):
     assert str(out) in done.stdout
     with open(out / "trajectory.csv") as stream:
         header = stream.readline().strip().split(",")
-    table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    segment = header.index("segment")
+    rows = [line.strip().split(",") for line in (out / "trajectory.csv").open().readlines()[1:]]
+    labels = np.array([row[segment] for row in rows])
+    numbers = [
+        [float(v) if v else np.nan for k, v in enumerate(row) if k != segment] for row in rows
+    ]
+    whole = np.array(numbers)
     report = json.loads((out / "report.json").read_text())
-    return request.param, header, table, report
+    return request.param, [h for h in header if h != "segment"], whole, labels, report
+
+
+@pytest.fixture(scope="module")
+def planned(planned_job_csv):
+    """The seam's rows (segment process:seam, and the next row: the seam's last sample
+    is where the retract starts), its clock from 0."""
+    cell_file, header, whole, labels, report = planned_job_csv
+    rows = np.flatnonzero(labels == "process:seam")
+    table = whole[rows[0] : rows[-1] + 2].copy()
+    table[:, 0] -= table[0, 0]
+    return cell_file, header, table, report
+
+
+def test_one_seam_job_segments_and_defaults(planned_job_csv):
+    """A path: cell runs home → link → approach → seam → retract → link → home, starting
+    and ending at the home pose, and its report says how home, approach and retract
+    were chosen (robot.yaml / job.home; normal 50 mm by default)."""
+    cell_file, header, whole, labels, report = planned_job_csv
+    order = [labels[0]] + [b for a, b in zip(labels[:-1], labels[1:], strict=True) if a != b]
+    assert order == ["link", "approach:seam", "process:seam", "retract:seam", "link"]
+    cell, robot = load_cell(cell_file), load_robot(load_cell(cell_file).robot.model)
+    col = {name: i for i, name in enumerate(header)}
+    q = whole[:, [col[f"q{i}"] for i in range(1, 7)]]
+    home = np.deg2rad(cell.job.home.joints_deg) if cell.job and cell.job.home else robot.home_c
+    for row in (q[0], q[-1]):
+        np.testing.assert_allclose(robot.controller_joints(row), home, atol=1e-9)
+    job = report["job"]
+    assert job["home_from"] == ("job.home" if cell.job and cell.job.home else "robot.yaml home_deg")
+    (seam,) = job["order"]
+    assert seam["approach"] == seam["retract"] == {"kind": "normal", "distance_mm": 50.0}
+    # The seam's one-seam keys stay at the top of report.json; the cycle is the job's.
+    assert report["trajectory"]["duration_s"] == report["seams"][0]["trajectory"]["duration_s"]
+    assert job["cycle_time_s"] == pytest.approx(whole[-1, 0], abs=1e-6)
+    assert job["cycle_time_s"] > report["trajectory"]["duration_s"]
 
 
 def test_header_and_sampling(planned):
     cell_file, header, table, report = planned
-    assert header == csv_columns(6)
     assert header[: len(CSV_COLUMNS)] == CSV_COLUMNS
+    assert header[len(CSV_COLUMNS) :] == [f"q{i}" for i in range(1, 7)] + [
+        f"qd{i}" for i in range(1, 7)
+    ]
     t = table[:, 0]
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
-    np.testing.assert_allclose(np.diff(t)[:-1], 1 / 250.0, atol=1e-9)
+    np.testing.assert_allclose(np.diff(t)[:-1], 1 / 250.0, atol=1e-8)  # CSV: 10 digits
     assert t[-1] == pytest.approx(report["trajectory"]["duration_s"], abs=1e-6)
     assert report["fit"]["max_error_mm"] <= report["fit"]["tolerance_mm"]
 
@@ -120,10 +164,11 @@ def test_tcp_speed_is_the_commanded_speed(planned):
     assert report["trajectory"]["tcp_speed_max_error_rel"] <= 1e-9
 
 
-def test_joint_columns_drive_the_flange_along_the_planned_poses(planned):
-    """Drake's FK of the URDF at q1..q6 reproduces the planned flange pose (what the
-    controller will do is what the preview shows), within the joint limits."""
-    cell_file, header, table, report = planned
+def test_joint_columns_drive_the_flange_along_the_planned_poses(planned_job_csv):
+    """Drake's FK of the URDF at q1..q6 reproduces the planned flange pose on every row
+    of the job (what the controller will do is what the preview shows), within the
+    joint limits."""
+    cell_file, header, table, _, report = planned_job_csv
     cell = load_cell(cell_file)
     col = {name: i for i, name in enumerate(header)}
     robot = load_robot(cell.robot.model)

@@ -23,7 +23,9 @@ from offline_prog.collision.check import CollisionResult
 from offline_prog.errors import PlanFailedError
 from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.bspline_fit import fit_on_knots, open_knots
+from offline_prog.path.cusps import SmoothedFlangePath
 from offline_prog.path.fixed_tcp import FlangePath
+from offline_prog.timing.time_law import Sin2TimeLaw
 
 GRID_POINTS = 80  # IK samples along the path
 CLEARANCE_MARGIN_M = 2e-3  # asked of the IK beyond the clearance
@@ -119,13 +121,13 @@ MAX_AVOIDANCE_ATTEMPTS = 12
 
 @dataclasses.dataclass
 class Attempt:
-    """One joint plan and its collision check."""
+    """One joint plan and its collision check (None until the ``check`` stage ran)."""
 
-    rotation: float
-    flange: object
-    nominal: object
+    rotation: float  # the tool's turn about its symmetry axis [rad]
+    flange: FlangePath | SmoothedFlangePath
+    nominal: Sin2TimeLaw  # the process law without joint limits
     joints: JointTrajectory
-    collisions: CollisionResult
+    collisions: CollisionResult | None
 
 
 def avoid_collisions(first: Attempt, rotations, attempt) -> tuple[Attempt, dict]:

@@ -70,15 +70,13 @@ BAS(#ACC_PTP,{ptp_acc})
 $VEL.ORI1={ori:.0f}
 $VEL.ORI2={ori:.0f}
 $APO.CDIS={cdis:.3f}
-; Approach: PTP (joints) to {approach:g} mm off the path start, then LIN onto the path
-PTP XAPPROACH
+; Start: PTP (joints) to {start}, then LIN onto the path
+PTP {start_name}
 $VEL.CP={v:.4f}
 LIN XP1
 ; Process start
 {process}
-; Process end. Retract {approach:g} mm
-$VEL.CP={v:.4f}
-LIN XRETRACT
+; Process end{retract}
 END"""
 
 
@@ -136,18 +134,20 @@ def write_krl(
     angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
     line_limit: int = 1400,
     tcp_pose_convention: str = "X_TP",
-    approach_m: float = 0.02,
+    approach_m: float = 0.0,
     blend_m: float = 0.001,
     forced: bool = False,
 ) -> KrlResult:
     """Write the KRL program for a plan (see the module docstring for the frames).
 
-    The main program sets the frames, moves PTP (E6AXIS, joint solution nearest the
-    plan's start) to the approach pose ``approach_m`` off the path start against the
-    process normal (y of F), goes LIN onto the path, runs the process LIN points
-    (``C_DIS`` with ``$APO.CDIS`` = blend_m; ``$VEL.CP`` see ``_process_lines``: the TCP
-    speed, or the part-origin speed in the flange style) and retracts LIN by
-    ``approach_m``. Process lines beyond ``line_limit`` go to ``name_1``, ``name_2``, ...
+    The main program sets the frames, moves PTP (E6AXIS) to the plan's first joints
+    (or, with ``approach_m`` > 0, to the joint solution nearest them at the pose
+    ``approach_m`` off the path start against the process normal, y of F: a move the
+    plan does not hold), goes LIN onto the path, runs the process LIN points (``C_DIS``
+    with ``$APO.CDIS`` = blend_m; ``$VEL.CP`` see ``_process_lines``: the TCP speed, or
+    the part-origin speed in the flange style) and, with ``approach_m`` > 0, retracts
+    LIN by ``approach_m``. A whole job's program (``krl_job``) moves only as planned.
+    Process lines beyond ``line_limit`` go to ``name_1``, ``name_2``, ...
     (own .src/.dat each), called in order from the main program.
 
     Args:
@@ -158,7 +158,8 @@ def write_krl(
         chord_tol_m, angle_tol_rad: allowed deviation of the plan from the LIN path [m, rad].
         line_limit: most process lines in one .src before splitting.
         tcp_pose_convention: "X_TP" (default, P in T) or "X_PF" (T in P), external_tcp only.
-        approach_m, blend_m: approach/retract distance and C_DIS blend distance [m].
+        approach_m, blend_m: approach/retract distance (0: none, the default) and C_DIS
+            blend distance [m].
         forced: the plan failed and is exported anyway (the header says so).
 
     Raises:
@@ -177,8 +178,11 @@ def write_krl(
     off[1, 3] = -approach_m  # the tool frame backed off against the normal n = y of F
     X_PF_off = data.X_PF[[0, -1]] @ off  # approach, retract
     X_BE_off = data.X_BT @ np.linalg.inv(X_PF_off) @ np.linalg.inv(data.X_EP)
-    q_approach = joints_near(robot, X_BE_off[0], data.q[0], data, "approach")
-    q_retract = joints_near(robot, X_BE_off[1], data.q[-1], data, "retract")
+    retract = approach_m > 0
+    q_start, q_retract = data.q[0], data.q[-1]
+    if retract:
+        q_start = joints_near(robot, X_BE_off[0], data.q[0], data, "approach")
+        q_retract = joints_near(robot, X_BE_off[1], data.q[-1], data, "retract")
     X_PF = np.concatenate([data.X_PF[idx], X_PF_off[1:]])  # the process points, retract
     X_BE = np.concatenate([data.X_BE[idx], X_BE_off[1:]])
     if style == "flange":
@@ -214,19 +218,26 @@ def write_krl(
         ptp_acc=PTP_ACC_PERCENT,
         ori=max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S),
         cdis=blend_m * 1e3,
-        approach=approach_m * 1e3,
+        start=f"{approach_m * 1e3:g} mm off the path start" if retract else "the plan's start",
+        start_name="XAPPROACH" if retract else "XSTART",
+        retract=(
+            f". Retract {approach_m * 1e3:g} mm\n$VEL.CP={vel_cp(data.process_speed_m_s):.4f}"
+            "\nLIN XRETRACT"
+            if retract
+            else ""
+        ),
         v=vel_cp(data.process_speed_m_s),
         process="\n".join([f"{sub}( )" for sub in subs] or parts[0]),
     )
-    axes = ",".join(f"A{i + 1} {krl_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_approach)))
+    axes = ",".join(f"A{i + 1} {krl_num(v, 5)}" for i, v in enumerate(np.rad2deg(q_start)))
     dat = [
         f"DEFDAT {name}",
         "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
         f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ data.X_EP)}}}",
         *([f"DECL FRAME FIXED_TOOL={{{krl_frame(data.X_BT)}}}"] if style != "flange" else []),
-        f"DECL E6AXIS XAPPROACH={{{axes}{_ZEROS}}}",
+        f"DECL E6AXIS {'XAPPROACH' if retract else 'XSTART'}={{{axes}{_ZEROS}}}",
         decl["XP1"],
-        decl["XRETRACT"],
+        *([decl["XRETRACT"]] if retract else []),
     ]
     dat += [] if subs else [decl[n] for n in names[1:-1]]
     files = _write(Path(out_dir), name, head + src.splitlines(), head + dat + ["ENDDAT"])

@@ -36,7 +36,10 @@ from offline_prog.export.program import ProgramData
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.robot.model import RobotModel
 
-DEFAULT_APPROACH_M = 0.02  # approach / retract along -y of F (y = pressing direction n)
+# Approach / retract along -y of F (y = pressing direction n): none by default, so the
+# program moves only as planned (MoveAbsJ to the plan's first joints); a whole job's
+# program (rapid_job) has the planned approach and retract.
+DEFAULT_APPROACH_M = 0.0
 START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ
 APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retract
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000

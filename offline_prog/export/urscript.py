@@ -15,7 +15,6 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
@@ -47,11 +46,18 @@ class UrScriptResult:
 
 
 def resample_joints(data: ProgramData, period_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """(t (M,), q (M, 6)) on the controller period, by cubic Hermite on q and q̇."""
-    spline = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)
+    """(t (M,), q (M, 6)) on the controller period, on the plan's straight joint steps
+    (:func:`joints_on_steps`)."""
     t = np.arange(0.0, data.t[-1], period_s)
     t = np.append(t, data.t[-1]) if data.t[-1] - t[-1] > 1e-9 else t
-    return t, spline(t)
+    return t, joints_on_steps(data.t, data.q, t)
+
+
+def joints_on_steps(t: np.ndarray, q: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """(M, 6) the joints at times ``grid`` (M,) [s], linear between the plan's samples
+    t (N,), q (N, 6) [rad]: the straight joint step between two samples is what the
+    collision check certified (collision.check), so a servoj target never leaves it."""
+    return np.column_stack([np.interp(grid, t, q[:, j]) for j in range(q.shape[1])])
 
 
 def _list(values: np.ndarray, digits: int = 7) -> str:

@@ -21,7 +21,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.header import header_lines
@@ -34,6 +33,7 @@ from offline_prog.export.urscript import (
     SERVOJ_GAIN,
     SERVOJ_LOOKAHEAD_S,
     _list,
+    joints_on_steps,
 )
 from offline_prog.io_events import Signal
 
@@ -106,11 +106,10 @@ def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> li
     job, io = data.job, data.process_io
     name = data.seam_names[seam]
     t = job.t[rows]
-    spline = CubicHermiteSpline(t - t[0], job.q[rows], job.qd[rows], axis=0)
     grid = np.arange(0.0, t[-1] - t[0], period_s)
     grid = np.append(grid, t[-1] - t[0]) if t[-1] - t[0] - grid[-1] > 1e-9 else grid
-    q = spline(grid)
     grid = grid + t[0]  # the job's clock
+    q = joints_on_steps(t, job.q[rows], grid)
     # Event k is set before the first command whose sample is at or past its time.
     sets: dict[int, list] = {}
     for event in data.events:

@@ -32,13 +32,9 @@ def job_seams(cell: Cell) -> list[SeamConfig]:
     return [SeamConfig(**fields, name=SHORTHAND_NAME)]
 
 
-def is_job(cell: Cell) -> bool:
-    """``seams:``, or ``path:`` with ``job:`` (a one-seam job), plans as a whole job."""
-    return bool(cell.seams) or cell.job is not None
-
-
 def job_config(cell: Cell) -> JobConfig:
-    """The cell's ``job:``, or its defaults (home from the robot, the given order)."""
+    """The cell's ``job:``, or its defaults (home from the robot, the given order): a
+    ``path:`` cell without ``job:`` is a one-seam job with these defaults."""
     return cell.job or JobConfig()
 
 

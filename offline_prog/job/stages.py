@@ -1,6 +1,6 @@
 """The stages of :func:`offline_prog.plan.plan_job` beyond the one-seam pipeline.
 
-``home_pose`` → ``seam_options`` (each seam planned in each direction it may run,
+``job.home.home_pose`` → ``seam_options`` (each seam planned in each direction it may run,
 with its approach and retract) → ``choose_order`` → ``job_pieces`` (links between the
 chosen seams, from home and back) → ``job.assemble.lay_out`` → ``check_job``.
 """
@@ -13,11 +13,14 @@ import numpy as np
 
 from offline_prog.collision.check import CollisionResult, check_trajectory
 from offline_prog.collision.motion import MotionChecker
+from offline_prog.collision.profile import distance_profile
 from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.job.approach import CartesianMove, cartesian_move
-from offline_prog.job.assemble import JobSamples, Piece
+from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.order import JobOrder, order_job
+from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
+from offline_prog.job.records import SeamOption
 from offline_prog.job.seams import (
     errors_named_for,
     job_config,
@@ -33,71 +36,10 @@ MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order be
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
 
 
-@dataclasses.dataclass
-class SeamOption:
-    """One way to run a seam: its plan (a :class:`~offline_prog.plan.Plan`) in one
-    direction, the approach and retract, and the link ends q_in / q_out (6,) [rad]."""
-
-    seam: int
-    name: str
-    reverse: bool
-    plan: object
-    approach: CartesianMove | None
-    retract: CartesianMove | None
-
-    @property
-    def q_in(self) -> np.ndarray:
-        return self.approach.q[0] if self.approach else self.plan.joints.q[0]
-
-    @property
-    def q_out(self) -> np.ndarray:
-        return self.retract.q[-1] if self.retract else self.plan.joints.q[-1]
-
-    @property
-    def label(self) -> str:
-        direction = "reverse" if self.reverse else "forward"
-        return f"{self.name} {direction} branch {self.plan.joints.branch}"
-
-
-def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
-    """(6,) the job's home in URDF joints [rad]: ``job.home`` or the robot's own,
-    inside the joint limits and collision-free at the cell's clearances.
-
-    Raises:
-        InputError: naming ``job.home.joints_deg``.
-    """
-    robot, home = inputs.robot, job_config(inputs.cell).home
-    key = "job.home.joints_deg"
-    if home is None:
-        if robot.home_c is None:
-            raise InputError(
-                inputs.file, "job.home", f"robot {robot.name} has no home_deg: give one"
-            )
-        q_c = np.asarray(robot.home_c)
-    else:
-        q_c = np.deg2rad(home.joints_deg)
-        outside = (q_c < robot.q_lower - 1e-12) | (q_c > robot.q_upper + 1e-12)
-        if outside.any():
-            j = int(np.argmax(outside))
-            raise InputError(
-                inputs.file, key, f"axis {j + 1} = {home.joints_deg[j]:g}° is outside its limits "
-                f"[{np.rad2deg(robot.q_lower[j]):g}, {np.rad2deg(robot.q_upper[j]):g}]°",
-            )  # fmt: skip
-    q = robot.urdf_joints(q_c)
-    motion = inputs.cell.motion
-    check = check_trajectory(
-        scene, q[None, :], np.zeros(1), np.zeros(1),
-        clearance=motion.clearance, self_clearance=motion.self_clearance,
-    )  # fmt: skip
-    if not check.collision_free:
-        where = "job.home" if home is None else key
-        raise InputError(inputs.file, where, f"the home pose collides: {check.message}")
-    return q
-
-
 def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[list[SeamOption]]:
     """Each seam planned in each direction it may run (``direction``), with approach and
     retract. A direction the robot cannot do is dropped when the other one works.
+    ``plan_seam(k, reverse, seam_inputs, scene)`` plans seam k in one direction.
 
     Raises:
         InputError: naming ``seams[k].<key>``.
@@ -113,8 +55,11 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
             try:
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
-                    plan = plan_seam(seam_in, scene)
-                    for variant in [plan, *_other_branches(seam_in, scene, plan)]:
+                    plan = plan_seam(k, reverse, seam_in, scene)
+                    # A path: cell's one seam keeps the branch its pipeline chose (the
+                    # plan as before issue 24, not planned again on other branches).
+                    others = _other_branches(seam_in, scene, plan) if inputs.cell.seams else []
+                    for variant in [plan, *others]:
                         try:
                             approach, retract = _ends(seam_in, variant, seam)
                         except PlanFailedError:
@@ -126,9 +71,9 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
                 errors.append(error)
         if not found:
             failure = errors[0].failure
-            raise PlanFailedError(
-                dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
-            )
+            if inputs.cell.seams:  # name the seam (a path: cell has only the one)
+                failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
+            raise PlanFailedError(failure)
         options.append(found)
     progress(Step(f"{len(seams)} seams planned", stage="seams", done=len(seams), total=len(seams)))
     return options
@@ -267,14 +212,66 @@ def _seam_pieces(option: SeamOption) -> list[Piece]:
     return out
 
 
-def check_job(inputs: Inputs, scene: DrakeCell, samples: JobSamples) -> CollisionResult:
+@dataclasses.dataclass
+class LinkedJob:
+    """Stage ``links``: the options run, in order; the links (home → first, …, last →
+    home); the job's samples and the tool's speed along the part on every row (N,)
+    [m/s]."""
+
+    chosen: list[SeamOption]
+    links: list[LinkMotion]
+    samples: JobSamples
+    tcp_speed: np.ndarray
+
+
+def link_job(
+    inputs: Inputs,
+    scene: DrakeCell,
+    options: list[list[SeamOption]],
+    order: JobOrder,
+    q_home: np.ndarray,
+    progress,
+) -> LinkedJob:
+    """The chosen options linked from home and back (:func:`job_pieces`), laid out as
+    one trajectory (``job.assemble.lay_out``)."""
+    flat = [option for seam in options for option in seam]
+    chosen = [flat[i] for i in order.sequence]
+    pieces, links = job_pieces(inputs, scene, chosen, q_home, progress)
+    samples = lay_out(pieces)
+    return LinkedJob(chosen, links, samples, tool_speed(inputs, samples, chosen))
+
+
+def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
+    """Stage ``io``: the process I/O on every row (``job.process_io``).
+
+    Raises:
+        InputError: a switch that falls outside its seam's moves (the key named).
+    """
+    lengths = {option.name: option.plan.path.length for option in linked.chosen}
+    process_io = inputs.cell.tool.process_io
+    try:
+        return io_columns(linked.samples, process_io, lengths, linked.tcp_speed)
+    except IoPlacementError as error:
+        raise InputError(inputs.file, error.key, error.reason) from None
+
+
+def check_job(inputs: Inputs, scene: DrakeCell, linked: LinkedJob) -> CollisionResult:
     """The whole job's collision check: every sample and between samples, the same
     geometry, clearances and rules as a seam (collision.check)."""
-    motion = inputs.cell.motion
+    motion, samples = inputs.cell.motion, linked.samples
     return check_trajectory(
-        scene, samples.q, samples.t, np.nan_to_num(samples.path_m),
-        clearance=motion.clearance, self_clearance=motion.self_clearance,
-    )  # fmt: skip
+        scene,
+        samples.q,
+        samples.t,
+        np.nan_to_num(samples.path_m),
+        clearance=motion.clearance,
+        self_clearance=motion.self_clearance,
+    )
+
+
+def job_clearance(scene: DrakeCell, linked: LinkedJob):
+    """Stage ``clearance``: the whole job's clearance profile (collision.profile)."""
+    return distance_profile(scene, linked.samples.q, linked.samples.t)
 
 
 def tool_speed(inputs: Inputs, samples: JobSamples, chosen: list[SeamOption]) -> np.ndarray:

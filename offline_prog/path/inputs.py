@@ -17,6 +17,7 @@ from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.closing import OpenEndsError
 from offline_prog.path.process_frames import (
+    NormalField,
     constant_normal,
     mesh_normals,
     normal_fit_angles,
@@ -125,7 +126,7 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
         raise _error(file, key, f"{source}: {error}") from None
 
 
-def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath):
+def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath) -> NormalField:
     """The surface-normal field, from exactly one of: CSV columns, path.normal, part.mesh."""
     given = [
         k

@@ -16,11 +16,11 @@ import numpy as np
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from offline_prog.config.cell import Cell, transform
-from offline_prog.job.seams import is_job, job_seams, seam_inputs
+from offline_prog.config.edits import CellValues, apply, initial_values, schema_transform
+from offline_prog.job.seams import job_seams, seam_inputs
 from offline_prog.placement.payload import CellPayload, unpack
 from offline_prog.placement.space import Candidate, Pose
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.session.state import SessionState, apply, initial_state, schema_transform
 from offline_prog.stages import FittedPath, Inputs, fit_path, load_inputs
 
 SCREEN_SAMPLES = 1000  # σ samples of a seam's path-IK screen (corners need ~10 each)
@@ -41,17 +41,18 @@ class Context:
 
     Attributes:
         inputs: the cell as given (a job's, for a job).
-        seams: every seam (one for a one-seam cell).
-        job: the cell plans as a whole job (``plan_job``).
+        seams: every seam (one for a ``path:`` cell, a one-seam job).
         initial: the cell's own editable values; carried: indices of the obstacles
             that stand with the tool.
+        fits: (seam index, reversed) ↦ fitted path, for ``plan_loaded_job``: each seam
+            is fitted once per direction in this process, whatever the placement.
     """
 
     inputs: Inputs
     seams: list[SeamView]
-    job: bool
-    initial: SessionState
+    initial: CellValues
     carried: tuple[int, ...]
+    fits: dict[tuple[int, bool], FittedPath] = dataclasses.field(default_factory=dict)
 
 
 _CONTEXTS: dict[str, Context] = {}  # per worker process: one loaded cell per payload
@@ -70,14 +71,11 @@ def load_context(cell_file: Path) -> Context:
     """
     inputs = load_inputs(cell_file, ROBOTS_DIR)
     cell = inputs.cell
-    job = is_job(cell)
-    if job:
-        seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
-    else:
-        seams = [_seam(inputs)]
+    seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
     names = set(cell.place.moves_with_tool) if cell.place else set()
     carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
-    return Context(inputs, seams, job, initial_state(cell), carried)
+    fits = {(k, False): seam.fit for k, seam in enumerate(seams)}
+    return Context(inputs, seams, initial_values(cell), carried, fits)
 
 
 def context(payload: CellPayload) -> Context:

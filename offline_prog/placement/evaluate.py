@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from offline_prog.errors import Failure, InputError, PlanFailedError
+from offline_prog.job.records import JobPlan, Plan
 from offline_prog.placement.context import Context, placed_inputs
 from offline_prog.placement.objective import (
     CANNOT_FOLLOW,
@@ -23,28 +24,22 @@ from offline_prog.placement.objective import (
 )
 from offline_prog.placement.screen import screen
 from offline_prog.placement.space import Candidate
-from offline_prog.plan import JobPlan, Plan, StageTimer, plan_flanges, plan_loaded_job
-from offline_prog.stages import build_scene, flange_paths
+from offline_prog.plan import StageTimer, plan_loaded_job
 
 MIN_VIOLATION = 1e-9  # [m]: a collision is never as good as none
 
 
-def plan_candidate(ctx: Context, candidate: Candidate) -> Plan | JobPlan:
-    """The candidate's plan: a :class:`~offline_prog.plan.Plan` (one seam, no clearance
-    plot) or, for a job, a :class:`~offline_prog.plan.JobPlan`.
+def plan_candidate(ctx: Context, candidate: Candidate) -> JobPlan:
+    """The candidate's job plan (a ``path:`` cell is a one-seam job), without the
+    clearance plot.
 
     Raises:
         PlanFailedError: the robot cannot follow a path (or no link is found);
         InputError: geometry the method refuses.
     """
-    inputs = placed_inputs(ctx, candidate)
     quiet = StageTimer(lambda stage: None)
-    if ctx.job:
-        return plan_loaded_job(inputs, quiet)
-    fit = ctx.seams[0].fit
-    flanges = flange_paths(inputs, fit)
-    scene = build_scene(inputs)
-    return plan_flanges(inputs, scene, fit, flanges, quiet, clearance_profile=False)
+    inputs = placed_inputs(ctx, candidate)
+    return plan_loaded_job(inputs, quiet, clearance_profile=False, fits=ctx.fits)
 
 
 def _seam_terms(plans: list[Plan]) -> dict:
@@ -71,8 +66,9 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
     try:
         plan = plan_candidate(ctx, candidate)
     except PlanFailedError as error:
+        # How far along the one seam it failed (0 for a job of several, or off the seam).
         length = ctx.seams[0].fit.path.length
-        done = 0.0 if ctx.job else error.failure.sigma_m / length
+        done = error.failure.sigma_m / length if len(ctx.seams) == 1 else 0.0
         screened = screen(ctx, candidate)
         return Evaluation(candidate, "plan", CANNOT_FOLLOW, screened.violation + 1.0 - done,
                           str(error.failure), error.failure.kind.value,
@@ -80,11 +76,8 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
     except InputError as error:
         return Evaluation(candidate, "plan", REFUSED, 1.0, error.reason, "refused",
                           seconds=time.perf_counter() - start)  # fmt: skip
-    if isinstance(plan, JobPlan):
-        seams, t = plan.seams, plan.samples.t
-        duration = float(t[-1] - t[0])
-    else:
-        seams, duration = [plan], float(plan.trajectory.duration)
+    seams, t = plan.seams, plan.samples.t
+    duration = float(t[-1] - t[0])
     air = duration - sum(float(p.trajectory.duration) for p in seams)
     collisions = plan.collisions
     tier, violation = FEASIBLE, 0.0

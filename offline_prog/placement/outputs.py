@@ -21,12 +21,12 @@ import math
 import os
 from pathlib import Path
 
+from offline_prog.config.cell_text import with_values
 from offline_prog.placement.context import Context, moved_obstacles
 from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import data_file_keys
 from offline_prog.placement.search import Placement
 from offline_prog.placement.space import Pose, SearchSpace
-from offline_prog.session.cell_text import with_values
 
 CUT_TARGET = 0.15  # the cycle-time cut a placement search should find (issue 16)
 

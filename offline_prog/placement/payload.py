@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from offline_prog.config.cell import Cell
-from offline_prog.session.cell_text import with_values
+from offline_prog.config.cell_text import with_values
 
 
 @dataclasses.dataclass(frozen=True)

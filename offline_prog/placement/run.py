@@ -142,9 +142,7 @@ def write_folder(out_dir: Path, cell_file: Path, ctx: Context, result: Placement
 
 def write_best_preview(ctx: Context, best: Evaluation, file: Path) -> None:
     """The best candidate planned again here, as an animated MeshCat page."""
-    from offline_prog.plan import JobPlan
     from offline_prog.viz.job_preview import write_job_preview_html
-    from offline_prog.viz.preview import write_preview_html
 
     plan = plan_candidate(ctx, best.candidate)  # evaluated feasible: plans again
-    (write_job_preview_html if isinstance(plan, JobPlan) else write_preview_html)(plan, file)
+    write_job_preview_html(plan, file)

@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cell import Cell, PlaceConfig
+from offline_prog.config.edits import rpy_deg_of
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
 from offline_prog.errors import InputError
-from offline_prog.session.state import rpy_deg_of
 
 MAX_SCREEN_POINTS = 100_000  # per grasp
 MAX_OFFSET_MM = 10_000.0  # a tool stand 10 m from the robot is a typo

@@ -23,11 +23,12 @@ from offline_prog.config.cell import transform
 from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
 from offline_prog.export.job_program import JobProgramData, JobSegment
 from offline_prog.export.program import PLAN_FILE, ProgramData
-from offline_prog.job.seams import job_config
-from offline_prog.plan import JobPlan
+from offline_prog.job.records import JobPlan
+from offline_prog.job.seams import job_config, job_seams
 from offline_prog.results.plan_folder import (
     InParallel,
     check_out_dir,
+    clearance_csv,
     program_data,
     program_names,
     time_law_name,
@@ -144,7 +145,7 @@ def job_report(job: JobPlan) -> dict:
             }
         )
     io_ = job.io
-    return {
+    summary = {
         "generator": f"offline_prog {__version__}",
         "generated": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
         "cell": str(job.cell_file),
@@ -155,6 +156,7 @@ def job_report(job: JobPlan) -> dict:
         "payload": payload_summary(job.cell),
         "job": {
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
+            "home_from": "job.home" if job_config(job.cell).home else "robot.yaml home_deg",
             "order_mode": job_config(job.cell).order,
             "order": [
                 {
@@ -162,6 +164,7 @@ def job_report(job: JobPlan) -> dict:
                     "direction": "reverse" if o.reverse else "forward",
                     "branch": int(o.plan.joints.branch),
                     "tool_rotation_deg": float(np.rad2deg(o.plan.tool_rotation_rad)),
+                    **_moves(job, o.seam),
                 }
                 for o in job.chosen
             ],
@@ -197,6 +200,21 @@ def job_report(job: JobPlan) -> dict:
         **collision_summary(job),
         "timings_s": job.timings_s,
     }
+    if not job.cell.seams:  # path: (one seam): its one-seam keys stay where they were
+        for key, value in summary["seams"][0].items():
+            if key != "seam":
+                summary.setdefault(key, value)
+    return summary
+
+
+def _moves(job: JobPlan, k: int) -> dict:
+    """The approach and retract of seam k as planned: kind and distance [mm] ("none",
+    0 when there is none), as given in the cell or by default (normal, 50 mm)."""
+    seam = job_seams(job.cell)[k]
+    return {
+        kind: {"kind": spec.kind, "distance_mm": 0.0 if spec.kind == "none" else spec.distance_mm}
+        for kind, spec in (("approach", seam.approach), ("retract", seam.retract))
+    }
 
 
 def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dict]:
@@ -216,6 +234,9 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
         write_atomic(files["trajectory"], trajectory_csv(job))
         write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
         write_collisions_json(job.collisions, files["collisions"])
+        if job.clearance_profile is not None:
+            files["clearance"] = folder / "clearance.csv"
+            write_atomic(files["clearance"], clearance_csv(*job.clearance_profile))
         data = job_program_data(job, summary)
         files["job"] = data.save(folder)
         files["plan"] = folder / PLAN_FILE

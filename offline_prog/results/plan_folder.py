@@ -30,7 +30,7 @@ from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
-from offline_prog.plan import Plan
+from offline_prog.job.records import Plan
 from offline_prog.results.report import report
 from offline_prog.timing.trajectory import CSV_COLUMNS
 from offline_prog.viz.preview import write_preview_html

@@ -13,8 +13,8 @@ import numpy as np
 
 from offline_prog import __version__
 from offline_prog.export.payload import payload, payload_note, payload_record
+from offline_prog.job.records import Plan
 from offline_prog.joints.path_timing import without_joint_limits
-from offline_prog.plan import Plan
 from offline_prog.timing.speed_hold import HOLD
 
 

@@ -79,8 +79,11 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
     job = report["job"]
     console.print(
         f"[bold]{report['name'] or report['cell']}[/bold]  robot {report['robot']}, "
-        f"tool {report['tool']}, part {report['part']}: {len(report['seams'])} seams"
+        f"tool {report['tool']}, part {report['part']}: {len(report['seams'])} "
+        + ("seam" if len(report["seams"]) == 1 else "seams")
     )
+    if not report["payload"]["set"]:
+        console.print(f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]")
     order = ", ".join(f"{o['seam']} ({o['direction']})" for o in job["order"])
     console.print(
         f"  order     {order} ({job['order_mode']}, {job['order_method']}; estimated "

@@ -23,7 +23,7 @@ def _in_stretches(sigma: np.ndarray, stretches) -> np.ndarray:
 
 def sample_states(plan) -> np.ndarray:
     """(N,) one of OK, SLOWED, SINGULAR, COLLIDING per trajectory sample of ``plan``
-    (a :class:`~offline_prog.plan.Plan`)."""
+    (a :class:`~offline_prog.job.records.Plan`)."""
     traj, joints = plan.trajectory, plan.joints
     # The time law's own position: the σ that retiming and singularity stretches use.
     sigma = getattr(traj, "law_position", traj.s)

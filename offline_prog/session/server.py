@@ -23,6 +23,7 @@ import threading
 import time
 from pathlib import Path
 
+from offline_prog.config import cell_text
 from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
 from offline_prog.scene.drake_cell import build_cell_model
@@ -196,13 +197,12 @@ class Session:
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
             planner = self.replanner
-            saved = outputs.save_cell(planner.file, planner.initial, state, planner.cell(state))
+            saved = cell_text.save_cell(planner.file, planner.initial, state, planner.cell(state))
             self.saved[state] = saved
         if kind == "save":
             return saved
-        result = self.replanner.plan(state, progress)
         out = self.out_root / saved.stem
-        return saved, *outputs.export(self.replanner, result, saved, out, progress)
+        return saved, *outputs.export(saved, out, progress)
 
     # --- the main thread: MeshCat -------------------------------------------------------
 
@@ -265,7 +265,9 @@ class Session:
                 return  # stale: the controls moved on while it was planned
         self.view.show(answer)
         planner = self.replanner
-        line = plan_status(answer, planner.seam_names[answer.state.seam] if planner.is_job else "")
+        line = plan_status(
+            answer, planner.seam_names[answer.state.seam] if len(planner.seam_names) > 1 else ""
+        )
         with self.lock:
             self.shown_generation, self.plan_line = generation, line
         plan = answer.plan

@@ -158,29 +158,35 @@ def test_round_trip_reproduces_the_flange_poses(data, tmp_path, style, conventio
     result = write_krl(data, tmp_path, style=style, tcp_pose_convention=convention)
     motions, settings = read_program(tmp_path, "offline_prog")
     assert settings["IPO_MODE"] == ("#TCP" if style == "external_tcp" else "#BASE")
-    assert [m["kind"] for m in motions] == ["PTP"] + ["LIN"] * (result.n_points + 1)
-    assert motions[0]["type"] == "E6AXIS" and motions[0]["point"] == "XAPPROACH"
+    # No approach or retract of the writer's own: PTP to the plan's start, its points.
+    assert [m["kind"] for m in motions] == ["PTP"] + ["LIN"] * result.n_points
+    assert motions[0]["type"] == "E6AXIS" and motions[0]["point"] == "XSTART"
     lin = [m for m in motions if m["kind"] == "LIN"]
-    assert [m["point"] for m in lin] == [f"XP{k + 1}" for k in range(result.n_points)] + [
-        "XRETRACT"
-    ]
+    assert [m["point"] for m in lin] == [f"XP{k + 1}" for k in range(result.n_points)]
     indices = np.asarray(result.indices)
     assert indices[0] == 0 and indices[-1] == len(data.t) - 1 and np.all(np.diff(indices) > 0)
     X_BE = flange_poses(lin, settings, style, convention)
-    dp, da = pose_errors(X_BE[:-1], data.X_BE[indices])
-    assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    dp, da = pose_errors(X_BE[-1:], offset_pose(data, -1)[None])  # the retract
+    dp, da = pose_errors(X_BE, data.X_BE[indices])
     assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
     # Exact stops at the process start and end; blending in between.
-    assert [m["blended"] for m in lin] == [False] + [True] * (result.n_points - 2) + [False] * 2
+    assert [m["blended"] for m in lin] == [False] + [True] * (result.n_points - 2) + [False]
     if style == "external_tcp":  # the other convention would put the flange elsewhere
         other = {"X_TP": "X_PF", "X_PF": "X_TP"}[convention]
         assert pose_errors(flange_poses(lin, settings, style, other), X_BE)[0] > 0.01
 
 
-def test_ptp_start_joints(data, tmp_path, plant):
+def test_ptp_start_is_the_planned_start(data, tmp_path):
     write_krl(data, tmp_path)
     motions, _ = read_program(tmp_path, "offline_prog")
+    fields = motions[0]["fields"]
+    axes_deg = np.array([fields[f"A{i}"] for i in range(1, 7)])
+    np.testing.assert_allclose(axes_deg, np.rad2deg(data.q[0]), atol=1e-5)
+
+
+def test_ptp_to_an_asked_approach(data, tmp_path, plant):
+    write_krl(data, tmp_path, approach_m=0.02)
+    motions, _ = read_program(tmp_path, "offline_prog")
+    assert motions[0]["point"] == "XAPPROACH" and motions[-1]["point"] == "XRETRACT"
     fields = motions[0]["fields"]
     axes_deg = np.array([fields[f"A{i}"] for i in range(1, 7)])
     assert all(fields[f"E{i}"] == 0.0 for i in range(1, 7))
@@ -210,7 +216,7 @@ def geometric_status(plant, q_rad):
 def test_status_and_turn_on_the_plan(data, tmp_path, plant):
     result = write_krl(data, tmp_path)
     motions, _ = read_program(tmp_path, "offline_prog")
-    lin = [m for m in motions if m["kind"] == "LIN"][:-1]
+    lin = [m for m in motions if m["kind"] == "LIN"]
     q = data.q[result.indices]
     turn = np.array([m["fields"]["T"] for m in lin])
     expected = sum((q[:, i] < 0).astype(int) << i for i in range(6))  # bit i: A(i+1) < 0
@@ -273,7 +279,7 @@ def test_exported_points_follow_the_dense_plan(data, tmp_path, style):
     chord, angle = 0.05e-3, np.deg2rad(0.1)
     result = write_krl(data, tmp_path, style=style, chord_tol_m=chord, angle_tol_rad=angle)
     motions, settings = read_program(tmp_path, "offline_prog")
-    X_BE = flange_poses([m for m in motions if m["kind"] == "LIN"][:-1], settings, style, "X_TP")
+    X_BE = flange_poses([m for m in motions if m["kind"] == "LIN"], settings, style, "X_TP")
     X_BP = X_BE @ data.X_EP
     X_PT = np.linalg.inv(X_BP) @ data.X_BT  # the exported process frames, from the file
     p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
@@ -301,7 +307,7 @@ def test_vel_cp_follows_the_planned_speed(slowed, tmp_path):
     result = write_krl(data, tmp_path)
     motions, _ = read_program(tmp_path, "offline_prog")
     lin = [m for m in motions if m["kind"] == "LIN"]
-    assert lin[0]["vel_cp"] == lin[-1]["vel_cp"] == pytest.approx(data.process_speed_m_s)
+    assert lin[0]["vel_cp"] == pytest.approx(data.process_speed_m_s)
     for k, (i, j) in enumerate(zip(result.indices[:-1], result.indices[1:], strict=True)):
         planned = data.tcp_speed[i : j + 1].max()
         assert planned - 1e-4 - 1e-9 <= lin[k + 1]["vel_cp"] <= max(planned, 1e-3) + 1e-9

@@ -56,7 +56,7 @@ def test_krl_load(plans, tmp_path):
     mass, p_EC = expected_total(data)
     assert float(m.group(1)) == pytest.approx(mass)
     np.testing.assert_allclose([float(m.group(i)) for i in (2, 3, 4)], p_EC * 1e3, atol=0.06)
-    assert text.index("$LOAD=") < text.index("PTP XAPPROACH")
+    assert text.index("$LOAD=") < text.index("PTP XSTART")
 
 
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls

@@ -126,7 +126,9 @@ def data(planned_folder):
 
 @pytest.fixture(scope="module")
 def written(data, tmp_path_factory):
-    result = write_rapid(data, tmp_path_factory.mktemp("rapid"))
+    """With the legacy approach (``approach_m``): every process point is a MoveL; the
+    points and speeds do not depend on it (the default: test_start_joint_target...)."""
+    result = write_rapid(data, tmp_path_factory.mktemp("rapid"), approach_m=0.02)
     return result, parse_rapid(result.files)
 
 
@@ -170,7 +172,10 @@ def test_controller_composition_gives_the_planned_flange(data, written):
 
 
 def test_start_joint_target_is_the_planned_start(data, tmp_path):
-    program = parse_rapid(write_rapid(data, tmp_path, approach_m=0.0).files)
+    """By default no approach or retract of the writer's own: MoveAbsJ to the plan's
+    first joints, the process points, and nothing after the last one."""
+    program = parse_rapid(write_rapid(data, tmp_path).files)
+    assert program.moves[-1][1] == f"p{len(process_moves(program)):04d}"
     assert program.moves[0][:2] == ("MoveAbsJ", "jStart")
     kind, (axes, extax) = program.data["jStart"]
     assert kind == "jointtarget" and extax == [9e9] * 6
@@ -178,8 +183,9 @@ def test_start_joint_target_is_the_planned_start(data, tmp_path):
     assert axes[2] == pytest.approx(np.rad2deg(data.q[0, 1] + data.q[0, 2]), abs=JOINT_TOL_DEG)
 
 
-def test_approach_and_retract_back_off_along_the_tool_axis(data, written):
-    _, program = written
+def test_approach_and_retract_back_off_along_the_tool_axis(data, tmp_path):
+    """Only when asked (approach_m): by default the program moves only as planned."""
+    program = parse_rapid(write_rapid(data, tmp_path, approach_m=0.02).files)
     names = [m[1] for m in program.moves]
     assert names[:2] == ["jApproach", "p0000"] and names[-1] == "pRetract"
     X_EP_inv, approach_m = np.linalg.inv(data.X_EP), 0.02
@@ -245,7 +251,8 @@ def test_split_at_a_small_line_limit_keeps_every_point_in_order(data, tmp_path, 
     pgf = result.files[-1].read_text()
     assert re.findall(r"<Module>(.+?)</Module>", pgf) == [f.name for f in modules]
     split = parse_rapid(result.files)
-    assert split.moves == whole.moves and len(process_moves(split)) == result.n_points
+    # MoveAbsJ to the first point (no approach of the writer's own), MoveL to the rest.
+    assert split.moves == whole.moves and len(process_moves(split)) == result.n_points - 1
     for m in process_moves(split):
         assert split.data[m[1]] == whole.data[m[1]]
     with pytest.raises(ValueError, match="line_limit"):

@@ -28,16 +28,19 @@ def seal():
     return context(cell_payload(file, load_cell(file)))
 
 
-def test_the_cell_as_given_evaluates_to_its_plan(seal, planned_folder):
-    plan, _ = planned_folder("seal_plate_kr16")
-    cell = plan.cell
+def test_the_cell_as_given_evaluates_to_its_plan(seal, planned_job):
+    """A path: cell is a one-seam job: the candidate's cycle time is the job's, home to
+    home, and its clearance the whole job's."""
+    job, _ = planned_job("seal_plate_kr16")
+    plan, cell = job.seams[0], job.cell
     X_IT = (tuple(cell.tool.X_IT.translation), (90.0, 0.0, 0.0))
     X_PE = (tuple(cell.part.X_PE.translation), (180.0, 0.0, 0.0))
     e = evaluate(seal, Candidate((), -1, X_IT, X_PE))
     assert e.tier == FEASIBLE and e.reason == ""
-    assert e.cycle_time_s == pytest.approx(plan.trajectory.duration, abs=1e-9)
+    assert e.cycle_time_s == pytest.approx(job.samples.t[-1], abs=1e-9)
+    assert e.air_time_s == pytest.approx(job.samples.t[-1] - plan.trajectory.duration, abs=1e-9)
     assert e.joint_limit_margin_deg == pytest.approx(np.rad2deg(plan.joints.margin_rad.min()))
-    assert e.clearance_mm == pytest.approx(plan.collisions.min_distance_m * 1e3)
+    assert e.clearance_mm == pytest.approx(job.collisions.min_distance_m * 1e3)
     assert e.process_bound_s == pytest.approx(plan.nominal_duration_s)
     assert screen(seal, Candidate((), -1, X_IT, X_PE)).tier == FEASIBLE
 
@@ -106,7 +109,7 @@ def test_reach_excess_is_zero_wherever_the_robot_reaches_and_grows_outside(name,
 def test_a_job_is_screened_seam_by_seam():
     file = CELLS / "seal_job_kr16.yaml"
     ctx = context(cell_payload(file, load_cell(file)))
-    assert ctx.job and [s.inputs.cell.path.analytic.kind for s in ctx.seams] == [
+    assert [s.inputs.cell.path.analytic.kind for s in ctx.seams] == [
         "rounded_rectangle", "arc", "arc", "line",
     ]  # fmt: skip
     X_PE = ((0.0, 0.0, 0.1), (180.0, 0.0, 0.0))

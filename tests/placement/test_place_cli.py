@@ -13,7 +13,7 @@ import time
 import pytest
 
 from offline_prog.cli import main
-from offline_prog.plan import plan_cell
+from offline_prog.plan import plan_job
 
 from conftest import CELLS
 
@@ -72,9 +72,9 @@ def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_p
     # placed.yaml: the cell's text (comments kept) with the best placement; plan agrees.
     placed = (serial / "placed.yaml").read_text()
     assert "# Deliberately poor: 2.2 m from the robot base" in placed
-    plan = plan_cell(serial / "placed.yaml")
+    plan = plan_job(serial / "placed.yaml")  # a path: cell: a one-seam job, home to home
     assert plan.feasible
-    assert plan.trajectory.duration == pytest.approx(best["cycle_time_s"], abs=1e-9)
+    assert plan.samples.t[-1] == pytest.approx(best["cycle_time_s"], abs=1e-9)
     assert list(plan.cell.tool.X_IT.translation) == best["X_IT"]["translation"]
     page = (serial / "placement.html").read_text()
     assert '<svg id="search-map"' in page and 'src="best_preview.html"' in page

@@ -105,7 +105,7 @@ def test_session_in_the_browser(session):
         now = status(page)
         assert now["values"]["X_IT.x"] == 1000 + MOVE_MM
         details = now["status"]["details"]
-        assert details["ran"] == ["frames", "scene", "joints"]  # the path was not refitted
+        assert details["ran"] == ["frames", "scene", "joints", "check"]  # not refitted
         text = line.inner_text()
 
         # Save: the changed cell next to the original.

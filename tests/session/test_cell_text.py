@@ -7,8 +7,9 @@ import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
 from offline_prog.config.cell import load_cell
-from offline_prog.session.outputs import save_cell
-from offline_prog.session.state import apply, initial_state, with_value
+from offline_prog.config.cell_text import save_cell
+from offline_prog.config.edits import apply, initial_values
+from offline_prog.session.state import with_value
 
 from conftest import CELLS
 
@@ -22,7 +23,7 @@ def test_save_keeps_comments_and_loads_to_the_same_cell(tmp_path, name):
     original = tmp_path / f"{name}.yaml"
     shutil.copyfile(CELLS / f"{name}.yaml", original)
     cell = load_cell(original)
-    initial = state = initial_state(cell)
+    initial = state = initial_values(cell)
     for key, value in CHANGES:
         state = with_value(state, key, value)
     saved = save_cell(original, initial, state, apply(cell, initial, state))

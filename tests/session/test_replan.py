@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from offline_prog.config.cell import load_cell
+from offline_prog.config.edits import apply
 from offline_prog.session.replan import Replanner
-from offline_prog.session.state import apply, with_value
+from offline_prog.session.state import with_value
 from offline_prog.session.status import plan_status
 
 from conftest import CELLS
@@ -17,7 +18,7 @@ def replanner():
     """The tape cell (the fastest demo plan); its first plan made."""
     planner = Replanner(CELLS / "tape_cylinder_ur10e.yaml")
     first = planner.plan(planner.initial)
-    assert first.ran == ["fit", "frames", "scene", "joints"] and first.plan.feasible
+    assert first.ran == ["fit", "frames", "scene", "joints", "check"] and first.plan.feasible
     planner.first_duration_s = first.plan.trajectory.duration
     return planner
 
@@ -25,7 +26,7 @@ def replanner():
 def test_a_speed_change_keeps_the_fit_the_frames_and_the_scene(replanner):
     slower = with_value(replanner.initial, "speed", 120)
     result = replanner.plan(slower)
-    assert result.ran == ["joints"]
+    assert result.ran == ["joints", "check"]
     assert result.plan.trajectory.duration > replanner.first_duration_s
 
 
@@ -40,7 +41,7 @@ def test_a_clearance_change_only_checks_again(replanner):
 def test_a_tool_move_does_not_refit(replanner):
     moved = with_value(replanner.initial, "X_IT.z", 310)
     result = replanner.plan(moved)
-    assert result.ran == ["frames", "scene", "joints"]
+    assert result.ran == ["frames", "scene", "joints", "check"]
     assert result.scene.X_IT.translation()[2] == pytest.approx(0.31)
     # The same answer again: nothing re-runs.
     assert replanner.plan(moved).ran == []
@@ -48,8 +49,8 @@ def test_a_tool_move_does_not_refit(replanner):
 
 def test_the_session_plan_is_the_plan_of_the_same_cell(replanner, tmp_path):
     """Reused stages give the plan a fresh `plan` run gives of the changed cell."""
+    from offline_prog.config.cell_text import save_cell
     from offline_prog.plan import plan_cell
-    from offline_prog.session.outputs import save_cell
 
     moved = with_value(with_value(replanner.initial, "X_IT.x", 705), "speed", 140)
     result = replanner.plan(moved)
@@ -81,7 +82,7 @@ def test_a_tool_turn_smoothing_change_re_runs_the_frames_and_joints(replanner):
     replanner.plan(free)
     turning = with_value(free, "turn_smoothing", 20)
     result = replanner.plan(turning)
-    assert result.ran == ["frames", "joints"] and result.plan.feasible
+    assert result.ran == ["frames", "joints", "check"] and result.plan.feasible
     phi = result.plan.flange.tool_turn(np.linspace(0.0, result.plan.path.length, 200))[0]
     assert np.ptp(phi) > np.deg2rad(1.0)  # it turns along the path
     refused = replanner.plan(with_value(replanner.initial, "turn_smoothing", 20))

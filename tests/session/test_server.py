@@ -142,3 +142,26 @@ def test_a_job_plans_the_active_seam_and_exports_the_whole_job(tmp_path):
     report = json.loads((tmp_path / "out" / "job-1" / "report.json").read_text())
     assert [s["seam"] for s in report["seams"]].count("stripe") == 1
     assert report["cell"] == str(saved)
+
+
+@pytest.mark.slow
+def test_a_path_cell_exports_its_one_seam_job(tmp_path):
+    """A path: cell's Export writes the folder `plan` writes: the one-seam job, home to
+    home, with the job's files (issue 24: one pipeline whatever the caller)."""
+    import json
+    import shutil
+
+    shutil.copytree(CELLS / "data", tmp_path / "data")
+    cell = tmp_path / "tape.yaml"
+    shutil.copyfile(CELLS / "tape_cylinder_ur10e.yaml", cell)
+    session = Session(cell, Meshcat(), out_root=tmp_path / "out")
+    run_until(session, lambda: session.snapshot()["current"])
+    assert session.snapshot()["status"]["line"].startswith("feasible")
+    session.action("export")
+    run_until(session, lambda: session.snapshot()["exported"] is not None)
+    folder = tmp_path / "out" / "tape-1"
+    assert (folder / "job.npz").exists() and (folder / "clearance.csv").exists()
+    report = json.loads((folder / "report.json").read_text())
+    kinds = [s["segment"] for s in report["job"]["segments"]]
+    assert kinds == ["link", "approach:seam", "process:seam", "retract:seam", "link"]
+    assert report["trajectory"]["duration_s"] < report["job"]["cycle_time_s"]

@@ -7,7 +7,8 @@ import pytest
 from pydrake.common.yaml import yaml_dump_typed
 
 from offline_prog.config.cell import load_cell, transform
-from offline_prog.session.state import apply, controls, initial_state, values, with_value
+from offline_prog.config.edits import apply, initial_values
+from offline_prog.session.state import controls, values, with_value
 
 from conftest import CELLS
 
@@ -15,7 +16,7 @@ from conftest import CELLS
 @pytest.fixture(scope="module")
 def seal():
     cell = load_cell(CELLS / "seal_plate_kr16.yaml")
-    return cell, initial_state(cell)
+    return cell, initial_values(cell)
 
 
 def test_initial_state_reads_the_cell(seal):
@@ -63,7 +64,7 @@ def test_bad_values_are_refused_in_one_line(seal, key, text, reason):
 
 def test_a_seam_with_its_own_speed_is_edited_there():
     cell = load_cell(CELLS / "seal_job_kr16.yaml")
-    state = initial_state(cell)
+    state = initial_values(cell)
     stripe = [s.name for s in cell.seams].index("stripe")
     on_stripe = with_value(state, "seam", stripe)
     assert on_stripe.speed == 0.15  # the stripe's own speed, not motion.speed

@@ -1,4 +1,5 @@
-"""Save: the session's values written into the original cell file's text.
+"""Save: edited values written into the original cell file's text (session Save,
+placement's ``placed.yaml``), and the saved copy next to the original.
 
 Only the numbers that changed are replaced, each at its place in the text (the YAML
 node's marks), so comments, key order, flow or block style and every other value stay
@@ -11,10 +12,15 @@ result is loaded again and compared with the session's cell before it is written
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 
 import yaml
+from pydrake.common.yaml import yaml_dump_typed
 
-from offline_prog.session.state import SessionState
+from offline_prog.config.cell import Cell, load_cell
+from offline_prog.config.edits import CellValues
+from offline_prog.config.safe_yaml import read_text
 
 
 def number(value: float) -> str:
@@ -109,7 +115,7 @@ def _transform(edits: _Edits, node, p: tuple, rpy_deg: tuple) -> None:
             edits.scalar(item, value)
 
 
-def edited_text(text: str, initial: SessionState, state: SessionState) -> str:
+def edited_text(text: str, initial: CellValues, state: CellValues) -> str:
     """The cell file's ``text`` with the state's changed values written in.
 
     Raises:
@@ -180,3 +186,42 @@ def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> 
         if node.value != value:  # unchanged text stays as written
             edits.replace(node, json.dumps(value))
     return edits.result()
+
+
+MAX_SAVES = 10_000
+
+
+def free_name(file: Path) -> Path:
+    """``<stem>-<n>.yaml`` next to ``file``, the first n ≥ 1 not taken."""
+    for n in range(1, MAX_SAVES):
+        candidate = file.with_name(f"{file.stem}-{n}{file.suffix}")
+        if not candidate.exists():
+            return candidate
+    raise FileExistsError(f"{file.parent}: {MAX_SAVES} saved copies of {file.name}")
+
+
+def save_cell(original: Path, initial: CellValues, state: CellValues, cell: Cell) -> Path:
+    """Write ``cell`` (``state``'s, edited from ``initial``) next to ``original``; returns
+    the new file.
+
+    Raises:
+        OSError: the folder is not writable.
+        RuntimeError: the written file does not load to ``cell`` (it is removed).
+    """
+    text = edited_text(read_text(original), initial, state)
+    while True:
+        target = free_name(original)
+        try:
+            with open(target, "x", encoding="utf-8") as stream:  # never replaces a file
+                stream.write(text)
+            break
+        except FileExistsError:  # taken since free_name looked: the next one
+            continue
+    try:
+        same = yaml_dump_typed(load_cell(target)) == yaml_dump_typed(cell)
+    except Exception:
+        same = False
+    if not same:
+        os.unlink(target)
+        raise RuntimeError(f"{target}: the edited file did not load to the session's cell")
+    return target

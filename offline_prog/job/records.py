@@ -1,0 +1,149 @@
+"""The records a plan leaves: a seam's :class:`Plan`, a :class:`SeamOption` (one way to
+run a seam, with its approach and retract) and the whole :class:`JobPlan`.
+
+Every cell plans as a job (``path:`` is a one-seam job); the writers, the reports, the
+session and placement read these records and never re-derive what they hold.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.collision.check import CollisionResult
+from offline_prog.config.cell import Cell
+from offline_prog.errors import Failure
+from offline_prog.job.approach import CartesianMove
+from offline_prog.job.assemble import JobSamples
+from offline_prog.job.links import LinkMotion
+from offline_prog.job.order import JobOrder
+from offline_prog.job.process_io import IoColumns
+from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.bspline_fit import FittedSpline
+from offline_prog.path.cusps import Cusp, SmoothedFlangePath
+from offline_prog.path.fixed_tcp import FlangePath
+from offline_prog.path.inputs import NormalFit
+from offline_prog.path.sources import PathPoints
+from offline_prog.robot.model import RobotModel
+from offline_prog.timing.trajectory import WorkspaceTrajectory
+
+
+@dataclasses.dataclass
+class Plan:
+    """Everything a plan produced, for the writers and the tests."""
+
+    cell_file: Path
+    cell: Cell
+    points: PathPoints
+    fitted: FittedSpline
+    path: ArcLengthPath
+    flange: FlangePath | SmoothedFlangePath
+    trajectory: WorkspaceTrajectory
+    cusps: list[Cusp]
+    timings_s: dict[str, float]
+    robot: RobotModel
+    joints: JointTrajectory
+    nominal_duration_s: float
+    tool_rotation_rad: float
+    collisions: CollisionResult
+    avoidance: dict | None = None  # what the collision avoidance tried and changed
+    # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
+    clearance_profile: tuple | None = None
+    normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
+
+    @property
+    def feasible(self) -> bool:
+        """Every check passed (collision-free at the clearance)."""
+        return self.collisions.collision_free
+
+    @property
+    def failure(self) -> str:
+        """Why the plan failed, one line ("" if it did not)."""
+        return self.collisions.message
+
+    @property
+    def failure_kind(self) -> Failure | None:
+        """The Failure of a finished plan that fails a check (a collision), or None.
+        Failures that leave no plan (reach, limits, singularities) are PlanFailedErrors."""
+        return None if self.feasible else Failure.COLLISION
+
+
+@dataclasses.dataclass
+class SeamOption:
+    """One way to run a seam: its plan in one direction, the approach and retract, and
+    the link ends q_in / q_out (6,) [rad]."""
+
+    seam: int
+    name: str
+    reverse: bool
+    plan: Plan
+    approach: CartesianMove | None
+    retract: CartesianMove | None
+
+    @property
+    def q_in(self) -> np.ndarray:
+        return self.approach.q[0] if self.approach else self.plan.joints.q[0]
+
+    @property
+    def q_out(self) -> np.ndarray:
+        return self.retract.q[-1] if self.retract else self.plan.joints.q[-1]
+
+    @property
+    def label(self) -> str:
+        direction = "reverse" if self.reverse else "forward"
+        return f"{self.name} {direction} branch {self.plan.joints.branch}"
+
+
+@dataclasses.dataclass
+class JobPlan:
+    """A whole job: the seams as run (each a :class:`Plan`), the links, and the job's
+    samples with named segments, process I/O and the whole job's collision check."""
+
+    cell_file: Path
+    cell: Cell
+    robot: RobotModel
+    q_home: np.ndarray  # (6,) [rad]
+    options: list[list[SeamOption]]  # every seam option planned, by seam
+    chosen: list[SeamOption]  # the options run, in order
+    order: JobOrder
+    links: list[LinkMotion]  # in order (home → first, …, last → home)
+    samples: JobSamples
+    tcp_speed: np.ndarray  # (N,) speed of the tool along the part [m/s]
+    io: IoColumns
+    collisions: CollisionResult
+    timings_s: dict[str, float]
+    # (t_k, {pair group: smallest distance [m]}) over the whole job (clearance.csv).
+    clearance_profile: tuple | None = None
+
+    avoidance = None  # per seam, in each seam's report
+
+    @property
+    def seams(self) -> list[Plan]:
+        return [option.plan for option in self.chosen]
+
+    @property
+    def feasible(self) -> bool:
+        return (
+            self.collisions.collision_free
+            and all(p.feasible for p in self.seams)
+            and all(link.ok for link in self.links)
+        )
+
+    @property
+    def failure(self) -> str:
+        failed = next((link for link in self.links if not link.ok), None)
+        if failed is not None:
+            return failed.failure.reason
+        if self.collisions.collision_free:
+            failed = (o for o in self.chosen if not o.plan.feasible)
+            return next((f"seam {o.name}: {o.plan.failure}" for o in failed), "")
+        at = self.collisions.first_contact or self.collisions.closest
+        where = "" if at is None else f"{self.samples.segment_at(at.t_s).label}: "
+        return where + self.collisions.message
+
+    @property
+    def failure_kind(self) -> Failure | None:
+        return None if self.feasible else Failure.COLLISION
