@@ -1,0 +1,157 @@
+"""The plan's I/O events on a seam's FANUC ``L`` points, with FANUC's rules.
+
+FANUC's distance-before motion option (``L P[i] ... DB d mm,DO[n]=ON``) sets the output
+when the TCP comes within d of the motion's destination, and a motion statement takes
+ONE such option. The analog flow is set with plain ``AO[n]=value`` statements, which
+take effect when the statement runs: when the motion after them starts. So a seam's
+chain of ``L`` points (approach, seam, retract) is split at planned samples until
+
+- every analog event (the flow going live or back to idle, at ``IoEvent.set_path_m``:
+  ``lag_s`` ahead, since FANUC does not lead by the dispenser's lag itself) starts a
+  motion: the planned sample nearest its position becomes an ``L`` point;
+- every motion holds at most one digital event: where two fall on one motion, the
+  first planned sample at or after the earlier one becomes an ``L`` point.
+
+Every inserted point is a planned sample (trajectory.csv's rows on the approach and
+retract, the seam's densified samples on the seam), so the program still moves through
+the plan. Positions are the seam's path positions σ [m] (negative on the approach,
+beyond L on the retract), as the events'.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+import numpy as np
+
+from offline_prog.io_events import IoEvent, ProcessIo, Signal
+
+SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
+
+
+@dataclasses.dataclass(frozen=True)
+class Samples:
+    """A seam's planned samples from its approach's start to its retract's end.
+
+    Attributes:
+        sigma: (K,) path position [m], non-decreasing.
+        t: (K,) job time [s].
+        q: (K, 6) URDF joints [rad].
+        X_BP: (K, 4, 4) the part P in the robot base B.
+    """
+
+    sigma: np.ndarray
+    t: np.ndarray
+    q: np.ndarray
+    X_BP: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
+class Motion:
+    """One ``L`` motion from sample ``start`` to sample ``end`` (indices into Samples):
+    ``event`` the digital event it switches (None: none) ``before_end_m`` [m] before
+    its end; ``flow`` the value [V] of the flow output while it runs (None: no flow)."""
+
+    start: int
+    end: int
+    event: IoEvent | None = None
+    before_end_m: float = 0.0
+    flow: float | None = None
+
+
+def place_events(
+    samples: Samples,
+    points: list[int],
+    events: list[IoEvent],
+    *,
+    seam: str,
+    io: ProcessIo | None,
+    flow_between: Callable[[float, float], float] | None = None,
+) -> list[Motion]:
+    """The seam's ``L`` motions with its events on them, split at planned samples.
+
+    Args:
+        samples: the seam's planned samples (candidates for ``L`` points).
+        points: sorted indices of the ``L`` points before splitting; ``points[0]`` is
+            where the robot already is (the approach's start).
+        events: the seam's I/O events (the plan's).
+        seam: its name, for errors.
+        io: the process I/O (None: no flow values).
+        flow_between: the live flow's value [V] on a motion from job time ta to tb.
+
+    Returns:
+        The motions in run order (at most one digital event each).
+
+    Raises:
+        ValueError: two digital events fall between the same two planned samples, so
+            no ``L`` point can separate them (names the seam and both positions).
+    """
+    points = sorted(set(points))
+    sigma = samples.sigma
+    analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
+    edges = [(sigma[_split(sigma, points, e.set_path_m)], e.state) for e in analog]
+    digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.path_m)
+    while (pair := _crowded(sigma, points, digital)) is not None:
+        first, second = pair
+        inside = np.flatnonzero(
+            (sigma >= first.path_m - SAME_POINT_M) & (sigma < second.path_m - SAME_POINT_M)
+        )
+        inside = [i for i in inside if all(abs(sigma[i] - sigma[p]) > SAME_POINT_M for p in points)]
+        if not inside:
+            raise ValueError(
+                f"seam {seam}: the output switches at {first.path_m * 1e3:.3f} mm and at "
+                f"{second.path_m * 1e3:.3f} mm along its path with no planned sample "
+                "between them: a FANUC motion takes one DB option"
+            )
+        points = sorted({*points, int(inside[0])})
+    on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
+    motions = []
+    for i in range(1, len(points)):
+        a, b = points[i - 1], points[i]
+        event = on_motion.get(i)
+        before = 0.0 if event is None else float(min(sigma[b] - event.path_m, sigma[b] - sigma[a]))
+        motions.append(
+            Motion(a, b, event, max(before, 0.0), _flow(samples, a, b, edges, io, flow_between))
+        )
+    return motions
+
+
+def _flow(samples, a, b, edges, io, flow_between) -> float | None:
+    """The flow while the motion a → b runs: live between the edges, else idle."""
+    if io is None or io.analog_output is None:
+        return None
+    live = False
+    for position, state in edges:
+        if position <= samples.sigma[a] + SAME_POINT_M:
+            live = state
+    return float(flow_between(samples.t[a], samples.t[b])) if live else io.idle
+
+
+def _split(sigma: np.ndarray, points: list[int], position: float) -> int:
+    """Make the planned sample nearest ``position`` an L point (in place); its index."""
+    i = int(np.argmin(np.abs(sigma - position)))
+    for p in points:
+        if abs(sigma[p] - sigma[i]) <= SAME_POINT_M:
+            return p
+    if sigma[points[0]] < sigma[i] < sigma[points[-1]]:
+        points.append(i)
+        points.sort()
+        return i
+    return points[0] if sigma[i] <= sigma[points[0]] else points[-1]
+
+
+def _motion_of(sigma: np.ndarray, points: list[int], position: float) -> int:
+    """The motion (index of its end in points, ≥ 1) that ends at or past position."""
+    for m in range(1, len(points)):
+        if sigma[points[m]] >= position - 1e-9:
+            return m
+    return len(points) - 1
+
+
+def _crowded(sigma, points, digital) -> tuple[IoEvent, IoEvent] | None:
+    """The first two digital events on one motion, in path order (None: none)."""
+    for first, second in zip(digital, digital[1:], strict=False):
+        if _motion_of(sigma, points, first.path_m) == _motion_of(sigma, points, second.path_m):
+            return first, second
+    return None
