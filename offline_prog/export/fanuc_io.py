@@ -10,7 +10,11 @@ chain of ``L`` points (approach, seam, retract) is split at planned samples unti
   ``lag_s`` ahead, since FANUC does not lead by the dispenser's lag itself) starts a
   motion: the planned sample nearest its position becomes an ``L`` point;
 - every motion holds at most one digital event: where two fall on one motion, the
-  first planned sample at or after the earlier one becomes an ``L`` point.
+  first planned sample at or after the earlier one becomes an ``L`` point;
+- while the flow is live, the plan's flow (the ``ao`` column: the flow at the speed the
+  tool has ``lag_s`` later) varies by at most ``FLOW_STEP_V`` on a motion (where the
+  tool speeds up or slows down, a planned sample starts a new motion), and the motion's
+  value is the middle of that range.
 
 Every inserted point is a planned sample (trajectory.csv's rows on the approach and
 retract, the seam's densified samples on the seam), so the program still moves through
@@ -28,6 +32,7 @@ import numpy as np
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
+FLOW_STEP_V = 0.05  # a live motion's AO value is within half this of the plan's flow on it
 
 
 @dataclasses.dataclass(frozen=True)
@@ -67,7 +72,7 @@ def place_events(
     *,
     seam: str,
     io: ProcessIo | None,
-    flow_between: Callable[[float, float], float] | None = None,
+    flow_at: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> list[Motion]:
     """The seam's ``L`` motions with its events on them, split at planned samples.
 
@@ -78,7 +83,7 @@ def place_events(
         events: the seam's I/O events (the plan's).
         seam: its name, for errors.
         io: the process I/O (None: no flow values).
-        flow_between: the live flow's value [V] on a motion from job time ta to tb.
+        flow_at: the live flow's values [V] at job times (n,) [s] (the plan's).
 
     Returns:
         The motions in run order (at most one digital event each).
@@ -105,6 +110,8 @@ def place_events(
                 "between them: a FANUC motion takes one DB option"
             )
         points = sorted({*points, int(inside[0])})
+    if io is not None and io.analog_output is not None:
+        points = _flow_splits(samples, points, edges, flow_at)
     on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
     motions = []
     for i in range(1, len(points)):
@@ -112,20 +119,44 @@ def place_events(
         event = on_motion.get(i)
         before = 0.0 if event is None else float(min(sigma[b] - event.path_m, sigma[b] - sigma[a]))
         motions.append(
-            Motion(a, b, event, max(before, 0.0), _flow(samples, a, b, edges, io, flow_between))
+            Motion(a, b, event, max(before, 0.0), _flow(samples, a, b, edges, io, flow_at))
         )
     return motions
 
 
-def _flow(samples, a, b, edges, io, flow_between) -> float | None:
-    """The flow while the motion a → b runs: live between the edges, else idle."""
-    if io is None or io.analog_output is None:
-        return None
+def _live(samples: Samples, a: int, edges) -> bool:
+    """Whether the flow is live on the motion from sample a (the edges before it)."""
     live = False
     for position, state in edges:
         if position <= samples.sigma[a] + SAME_POINT_M:
             live = state
-    return float(flow_between(samples.t[a], samples.t[b])) if live else io.idle
+    return live
+
+
+def _flow(samples, a, b, edges, io, flow_at) -> float | None:
+    """The flow while the motion a → b runs: live between the edges, else idle."""
+    if io is None or io.analog_output is None:
+        return None
+    if not _live(samples, a, edges):
+        return io.idle
+    values = flow_at(samples.t[a : b + 1])
+    return float(values.max() + values.min()) / 2
+
+
+def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
+    """Points split so the plan's flow varies by at most FLOW_STEP_V on a live motion."""
+    out = [points[0]]
+    for a, b in zip(points, points[1:], strict=False):
+        if _live(samples, a, edges):
+            values = flow_at(samples.t[a : b + 1])
+            start = 0
+            for k in range(1, len(values)):
+                span = values[start : k + 1]
+                if span.max() - span.min() > FLOW_STEP_V and k - 1 > start:
+                    start = k - 1
+                    out.append(a + start)
+        out.append(b)
+    return out
 
 
 def _split(sigma: np.ndarray, points: list[int], position: float) -> int:

@@ -3,11 +3,11 @@
 faceplate, positions = P in UFRAME[1] = base_link).
 
 ``<name>.ls``: ``J`` home; per seam the link (``J`` through its joint-represented
-points, FINE: the planned, collision-checked joint moves), the approach (``L`` to the
-seam's first point), ``CALL <name>_S<k>`` (the seam's ``L`` moves, the one-seam point
-choice on the flange path, in its own program so that no program grows with the job),
-the retract (``L``); home at the end (the last link). Every ``L`` point is a planned
-sample.
+points, FINE: the planned, collision-checked joint moves) and ``CALL <name>_S<k>``: the
+approach (``L`` to the seam's first point), the seam's ``L`` moves (the one-seam point
+choice on the flange path) and the retract (``L``), in its own program so that no
+program grows with the job; home at the end (the last link). Every ``L`` point is a
+planned sample.
 
 Process I/O, translated from the plan's I/O events (``io_events``), placed by
 :mod:`offline_prog.export.fanuc_io`:
@@ -22,9 +22,10 @@ Process I/O, translated from the plan's I/O events (``io_events``), placed by
   flow edge: the planned sample nearest it is an ``L`` point). While the output is on
   (from the plan's flow-live event to its flow-idle event, both ``lag_s`` ahead of the
   output's switches, since FANUC does not lead by the dispenser's lag itself) each
-  motion's value is the plan's flow (offset + per_mps · v, clipped) averaged over the
-  motion's time at the speed the tool has ``lag_s`` later; otherwise ``AO[n]`` is the
-  idle value (``ProcessIo.idle``), set once at the program's start.
+  motion's value is the plan's flow (offset + per_mps · v, clipped, at the speed the
+  tool has ``lag_s`` later) within ``fanuc_io.FLOW_STEP_V`` / 2 (a planned sample
+  starts a new motion where the speed changes more); otherwise ``AO[n]`` is the idle
+  value (``ProcessIo.idle``), set once at the program's start.
 A time-before trigger (``TB t sec,...``) is not used: the events are distances.
 """
 
@@ -124,11 +125,10 @@ def write_fanuc_job(
         elif isinstance(step, Process):
             seam_no += 1
             chain = _Chain(data, step, robot)
-            main.add(chain.approach)
-            parts = _seam_parts(f"{name}_S{seam_no}", chain.process, line_limit)
+            lines = chain.approach + chain.process + chain.retract
+            parts = _seam_parts(f"{name}_S{seam_no}", lines, line_limit)
             seams += parts
             main.add([f"  CALL {part.name}" for part in parts])
-            main.add(chain.retract)
     header = header_lines(data.job, conventions=_conventions(data, robot), forced=forced)
     main.lines[2:2] = remarks(header)
     if len(main.lines) > line_limit:
@@ -150,9 +150,7 @@ class _Chain:
         io, seam = data.process_io, step.seam
         samples, points, (n_a, n_p) = _samples(data, step)
         events = [e for e in data.events if e.seam == seam]
-        motions = place_events(
-            samples, points, events, seam=seam, io=io, flow_between=_flow_between(data)
-        )
+        motions = place_events(samples, points, events, seam=seam, io=io, flow_at=_flow_at(data))
         configs = config_strings(robot, samples.q)
         speed = data.seams[data.seam_names.index(seam)].process_speed_m_s  # approach, retract
         process = [m.end for m in motions if n_a < m.end <= n_p]
@@ -212,21 +210,13 @@ def _samples(data: JobProgramData, step: Process):
     return samples, points, (n_a, n_p)
 
 
-def _flow_between(data: JobProgramData):
-    """The live flow [V] on a motion from job time ta to tb: the time mean of the
-    plan's flow at the speed the tool has ``lag_s`` later (the plan's ``ao`` column)."""
+def _flow_at(data: JobProgramData):
+    """The live flow [V] at job times (n,) [s]: the plan's flow at the speed the tool
+    has ``lag_s`` later, as the plan's ``ao`` column holds it while live."""
     io, t, v = data.process_io, data.job.t, data.job.tcp_speed
     if io is None or io.analog_output is None:
         return None
-
-    def between(ta: float, tb: float) -> float:
-        grid = np.concatenate([[ta], t[(t > ta) & (t < tb)], [tb]])
-        values = io.flow(np.interp(grid + io.lag_s, t, v))
-        if tb - ta < 1e-9:
-            return float(values[0])
-        return float(np.trapezoid(values, grid) / (tb - ta))
-
-    return between
+    return lambda times: io.flow(np.interp(np.asarray(times) + io.lag_s, t, v))
 
 
 def _seam_parts(name: str, lines: list, line_limit: int) -> list[_Program]:
