@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
+from offline_prog.errors import InputError
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.fanuc import cartesian_pos, config_strings, fanuc_axes_deg, joint_pos
 from offline_prog.export.fanuc_io import Samples, place_events
@@ -101,8 +102,9 @@ def write_fanuc_job(
     called in turn, where a seam's moves exceed ``line_limit`` lines); returns the files.
 
     Raises:
-        ValueError: a bad name or line limit, a robot that is not OPW, or two process
-            output switches that no planned sample separates (``fanuc_io``).
+        ValueError: a bad name or line limit, a robot that is not OPW.
+        InputError: two process output switches that no planned sample separates
+            (``fanuc_io``; names the cell file, the seam and both positions).
     """
     identifier(name, max_chars=NAME_MAX - 8, what="name")
     if line_limit < 8:
@@ -150,7 +152,12 @@ class _Chain:
         io, seam = data.process_io, step.seam
         samples, points, (n_a, n_p) = _samples(data, step)
         events = [e for e in data.events if e.seam == seam]
-        motions = place_events(samples, points, events, seam=seam, io=io, flow_at=_flow_at(data))
+        try:
+            motions = place_events(
+                samples, points, events, seam=seam, io=io, flow_at=_flow_at(data)
+            )
+        except ValueError as error:  # the cell's switch positions: one line, exit 2
+            raise InputError(data.job.cell_file, "tool.process_io", str(error)) from None
         configs = config_strings(robot, samples.q)
         speed = data.seams[data.seam_names.index(seam)].process_speed_m_s  # approach, retract
         process = [m.end for m in motions if n_a < m.end <= n_p]

@@ -272,3 +272,23 @@ def test_fanuc_refuses_switches_no_sample_separates(stripe, tmp_path):
     )
     with pytest.raises(ValueError, match=r"seam stripe: .* 100\.000 mm and at 100\.010 mm"):
         write_fanuc_job(dataclasses.replace(data, events=events), tmp_path)
+
+
+def test_plan_refuses_switches_no_sample_separates_in_one_line(tmp_path, capsys):
+    """A cell whose on and off switches lie 0.01 mm apart: no FANUC motion can carry
+    both DB options, so planning stops with one line naming the seam, exit 2."""
+    from offline_prog.cli import main
+
+    _m20ia(tmp_path)
+    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    head, rest = text.split("seams:", 1)
+    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
+    head = head.replace("lead_mm: 5}", "lead_mm: -100}").replace("lead_mm: 2}", "lead_mm: 139.99}")
+    cell = tmp_path / "crowded.yaml"
+    cell.write_text(head + "seams:\n" + seam + rest[rest.index("job:") :])
+    capsys.readouterr()
+    code = main(["plan", str(cell), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "crowded.yaml: tool.process_io: seam stripe:" in err[0]
+    assert "100.000 mm and at 100.010 mm" in err[0]
