@@ -113,6 +113,7 @@ def place_events(
     if io is not None and io.analog_output is not None:
         points = _flow_splits(samples, points, edges, flow_at)
     on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
+    assert len(on_motion) == len(digital), "one digital event per motion"
     motions = []
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
@@ -152,8 +153,9 @@ def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[in
             start = 0
             for k in range(1, len(values)):
                 span = values[start : k + 1]
-                if span.max() - span.min() > FLOW_STEP_V and k - 1 > start:
-                    start = k - 1
+                moved = samples.sigma[a + k - 1] - samples.sigma[out[-1]] > SAME_POINT_M
+                if span.max() - span.min() > FLOW_STEP_V and k - 1 > start and moved:
+                    start = k - 1  # no L motion of zero length: at rest the flow waits
                     out.append(a + start)
         out.append(b)
     return out
