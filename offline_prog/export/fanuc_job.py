@@ -251,7 +251,7 @@ def _conventions(data: JobProgramData, robot) -> list[str]:
         lines.append(
             f"Process output DO[{io.digital_output}]: DB (distance before), on "
             f"{io.on_lead_m * 1e3:g} mm before each seam's start, off {io.off_lead_m * 1e3:g} mm "
-            "before its end."
+            "before its end; one DB per motion (split at planned samples)."
         )
     if io is not None and io.analog_output is not None:
         lines.append(
