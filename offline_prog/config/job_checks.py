@@ -95,21 +95,6 @@ def check_job(file: Path, cell: Cell) -> None:
                 "tool.process_io.flow.lag_s",
                 f"must be within [0, {MAX_FLOW_LAG_S:g}] s, got {io.flow.lag_s:g}",
             )
-    refuse_io_without_job(file, cell)
-
-
-def refuse_io_without_job(file: Path, cell: Cell) -> None:
-    """``tool.process_io`` on a ``path:`` cell without ``job:``: that cell plans the
-    seam alone and its programs have no process I/O, so the key would be ignored.
-    Refused until a one-seam cell runs the job pipeline (then this check goes)."""
-    if cell.path is not None and cell.job is None and cell.tool.process_io is not None:
-        raise _error(
-            file,
-            "tool.process_io",
-            "a path: cell without job: plans the seam alone, without process I/O; add "
-            "`job: {}` to plan it as a one-seam job that switches the outputs (an empty "
-            "`job:` is no job)",
-        )
 
 
 # The process outputs each controller family can have (its own numbering):

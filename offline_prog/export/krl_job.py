@@ -53,16 +53,27 @@ def write_krl_job(
     chord_tol_m: float = DEFAULT_CHORD_TOL_M,
     angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
     blend_m: float = 0.001,
+    tcp_pose_convention: str = "X_TP",
     forced: bool = False,
 ) -> list[Path]:
-    """Write the job's KRL modules into out_dir; returns the files (main first)."""
+    """Write the job's KRL modules into out_dir; returns the files (main first).
+
+    ``tcp_pose_convention``: the E6POS of the external-TCP points, "X_TP" (P in T, the
+    default) or "X_PF" (T in P, the inverse; ``export --tcp-pose-convention``).
+    """
+    if tcp_pose_convention not in ("X_TP", "X_PF"):
+        raise ValueError(
+            f"write_krl: tcp_pose_convention {tcp_pose_convention!r}: use X_TP or X_PF"
+        )
     robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
     if len(name) > 20 or not name.replace("_", "a").isalnum() or not name[0].isalpha():
         raise ValueError(f"write_krl: name {name!r} is not a KRL name of <= 20 characters")
     job, io = data.job, data.process_io
-    steps = job_steps(data, chord_tol_m, angle_tol_rad, flow_where_set=True)
+    steps = job_steps(
+        data, chord_tol_m, angle_tol_rad, convention=tcp_pose_convention, flow_where_set=True
+    )
     src, modules = [], []
     decl = []  # main .dat declarations
     q_home = steps[0].targets[0]
@@ -89,7 +100,7 @@ def write_krl_job(
             src.append(f"$VEL.CP={vel_cp(step.speed_m_s):.4f}")
             src += [_trigger(s, io, factor) for s in step.switches]
             status, turn = status_turn(robot.params, step.q[None])
-            pose = krl_frame(np.linalg.inv(step.X_PT))
+            pose = krl_frame(_point(step.X_PT, tcp_pose_convention))
             decl.append(f"DECL E6POS {label}={{{pose},S {status[0]},T {turn[0]}{_ZEROS}}}")
             src.append(f"LIN {label}")
         else:
@@ -98,7 +109,7 @@ def write_krl_job(
             src.append(f"{module}( )")
             modules.append((module, step))
     # The approach ends at the seam's first point: its E6POS is the seam's XP1.
-    head = _header(data, steps, forced)
+    head = _header(data, steps, tcp_pose_convention, forced)
     ori = _ori_speed(job)
     main_src = [
         f"DEF {name}( )",
@@ -120,8 +131,15 @@ def write_krl_job(
     ]
     files = _write(Path(out_dir), name, head + main_src, head + main_dat)
     for module, step in modules:
-        files += _seam_module(Path(out_dir), module, step, robot, head, io, factor)
+        files += _seam_module(
+            Path(out_dir), module, step, robot, head, io, factor, tcp_pose_convention
+        )
     return files
+
+
+def _point(X_PT: np.ndarray, convention: str) -> np.ndarray:
+    """(4, 4) the E6POS of the tool frame T in P at a point: P in T (X_TP) or T in P."""
+    return X_PT if convention == "X_PF" else np.linalg.inv(X_PT)
 
 
 def _anout_on(io, factor: str) -> list[str]:
@@ -149,14 +167,14 @@ def _trigger(switch, io, factor: str) -> str:
 
 
 def _seam_module(
-    folder: Path, module: str, step: Process, robot, head, io, factor: str
+    folder: Path, module: str, step: Process, robot, head, io, factor: str, convention: str
 ) -> list[Path]:
     """``module.src`` / ``.dat``: the seam's LIN points (the first is where the approach
     ended), with the switches before the LIN whose motion holds them."""
     data, idx = step.data, step.indices
     names = [f"XP{k + 1}" for k in range(len(idx))]
     status, turn = status_turn(robot.params, data.q[idx])
-    poses = np.linalg.inv(data.X_PF[idx])
+    poses = _point(data.X_PF[idx], convention)
     decls = [
         f"DECL E6POS {n}={{{krl_frame(X)},S {s},T {t}{_ZEROS}}}"
         for n, X, s, t in zip(names, poses, status, turn, strict=True)
@@ -187,13 +205,15 @@ def _ori_speed(job) -> float:
     return max(np.ceil(ORI_SPEED_MARGIN * np.rad2deg(omega.max())), ORI_SPEED_MIN_DEG_S)
 
 
-def _header(data: JobProgramData, steps, forced: bool) -> list[str]:
+def _header(data: JobProgramData, steps, convention: str, forced: bool) -> list[str]:
     io = data.process_io
     order = ", ".join(data.seam_names)
     lines = [
         f"Job: {len(data.seam_names)} seams in this order: {order}.",
         "Style external_tcp: $BASE = fixed tool T in $WORLD (= base_link), $TOOL = part P "
-        "in $FLANGE, $IPO_MODE = #TCP; E6POS = P in T (X_TP); E6AXIS = q [deg].",
+        "in $FLANGE, $IPO_MODE = #TCP; E6POS = "
+        + ("T in P (X_PF)" if convention == "X_PF" else "P in T (X_TP)")
+        + "; E6AXIS = q [deg].",
         "Links: PTP to E6AXIS fine points (the planned, collision-checked joint moves); "
         "approach and retract: LIN; seams: LIN with C_DIS, $VEL.CP = planned speed.",
     ]

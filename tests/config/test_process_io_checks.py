@@ -39,12 +39,15 @@ def with_cell_dir(text: str) -> str:
 
 
 @pytest.mark.parametrize("job", ["", "job:\n"])
-def test_process_io_on_a_path_cell_without_job_is_refused(capsys, tmp_path, job):
+def test_process_io_on_a_path_cell_switches_its_outputs(capsys, tmp_path, job):
+    """A path: cell is a one-seam job (also with an empty job:): its process I/O is
+    planned, not ignored: the output is on along the seam and off at home."""
     text = (CELLS / "seal_plate_kr16.yaml").read_text().replace("tool:\n", IO, 1)
     code, err = run(capsys, tmp_path, with_cell_dir(text.replace("motion:", job + "motion:", 1)))
-    assert code == 2 and len(err) == 1, err
-    assert "tool.process_io" in err[0] and "job: {}" in err[0]
-    assert not (tmp_path / "out").exists()
+    assert code == 0, err
+    rows = np.genfromtxt(tmp_path / "out" / "trajectory.csv", delimiter=",", names=True)
+    do = rows[[n for n in rows.dtype.names if n.startswith("do")][0]]
+    assert do[0] == 0 and do[-1] == 0 and do.max() == 1
 
 
 @pytest.mark.parametrize(

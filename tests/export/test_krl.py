@@ -398,9 +398,35 @@ def test_export_command_sets_the_tcp_pose_convention(planned_folder, tmp_path, c
     argv = ["export", str(plan_dir), "--format", "krl", "--out", str(tmp_path), *flags]
     assert main(argv) == 0
     motions, settings = read_program(tmp_path, "offline_prog")
-    lin = [m for m in motions if m["kind"] == "LIN"][:-1]  # without the retract
+    lin = [m for m in motions if m["kind"] == "LIN"]  # the seam's (no unplanned retract)
     X_BE = flange_poses(lin, settings, "external_tcp", convention)
     data = ProgramData.load(plan_dir)
     dp, da = pose_errors(X_BE[[0, -1]], data.X_BE[[0, -1]])
     assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
+    assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
+
+
+@pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
+def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, convention):
+    """A job's KRL (every plan's, a path: cell being a one-seam job) takes
+    ``--tcp-pose-convention`` too: the approach ends on each seam's first point and the
+    seam's last LIN on its last, read back under the convention the header names."""
+    from offline_prog.cli import main
+    from offline_prog.export.job_program import JobProgramData
+
+    plan_dir = planned_job("seal_job_kr16")[1]
+    argv = ["export", str(plan_dir), "--format", "krl", "--out", str(tmp_path)]
+    assert main([*argv, "--tcp-pose-convention", convention]) == 0
+    motions, settings = read_program(tmp_path, "offline_prog")
+    job = JobProgramData.load(plan_dir)
+    lin = [m for m in motions if m["kind"] == "LIN"]
+    for seam in job.seams:
+        first = lin.pop(0)  # the approach's end: the seam's first point
+        while lin[0]["module"] != "offline_prog":  # the seam's LINs in its module
+            last = lin.pop(0)
+        lin.pop(0)  # the retract
+        X_BE = flange_poses([first, last], settings, "external_tcp", convention)
+        dp, da = pose_errors(X_BE, seam.X_BE[[0, -1]])
+        assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
+    assert not lin
     assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
