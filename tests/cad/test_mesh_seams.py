@@ -40,6 +40,7 @@ def fitted(folder, model, seam):
     return inputs.points.exact, fit_path(inputs)
 
 
+@pytest.mark.slow  # a 0.01 mm tessellation's seam fit (CI runs the slow tests too)
 def test_plate_top_loop_from_the_mesh_is_the_step_loop(parts):
     seam = {"cad": {"loop": {"face_near_mm": [150, 100, 10]}}}
     (exact, mesh), (_, step) = fitted(parts, "plate.stl", seam), fitted(parts, "plate.step", seam)

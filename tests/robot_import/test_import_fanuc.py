@@ -94,6 +94,7 @@ def test_fanuc_j3_counts_from_the_horizontal(robots):
         assert abs(z[2]) < 1e-12
 
 
+@pytest.mark.slow  # plans a whole cell (CI runs the slow tests too)
 def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_path):
     """The README's steps with the shared M-20iA: import on the command line, a cell
     using robots_dir, plan, and a FANUC program that moves the robot as planned."""
@@ -248,6 +249,7 @@ def test_preview_draws_the_imported_meshes(robots, tmp_path):
         assert drawn[link] == len(trimesh.load(obj, force="mesh").faces), link
 
 
+@pytest.mark.slow  # plans a whole cell (CI runs the slow tests too)
 def test_m10ia_on_the_search_path_plans_the_seal_demo(robots, tmp_path):
     """The M-10iA found through OFFLINE_PROG_ROBOTS (no robots_dir in the cell) plans the
     seal demo collision-free and exports a FANUC program that reads back as planned;
