@@ -18,6 +18,7 @@ import numpy as np
 from rich.console import Console
 
 from offline_prog.cli_flags import EXIT_BAD_INPUT, one_line, parser
+from offline_prog.cli_progress import PlanProgress
 
 EXIT_PLAN_FAILED = 1
 EXIT_INTERNAL = 3
@@ -39,33 +40,20 @@ def _export_options(args) -> dict:
         options["angle_tol_rad"] = float(np.deg2rad(args.angle_tol_deg))
     if args.style is not None and args.format == "krl":
         options["style"] = args.style
+    if args.tcp_pose_convention is not None and args.format == "krl":
+        options["tcp_pose_convention"] = args.tcp_pose_convention
     if args.mode is not None and args.format == "urscript":
         options["mode"] = args.mode
-    if args.line_limit is not None and args.format in ("krl", "rapid"):
+    if args.line_limit is not None and args.format in ("krl", "rapid", "fanuc"):
         options["line_limit"] = args.line_limit
     return options
 
 
 def _run_robots(args, console: Console) -> None:
-    """``robots list`` and ``robots self-collision ROBOT``."""
-    from offline_prog.errors import InputError
-    from offline_prog.robot.model import ROBOTS_DIR, list_robots, load_robot
+    """``robots list | self-collision | import`` (offline_prog.cli_robots)."""
+    from offline_prog.cli_robots import run_robots
 
-    if args.robots_command == "list":
-        for name in list_robots():
-            console.print(name)
-        return
-    from offline_prog.scene.self_collision import write_matrix
-
-    try:
-        robot = load_robot(args.robot)
-    except ValueError as error:
-        raise InputError(ROBOTS_DIR, "", str(error)) from None
-    file, pairs = write_matrix(robot, samples=args.samples, seed=args.seed)
-    for kind in ("adjacent", "always", "constant", "never", "check"):
-        names = [f"{p.a}-{p.b}" for p in pairs if p.kind == kind]
-        console.print(f"  {kind:<9} {len(names):3d}  {', '.join(names)}", highlight=False)
-    console.print(f"wrote {file} ({args.samples} samples, seed {args.seed})")
+    run_robots(args, console)
 
 
 def _run_export(args, console: Console) -> None:
@@ -82,22 +70,19 @@ def _run_export(args, console: Console) -> None:
 
 
 def _serve_preview(plan, args, console: Console) -> None:
-    """Show the plan in a MeshCat server on localhost until Ctrl-C (or --seconds)."""
-    from pydrake.geometry import Meshcat, MeshcatParams
-
+    """Show the plan in a MeshCat server on --host (localhost) until Ctrl-C (or --seconds)."""
     from offline_prog.job.records import JobPlan
     from offline_prog.viz.job_preview import show_job
+    from offline_prog.viz.local_server import open_meshcat, url
     from offline_prog.viz.preview import near_collision_mask, show_plan
 
-    params = MeshcatParams()
-    params.port = args.port
-    meshcat = Meshcat(params)
+    meshcat = open_meshcat(args.host, args.port)
     if isinstance(plan, JobPlan):
         info = show_job(plan, meshcat)
     else:
         info = show_plan(plan, meshcat, near_collision=near_collision_mask(plan))
     console.print(
-        f"MeshCat preview at [bold]{meshcat.web_url()}[/bold] "
+        f"MeshCat preview at [bold]{url(args.host, args.port, '')}[/bold] "
         f"({info['frames']} animation frames; Ctrl-C to stop)"
     )
     seconds = getattr(args, "seconds", None)
@@ -132,7 +117,10 @@ def _run_place(args, console: Console, errors: Console) -> str:
             args.cell, out, budget=args.budget, seed=args.seed, workers=args.workers,
             scheduler=args.scheduler, progress=progress,
         )  # fmt: skip
+    from offline_prog.atomic import read_manifest
+
     best, cut, engine = data["best"], data["cycle_time_cut"], data["engine"]
+    wrote = ", ".join(sorted((read_manifest(out) or {}).get("files", {}).get("plan", [])))
     verdict = "feasible" if best["feasible"] else f"infeasible ({best['reason']})"
     console.print(f"best placement: {verdict}", highlight=False, markup=False)
     if best["feasible"]:
@@ -152,7 +140,7 @@ def _run_place(args, console: Console, errors: Console) -> str:
     console.print(
         f"{engine['candidates_evaluated']} candidates planned, {engine['screened']} screened, "
         f"{engine['wall_time_s']:.1f} s on {engine['workers']} worker(s) "
-        f"({engine['scheduler']}); wrote {out}/placement.json, placed.yaml, placement.html",
+        f"({engine['scheduler']}); wrote into {out}: {wrote}",
         highlight=False,
         markup=False,
     )
@@ -212,6 +200,11 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "robots":
             _run_robots(args, console)
             return 0
+        if args.command == "seams":
+            from offline_prog.viz.seams_page import run_seams
+
+            run_seams(args.part, args.out, args.mesh_units, say=console.print)
+            return 0
         if args.command == "session":
             from offline_prog.session.launch import run_session
 
@@ -223,12 +216,18 @@ def main(argv: list[str] | None = None) -> int:
             return fail(failed, EXIT_PLAN_FAILED) if failed else 0
         if args.command == "preview":
             args.preview, args.out = True, None
+        if args.preview:  # a taken port is known before planning
+            from offline_prog.viz.local_server import check_free
+
+            check_free(args.host, args.port)
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
-        with errors.status("planning") as status:  # every cell is a job (path: one seam)
-            plan = plan_job(args.cell, progress=lambda stage: status.update(stage))
-            status.update("writing outputs")
+        # Progress on stderr only while stdout is a terminal: logs and pipes stay clean.
+        # Every cell is a job (path: is a one-seam job).
+        with PlanProgress(errors, enabled=console.is_terminal) as progress:
+            plan = plan_job(args.cell, progress=progress)
+            progress("writing outputs")
             if args.command == "plan":
                 files, report = write_job_outputs(plan, out)
         if args.command == "plan":

@@ -11,13 +11,24 @@ import argparse
 import math
 from pathlib import Path
 
+from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
+from offline_prog.viz.local_server import MAX_PORT, MIN_PORT
+
 EXIT_BAD_INPUT = 2
 MAX_MESSAGE_CHARS = 500  # one stderr line, however long the cause's text
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors: ``error: <message> (see offline-prog <cmd> --help)``
-    and exit code 2, instead of the usage block."""
+    and exit code 2, instead of the usage block; ``--debug`` is taken before or after
+    any (sub)command (every internal error says "rerun with --debug")."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # SUPPRESS: a subcommand without the flag leaves the value parsed before it.
+        self.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks"
+        )
 
     def error(self, message: str):
         self.exit(EXIT_BAD_INPUT, f"error: {one_line(message)} (see {self.prog} --help)\n")
@@ -32,17 +43,20 @@ def one_line(message: str) -> str:
 def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
     """An argparse type: a finite ``kind`` (float or int) above ``low`` (or equal to it
     when inclusive), at most ``high``; ArgumentTypeError otherwise."""
+    noun = "an integer" if kind is int else "a number"
+    show = (lambda v: f"{int(v)}") if kind is int else (lambda v: f"{v:g}")
 
     def parse(text: str):
         try:
             value = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a {kind.__name__}") from None
+            raise argparse.ArgumentTypeError(f"{text!r} is not {noun}") from None
         if not (math.isfinite(value) and low <= value <= high) or (value == low and not inclusive):
-            bound = (f">= {low:g}" if inclusive else f"> {low:g}") + (
-                f" and <= {high:g}" if high < math.inf else ""
+            bound = (f">= {show(low)}" if inclusive else f"> {show(low)}") + (
+                f" and <= {show(high)}" if high < math.inf else ""
             )
-            raise argparse.ArgumentTypeError(f"{text!r}: need a finite number {bound}")
+            finite = noun if kind is int else "a finite number"
+            raise argparse.ArgumentTypeError(f"{text!r}: need {finite} {bound}")
         return value
 
     parse.__name__ = kind.__name__  # argparse names the type in its messages
@@ -50,7 +64,8 @@ def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
 
 
 POSITIVE = _number(float, low=0.0, inclusive=False)
-PORT = _number(int, low=1, inclusive=True, high=65535)
+PORT = _number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT)  # MeshCat aborts below 1024
+HOST_HELP = "listen on this host (default localhost; 0.0.0.0: every interface; ::1: IPv6)"
 MIN_LINE_LIMIT = 20  # the smallest program part the writers can split into
 MAX_MATRIX_SAMPLES = 10_000_000  # self-collision samples (10⁴ take ~3 s)
 
@@ -60,20 +75,24 @@ def parser() -> argparse.ArgumentParser:
         prog="offline-prog",
         description="Plan robot motions that carry a part past a spatially fixed tool.",
     )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    parser.set_defaults(debug=False)
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     plan = commands.add_parser("plan", help="plan a cell and write the outputs")
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
     plan.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: out/<cell name>)"
-    )
+        "--out", type=Path, default=None,
+        help="output folder (default: out/<file stem>, e.g. out/seal_plate_kr16 for "
+        "cells/seal_plate_kr16.yaml)",
+    )  # fmt: skip
     plan.add_argument(
         "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
     )
     plan.add_argument("--port", type=PORT, default=7000, help="MeshCat port for --preview")
+    plan.add_argument("--host", default="localhost", help=f"--preview: {HOST_HELP}")
     preview = commands.add_parser("preview", help="plan a cell and show it in MeshCat")
     preview.add_argument("cell", type=Path, help="work-cell YAML file")
     preview.add_argument("--port", type=PORT, default=7000, help="MeshCat port (default 7000)")
+    preview.add_argument("--host", default="localhost", help=HOST_HELP)
     preview.add_argument(
         "--seconds",
         type=_number(float, low=0.0, inclusive=True),
@@ -82,14 +101,16 @@ def parser() -> argparse.ArgumentParser:
     )
     _session_flags(commands)
     _place_flags(commands)
+    _seams_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
     )
-    robot_commands.add_parser("list", help="the robots in offline_prog/robots")
+    robot_commands.add_parser("list", help="the robots found, and where each comes from")
+    _import_flags(robot_commands)
     matrix = robot_commands.add_parser(
         "self-collision",
-        help="sample configurations and write robots/<robot>/self_collision.yaml",
+        help="sample configurations and write the robot's self-collision matrix",
     )
     matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
     matrix.add_argument(
@@ -97,10 +118,15 @@ def parser() -> argparse.ArgumentParser:
         default=10_000, help="configurations (10000)",
     )  # fmt: skip
     matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    matrix.add_argument(
+        "--out", type=Path, default=Path("."),
+        help="file, or folder for self_collision.yaml (default: the current folder); "
+        "the planner reads the one in the robot's folder",
+    )  # fmt: skip
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
-        "--format", required=True, choices=["krl", "rapid", "urscript", "csv", "ros-json"]
+        "--format", required=True, choices=["krl", "rapid", "urscript", "fanuc", "csv", "ros-json"]
     )
     export.add_argument(
         "--out", type=Path, default=None, help="output folder (default: PLAN_DIR/programs)"
@@ -113,6 +139,12 @@ def parser() -> argparse.ArgumentParser:
         choices=["external_tcp", "flange"],
         default=None,
         help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
+    )
+    export.add_argument(
+        "--tcp-pose-convention",
+        choices=["X_TP", "X_PF"],
+        default=None,
+        help="KRL external_tcp points: the part P in the tool T (X_TP, default) or T in P (X_PF)",
     )
     export.add_argument(
         "--mode",
@@ -148,13 +180,11 @@ def _session_flags(commands) -> None:
     )
     session.add_argument("cell", type=Path, help="work-cell YAML file")
     session.add_argument(
-        "--port", type=_number(int, low=1, inclusive=True, high=65534), default=7000,
+        "--port", type=_number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT - 1),
+        default=7000,
         help="panel port (default 7000); MeshCat uses the next one",
     )  # fmt: skip
-    session.add_argument(
-        "--host", default="localhost",
-        help="listen on this host (default localhost; 0.0.0.0: every interface)",
-    )  # fmt: skip
+    session.add_argument("--host", default="localhost", help=HOST_HELP)
     session.add_argument("--no-browser", action="store_true", help="do not open a browser")
     session.add_argument(
         "--seconds", type=_number(float, low=0.0, inclusive=True), default=None,
@@ -169,14 +199,15 @@ def _place_flags(commands) -> None:
     )
     place.add_argument("cell", type=Path, help="work-cell YAML file with a place: block")
     place.add_argument(
-        "--out", type=Path, default=None, help="output folder (default: out/<cell name>_place)"
-    )
+        "--out", type=Path, default=None,
+        help="output folder (default: out/<file stem>_place)",
+    )  # fmt: skip
     place.add_argument(
-        "--budget", type=_number(int, low=1, inclusive=True), default=None,
+        "--budget", type=_number(int, low=1, inclusive=True, high=MAX_PLACE_BUDGET), default=None,
         help="candidates through the planning pipeline (default: place.budget)",
     )  # fmt: skip
     place.add_argument(
-        "--seed", type=_number(int, low=0, inclusive=True), default=None,
+        "--seed", type=_number(int, low=0, inclusive=True, high=MAX_PLACE_SEED), default=None,
         help="search seed (default: place.seed)",
     )  # fmt: skip
     where = place.add_mutually_exclusive_group()
@@ -188,3 +219,43 @@ def _place_flags(commands) -> None:
         "--scheduler", default=None,
         help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
     )  # fmt: skip
+
+
+def _import_flags(robot_commands) -> None:
+    """``robots import DESCRIPTION --name NAME ...``."""
+    imp = robot_commands.add_parser(
+        "import", help="a robot folder from a URDF or xacro (six revolute joints)"
+    )
+    imp.add_argument("description", type=Path, help="the robot's .urdf or .xacro file")
+    imp.add_argument("--name", required=True, help="the robot folder's name, e.g. fanuc_m20ia")
+    imp.add_argument(
+        "--package-path", type=Path, action="append",
+        help="a folder holding ROS packages (package.xml), for package:// and $(find); "
+        "repeatable (default: the folder above the description's package)",
+    )  # fmt: skip
+    imp.add_argument(
+        "--vendor", default="other", choices=("fanuc", "kuka", "abb", "universal_robots", "other"),
+        help="the maker: chooses the controller language (default other: none)",
+    )  # fmt: skip
+    imp.add_argument("--out", type=Path, default=None, help="ROBOTS_DIR to write into (./robots)")
+    imp.add_argument("--base", default="base_link", help="the chain's base link (base_link)")
+    imp.add_argument("--tip", default="tool0", help="the chain's flange link (tool0)")
+    imp.add_argument(
+        "--samples", type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
+        default=10_000, help="self-collision configurations (10000)",
+    )  # fmt: skip
+    imp.add_argument("--force", action="store_true", help="replace an existing robot folder")
+
+
+def _seams_flags(commands) -> None:
+    """``seams PART.step|PART.stl [--out seams.html] [--mesh-units m|mm]``."""
+    seams = commands.add_parser(
+        "seams", help="list a part model's faces, loops and edge chains; write a 3D page"
+    )
+    seams.add_argument("part", type=Path, help="STEP (.step, .stp) or mesh (.stl, .obj, .ply)")
+    seams.add_argument(
+        "--out", type=Path, default=None, help="the page (default: <part>_seams.html beside it)"
+    )
+    seams.add_argument(
+        "--mesh-units", choices=("m", "mm"), default="m", help="a mesh file's unit (default m)"
+    )

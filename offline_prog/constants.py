@@ -6,6 +6,9 @@ import numpy as np
 DEFAULT_SPLINE_DEGREE = 5
 MIN_SPLINE_DEGREE = 5
 DEFAULT_FIT_TOLERANCE_M = 1e-4  # max distance from a given point to the curve [m]
+# A closed contour's points may stop short of their start by up to this many times the
+# larger of the first and last point spacing (path/closing.py); more is a missing stretch.
+CLOSING_GAP_STEP_RATIO = 2.0
 
 # Arc-length re-parameterization: Newton on s(u) stops below this [m].
 ARC_LENGTH_TOLERANCE_M = 1e-12
@@ -37,6 +40,11 @@ MAX_SPEED_M_S = 2.0  # motion.speed: process speeds are mm/s to ~1 m/s; above is
 MAX_VALUE_CHARS = 80  # a value quoted in an error message is cut to this
 MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this package drives
 MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin
+# place.budget / --budget: full evaluations; 10⁵ × ~0.5 s is a day on one core.
+MAX_PLACE_BUDGET = 100_000
+# place.seed / --seed: the search seeds CMA-ES with seed + 1 + its restarts (at most one
+# per evaluation), and numpy takes seeds below 2³²: this bound leaves room for them.
+MAX_PLACE_SEED = 2**31 - 1
 # A cell's mesh larger than this across is a unit slip (a mm file read as m: 1000×).
 MAX_MESH_EXTENT_M = 20.0
 # motion.time_law: TOPP-RA + jerk stage (the default, config/cell.py), or the paper's

@@ -4,7 +4,8 @@
   folder). One line ``file: key: reason``; the CLI exits with 2.
 - :class:`PlanFailure`: the input is valid but the robot cannot do it (out of reach,
   a joint limit, a singularity, a collision). A result, not a crash: it says where
-  (σ [m], t [s]) and why, with a :class:`Failure` kind; the CLI exits with 1.
+  (σ [m], t [s]) and why, with a :class:`Failure` kind set where the failure is found
+  (never read back from the reason's words); the CLI exits with 1.
   :class:`PlanFailedError` carries one out of a stage that cannot go on.
 
 The CLI maps both to exit codes in one place (``cli.EXIT_CODES``).
@@ -33,21 +34,6 @@ class Failure(enum.Enum):
     JOINT_RATE_LIMIT = "joint_rate_limit"  # speed/acceleration even at reduced speed
     SINGULARITY = "singularity"
     COLLISION = "collision"
-
-    @classmethod
-    def of(cls, reason: str) -> Failure:
-        """The kind of a stage's reason text (each stage starts its reason with it)."""
-        prefixes = (
-            ("out of reach", cls.OUT_OF_REACH),
-            ("joint limit", cls.JOINT_LIMIT),
-            ("joint speed", cls.JOINT_RATE_LIMIT),
-            ("singularity", cls.SINGULARITY),
-            ("collision", cls.COLLISION),
-        )
-        for prefix, kind in prefixes:
-            if reason.startswith(prefix):
-                return kind
-        raise ValueError(f"no failure kind for reason {reason!r}")
 
 
 @dataclasses.dataclass(frozen=True)

@@ -103,7 +103,7 @@ JOB_STAGES = (
         seam_options,
         ("inputs", "scene", "seam_planner", "progress"),
     ),
-    Stage("order", "choosing the seam order", choose_order, ("inputs", "seams", "home")),
+    Stage("order", "ordering the seams", choose_order, ("inputs", "seams", "home", "progress")),
     Stage(
         "links",
         "linking moves",

@@ -19,6 +19,7 @@ from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
+from offline_prog.config.robot_search import find_robot, search_path
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
 from offline_prog.errors import InputError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
@@ -82,7 +83,9 @@ def load_inputs(file: Path, robots_dir: Path) -> Inputs:
     check_cell(file, cell, robots_dir)
     points = load_points(file, cell) if cell.path is not None else None
     try:
-        robot = load_robot(cell.robot.model, robots_dir)
+        folders = search_path(robots_dir, cell_file=file, robots_dir=cell.robot.robots_dir)
+        folder = find_robot(cell.robot.model, folders)
+        robot = load_robot(cell.robot.model, folder.parent if folder else robots_dir)
     except ValueError as error:
         raise InputError(file, "robot.model", str(error)) from None
     check_process_io(file, cell, robot.language)

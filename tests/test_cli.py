@@ -135,3 +135,54 @@ def test_ctrl_c_while_writing_is_exit_130_one_line_and_no_half_folder(
 def test_out_under_proc_is_one_line_exit_2(capsys):
     code, err = run(capsys, "plan", CELLS / "seal_plate_kr16.yaml", "--out", "/proc/offline_prog")
     assert code == 2 and len(err) == 1 and err[0].startswith("error: /proc")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["plan", "a.yaml", "--port", "7000.5"], "argument --port: '7000.5' is not an integer"),
+        (["session", "a.yaml", "--port", "x"], "argument --port: 'x' is not an integer"),
+        (["robots", "self-collision", "ur10e", "--samples", "1e3"], "'1e3' is not an integer"),
+        (["export", "d", "--format", "krl", "--chord-tol-mm", "x"], "'x' is not a number"),
+    ],
+)
+def test_a_flag_that_is_not_a_number_says_so(capsys, argv, message):
+    code, err = run(capsys, *argv)
+    assert code == 2 and len(err) == 1 and message in err[0], err
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_before_or_after_the_subcommand_shows_the_traceback(capsys, monkeypatch, where):
+    """Every internal error says "rerun with --debug": either place works."""
+    import offline_prog.cli as cli
+
+    def bug(*args, **kwargs):
+        raise RuntimeError("a bug of ours")
+
+    monkeypatch.setattr(cli, "_run_robots", bug)
+    code, err = run(capsys, "robots", "list")
+    assert code == 3 and err == ["internal error: RuntimeError: a bug of ours (rerun with --debug)"]
+    argv = ["--debug", "robots", "list"] if where == "before" else ["robots", "list", "--debug"]
+    with pytest.raises(RuntimeError, match="a bug of ours"):
+        main(argv)
+
+
+def test_self_collision_writes_where_the_user_says_not_into_the_package(
+    capsys, tmp_path, monkeypatch
+):
+    """The robot file shipped in the package stays as it is; the matrix goes to the
+    current folder (or --out), and the command says how to plan with it."""
+    from offline_prog.robot.model import ROBOTS_DIR
+    from offline_prog.scene.self_collision import MATRIX_FILE, read_matrix
+
+    shipped = ROBOTS_DIR / "ur10e" / MATRIX_FILE
+    before = shipped.read_bytes(), shipped.stat().st_mtime_ns
+    monkeypatch.chdir(tmp_path)
+    assert main(["robots", "self-collision", "ur10e", "--samples", "20"]) == 0
+    said = capsys.readouterr().out.splitlines()[-1]
+    assert said.startswith("wrote self_collision.yaml (20 samples, seed 0)")
+    assert said.endswith(f"copy it there: cp self_collision.yaml {shipped}")
+    assert len(read_matrix(tmp_path)) == len(read_matrix(shipped.parent))
+    assert main(["robots", "self-collision", "ur10e", "--samples", "20", "--out", "m.yaml"]) == 0
+    assert (tmp_path / "m.yaml").read_text() == (tmp_path / MATRIX_FILE).read_text()
+    assert (shipped.read_bytes(), shipped.stat().st_mtime_ns) == before

@@ -15,6 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.math import RigidTransform
 
 from offline_prog.config import safe_yaml
+from offline_prog.config.cad_keys import CadSeamConfig
 from offline_prog.config.typed_check import check_mapping
 from offline_prog.errors import InputError
 
@@ -43,7 +44,8 @@ class ShapeConfig:
 
 @dataclasses.dataclass
 class RobotConfig:
-    model: str = required()  # folder name in robots/
+    model: str = required()  # folder name in robots/ (or robots_dir, OFFLINE_PROG_ROBOTS)
+    robots_dir: str | None = None  # a folder of robot folders, relative to the cell file
     X_IB: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
 
 
@@ -59,13 +61,16 @@ class DigitalSwitch:
 @dataclasses.dataclass
 class AnalogFlow:
     """An analog output following the TCP speed: value = offset + per_mps · v_TCP,
-    clipped to [min, max] (the controller's unit, e.g. volts)."""
+    clipped to [min, max] (the controller's unit, e.g. volts), while the digital output
+    is on; at rest (offset clipped to [min, max]) otherwise. ``lag_s``: the dispenser's
+    lag [s], by which the command leads the tool."""
 
     analog_output: int = required()
     per_mps: float = required()
     offset: float = 0.0
     min: float = 0.0
     max: float = 10.0
+    lag_s: float = 0.0
 
 
 @dataclasses.dataclass
@@ -95,7 +100,8 @@ class PartConfig:
     X_PE: Transform = dataclasses.field(default_factory=Transform, metadata=REQUIRED)
     name: str = "part"
     mesh: str | None = None  # STL/OBJ/PLY in P, relative to the cell file
-    mesh_units: str = "m"
+    mesh_units: str = "m"  # of mesh, and of model when it is a mesh
+    model: str | None = None  # STEP or STL/OBJ/PLY: seams (cad:), collision and visual
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
     mass_kg: float | None = None  # payload: the part's mass ...
     center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
@@ -127,14 +133,15 @@ class AnalyticPath:
 
 @dataclasses.dataclass
 class PathConfig:
-    units: str = required()  # m | mm
-    closed: bool = False  # a closed contour (periodic spline): the ends must meet
+    units: str | None = None  # m | mm; required except for cad: (config.cad_keys)
+    closed: bool = False  # a closed contour (periodic spline); its ends: path.closing
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
     dxf_entity: int | None = None  # which path entity (0-based) when the DXF has several
     csv_seam: str | None = None  # rows of this seam (CSV seam column); seams: its name
     analytic: AnalyticPath | None = None
+    cad: CadSeamConfig | None = None  # edges and faces of part.model (config.cad_keys)
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5
@@ -274,7 +281,9 @@ def load_cell(file: str | os.PathLike) -> Cell:
     raw = safe_yaml.load(file, text)  # aliases, depth, duplicate keys
     check_mapping(file, "", raw, Cell)
     try:
-        return yaml_load_typed(schema=Cell, data=safe_yaml.quote_bool_keys(text))
+        # Drake's loader reads YAML 1.1 (on, off, yes, no are booleans): it gets the
+        # data our YAML 1.2 loader read, written out by Drake's own dumper.
+        return yaml_load_typed(schema=Cell, data=safe_yaml.drake_text(raw))
     except Exception as error:  # Drake's message is multi-line; keep its first line.
         first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
         raise InputError(file, "", first_line) from None

@@ -5,12 +5,15 @@ Every failure is a InputError naming the file and key (one line).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
+from offline_prog.config.cad_keys import check_cad, check_part_model
 from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.config.job_checks import check_job
+from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -30,15 +33,14 @@ def _error(file, key, reason) -> InputError:
 
 def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     """Semantic checks the types alone cannot express."""
-    robot_dirs = (
-        sorted(p.name for p in robots_dir.iterdir() if p.is_dir()) if (robots_dir.is_dir()) else []
-    )
-    if cell.robot.model not in robot_dirs:
+    folders = search_path(robots_dir, cell_file=file, robots_dir=cell.robot.robots_dir)
+    if find_robot(cell.robot.model, folders) is None:
+        have = sorted({name for name, _, _ in robots_in(folders)})
         raise _error(
             file,
             "robot.model",
             f"{cell.robot.model!r} is not a robot folder in "
-            f"{robots_dir} (have: {', '.join(robot_dirs) or 'none'})",
+            f"{os.pathsep.join(map(str, folders))} (have: {', '.join(have) or 'none'})",
         )
     motion = cell.motion
     if cell.part.mesh_units not in UNIT_SCALE:
@@ -47,6 +49,7 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         )
     if cell.part.mesh is not None:
         _check_data_file(file, "part.mesh", file.parent / cell.part.mesh)
+    check_part_model(file, cell, _check_data_file)
     if (cell.path is None) == (not cell.seams):
         raise _error(file, "seams", "give exactly one of path (one seam) or seams (a job)")
     for key, path in seam_keys(cell):
@@ -111,15 +114,19 @@ def seam_keys(cell: Cell) -> list[tuple[str, PathConfig]]:
 
 def _check_path(file: Path, key: str, path: PathConfig, cell: Cell) -> None:
     """One processing path (``path:`` or a seam): one source, units, normals, fit."""
-    if path.units not in UNIT_SCALE:
+    if path.units is None and path.cad is None:
+        raise _error(file, f"{key}.units", "missing (required)")
+    if path.units is not None and path.units not in UNIT_SCALE:
         raise _error(file, f"{key}.units", f"{path.units!r} is not a unit (use m or mm)")
-    sources = [k for k in ("points", "dxf", "analytic") if getattr(path, k) is not None]
+    sources = [k for k in ("points", "dxf", "analytic", "cad") if getattr(path, k) is not None]
     if len(sources) != 1:
         raise _error(
             file,
             key,
-            f"give exactly one of points, dxf, analytic (got {', '.join(sources) or 'none'})",
+            f"give exactly one of points, dxf, analytic, cad (got {', '.join(sources) or 'none'})",
         )
+    if path.cad is not None:
+        check_cad(file, key, path, cell, _check_data_file)
     for name in ("points", "dxf"):
         if getattr(path, name) is not None:
             _check_data_file(file, f"{key}.{name}", file.parent / getattr(path, name))
@@ -166,7 +173,7 @@ def _check_shapes(file: Path, cell: Cell) -> None:
         ("tool.geometry", cell.tool.geometry),
         ("obstacles", cell.obstacles),
     ]
-    names = {cell.part.name} if cell.part.mesh else set()
+    names = {cell.part.name} if cell.part.mesh or cell.part.model else set()
     for key, shapes in owners:
         for i, shape in enumerate(shapes):
             where = f"{key}[{i}]"

@@ -15,6 +15,7 @@ DIRECTIONS = ("forward", "reverse", "auto")
 APPROACH_KINDS = ("normal", "tangent", "none")
 MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
 MAX_LINK_TIME_S = 600.0  # planning time per link
+MAX_FLOW_LAG_S = 1.0  # a dispenser's lag: beyond this the path triggers cannot lead it
 MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
 SEAM_NAME = re.compile(rf"[A-Za-z][A-Za-z0-9_]{{0,{MAX_SEAM_NAME_CHARS - 1}}}")
 
@@ -82,6 +83,18 @@ def check_job(file: Path, cell: Cell) -> None:
             raise _error(file, "tool.process_io.off.digital_output", "must equal on's")
         if io.flow is not None and not io.flow.min < io.flow.max:
             raise _error(file, "tool.process_io.flow", "needs min < max")
+        if io.flow is not None and not io.flow.per_mps > 0:
+            raise _error(
+                file,
+                "tool.process_io.flow.per_mps",
+                f"must be > 0 V per m/s (the flow rises with the speed), got {io.flow.per_mps:g}",
+            )
+        if io.flow is not None and not 0 <= io.flow.lag_s <= MAX_FLOW_LAG_S:
+            raise _error(
+                file,
+                "tool.process_io.flow.lag_s",
+                f"must be within [0, {MAX_FLOW_LAG_S:g}] s, got {io.flow.lag_s:g}",
+            )
 
 
 # The process outputs each controller family can have (its own numbering):

@@ -50,17 +50,24 @@ TagTolerantLoader.yaml_implicit_resolvers = {
 TagTolerantLoader.add_implicit_resolver(
     "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
 )
-# Keys that YAML 1.1 loaders (Drake's typed loader is one) would read as booleans.
-_YAML11_BOOL_KEY = re.compile(
-    r"(?m)(^[ \t]*(?:-[ \t]+)?|[{,][ \t]*)(on|off|On|Off|ON|OFF|yes|no|Yes|No|YES|NO|y|n|Y|N)"
-    r"([ \t]*:(?:[ \t]|$))"
-)
 
 
-def quote_bool_keys(text: str) -> str:
-    """The YAML text with keys like ``on:`` quoted (``"on":``), so that a YAML 1.1
-    loader reads them as the strings a YAML 1.2 reader (and the schema) sees."""
-    return _YAML11_BOOL_KEY.sub(r'\1"\2"\3', text)
+def drake_text(data) -> str:
+    """YAML text that Drake's typed loader reads as ``data``, parsed by
+    :class:`TagTolerantLoader` (YAML 1.2 booleans): Drake's own dumper writes it, so a
+    string such as ``on`` or ``"demo, on: plate"`` is quoted where its YAML 1.1 loader
+    would read a boolean, and tagged mappings keep their tag. Nothing is edited in the
+    user's text."""
+    from pydrake.common.yaml import yaml_dump
+
+    def drake(value):
+        if isinstance(value, dict):
+            return {("_tag" if k == "__tag__" else k): drake(v) for k, v in value.items()}
+        if isinstance(value, list):
+            return [drake(v) for v in value]
+        return value
+
+    return yaml_dump(drake(data))
 
 
 _short = reprlib.Repr()

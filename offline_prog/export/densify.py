@@ -128,14 +128,13 @@ def _nearest(solutions: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _insert(data: ProgramData, s_new: np.ndarray, X_PF_new: np.ndarray) -> ProgramData:
     """The plan's rows plus rows at s_new (K,) with process frames X_PF_new (K, 4, 4)."""
-    from offline_prog.robot.model import load_robot
 
     rising = np.concatenate([[True], np.diff(data.sigma) > 0])
     t_new = PchipInterpolator(data.sigma[rising], data.t[rising])(s_new)
     hermite = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)
     q_new, qd_new = hermite(t_new), hermite(t_new, 1)
     X_BE_new = data.X_BT @ np.linalg.inv(X_PF_new) @ np.linalg.inv(data.X_EP)
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.params is not None:  # exact joints on the branch of the sample before
         left = np.searchsorted(data.sigma, s_new, side="right") - 1
         branch = _nearest(robot.inverse(data.X_BE[left]), data.q[left])[1]

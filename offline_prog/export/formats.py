@@ -19,7 +19,10 @@ from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
-FORMATS = ("krl", "rapid", "urscript", "csv", "ros-json")
+FORMATS = ("krl", "rapid", "urscript", "fanuc", "csv", "ros-json")
+# A controller's own language: only for a plan of that controller's robot (the joint
+# CSV and ROS JSON are for every robot).
+CONTROLLER_FORMATS = ("krl", "rapid", "urscript", "fanuc")
 PROGRAMS_DIR = "programs"
 
 
@@ -32,9 +35,14 @@ def default_formats(language: str | None) -> list[str]:
     return ([language] if language else []) + ["csv", "ros-json"]
 
 
+# Controller languages with a whole-job writer.
+JOB_LANGUAGES = ("krl", "rapid", "urscript", "fanuc")
+
+
 def job_formats(language: str | None) -> list[str]:
-    """The formats a whole job is exported in: as for one seam (default_formats)."""
-    return default_formats(language)
+    """The formats a whole job is exported in: as for one seam (default_formats), for
+    the languages that have a job writer."""
+    return default_formats(language if language in JOB_LANGUAGES else None)
 
 
 def export(
@@ -58,7 +66,7 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    if fmt in ("krl", "rapid") and fmt != data.language:  # (a job's language is its robot's)
+    if fmt in CONTROLLER_FORMATS and fmt != data.language:  # (a job's is its robot's)
         raise ValueError(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"
@@ -114,6 +122,10 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
         from offline_prog.export.urscript import write_urscript
 
         return [write_urscript(data, out_dir, forced=forced, **options).file]
+    if fmt == "fanuc":
+        from offline_prog.export.fanuc_ls import write_fanuc
+
+        return list(write_fanuc(data, out_dir, forced=forced, **options).files)
     if fmt == "krl":
         from offline_prog.export.krl import write_krl
 
@@ -126,7 +138,8 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
 # The options each job writer takes (the rest are one-seam options: refused by name).
 _JOB_OPTIONS = {"krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m"},
                 "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
-                "urscript": {"name", "period_s"}}  # fmt: skip
+                "urscript": {"name", "period_s"},
+                "fanuc": {"chord_tol_m", "angle_tol_rad", "name", "line_limit"}}  # fmt: skip
 
 
 def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
@@ -155,6 +168,10 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
         from offline_prog.export.krl_job import write_krl_job
 
         return write_krl_job(data, out_dir, forced=not data.feasible, **options)
+    if fmt == "fanuc":
+        from offline_prog.export.fanuc_job import write_fanuc_job
+
+        return write_fanuc_job(data, out_dir, forced=not data.feasible, **options)
     if fmt == "rapid":
         from offline_prog.export.rapid_job import write_rapid_job
 

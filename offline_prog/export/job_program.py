@@ -7,7 +7,8 @@ part from the seam's start, NaN on links; ``X_PF`` is the tool frame T in P, whi
 the process frame F on the seams and the backed-off frame on approach and retract);
 ``seams`` holds each seam's process rows exactly as a one-seam plan's ProgramData, so the
 one-seam point selection applies to them unchanged. Process I/O: ``digital`` (N,) 0/1
-and ``analog`` (N,) per row, and the switching positions along each seam.
+and ``analog`` (N,) per row, and the plan's I/O events (``offline_prog.io_events``):
+the writers translate them into statements and never recompute a switch position.
 
 Saved as ``plan.npz`` (the job's rows, under the one-seam keys) plus ``job.npz`` (the
 segments, the link waypoints, the I/O and each seam's data), so ``offline-prog export``
@@ -17,13 +18,15 @@ re-exports without re-planning.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog.atomic import atomic_stream
-from offline_prog.export.program import ProgramData
+from offline_prog.export.program import PLAN_FILE, ProgramData
+from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 JOB_FILE = "job.npz"
 
@@ -44,22 +47,6 @@ class JobSegment:
 
 
 @dataclasses.dataclass(frozen=True)
-class ProcessIo:
-    """``tool.process_io`` in SI units: the digital output switched ``on_lead_m`` before
-    each seam's start and ``off_lead_m`` before its end (None: no switching), and the
-    analog flow output value = offset + per_mps · v_TCP in [min, max] (None: no flow)."""
-
-    digital_output: int | None = None
-    on_lead_m: float = 0.0
-    off_lead_m: float = 0.0
-    analog_output: int | None = None
-    per_mps: float = 0.0
-    offset: float = 0.0
-    min: float = 0.0
-    max: float = 10.0
-
-
-@dataclasses.dataclass(frozen=True)
 class JobProgramData:
     """A finished job, as the program writers see it.
 
@@ -72,7 +59,8 @@ class JobProgramData:
             to fine points (the first is where the link starts).
         process_io: the process outputs, or None.
         digital: (N,) 0/1 state of the process output per row, or None.
-        analog: (N,) the flow output's value per row, or None.
+        analog: (N,) the flow output's command per row [V], or None.
+        events: the plan's I/O events in time order (``io_events.IoEvent``).
     """
 
     job: ProgramData
@@ -84,6 +72,7 @@ class JobProgramData:
     process_io: ProcessIo | None = None
     digital: np.ndarray | None = None
     analog: np.ndarray | None = None
+    events: tuple[IoEvent, ...] = ()
 
     @property
     def feasible(self) -> bool:
@@ -101,13 +90,13 @@ class JobProgramData:
     def language(self) -> str | None:
         return self.job.language
 
-    def switch_positions(self, k: int) -> tuple[float, float] | None:
-        """(on, off) positions [m] of seam k's process output along its tool path from
-        its start (on: −lead, on the approach when positive), or None."""
-        io = self.process_io
-        if io is None or io.digital_output is None:
-            return None
-        return -io.on_lead_m, self.seam_lengths_m[k] - io.off_lead_m
+    def seam_events(self, seam: str, signal: Signal = Signal.DIGITAL) -> list[IoEvent]:
+        """The events of one seam and output kind, in time order."""
+        return [e for e in self.events if e.seam == seam and e.signal is signal]
+
+    def load_robot(self):
+        """The job's RobotModel (ProgramData.load_robot)."""
+        return self.job.load_robot()
 
     def rows(self, segment: JobSegment) -> slice:
         """The rows of a segment and the row where it ends: [start, stop]."""
@@ -121,7 +110,11 @@ class JobProgramData:
             "seam_names": list(self.seam_names),
             "seam_lengths_m": list(self.seam_lengths_m),
             "process_io": None if self.process_io is None else dataclasses.asdict(self.process_io),
+            "events": [e.as_dict() for e in self.events],
             "seams": [],
+            # Which plan.npz these belong to: its rows and when it was made.
+            "rows": len(self.job.t),
+            "generated": self.job.generated,
         }
         arrays = {f"link_{k}": w for k, w in enumerate(self.link_waypoints)}
         for name in ("digital", "analog"):
@@ -141,10 +134,16 @@ class JobProgramData:
         """Read a job's plan folder; None when the folder holds a one-seam plan.
 
         Raises:
-            ValueError: one line naming the file when it is unreadable.
+            ValueError: one line naming the file when it is unreadable, missing (a
+                job's plan.npz without its job.npz) or from another plan.
         """
         file = Path(folder) / JOB_FILE
         if not file.is_file():
+            if ProgramData.load(folder).whole_job:
+                raise ValueError(
+                    f"{file}: missing: {Path(folder) / PLAN_FILE} holds a whole job's rows, "
+                    "which export only with their job.npz (plan the cell again)"
+                )
             return None
         job = ProgramData.load(folder)
         try:
@@ -164,7 +163,7 @@ class JobProgramData:
             )
             n_links = sum(1 for s in meta["segments"] if s["kind"] == "link")
             io = meta["process_io"]
-            return cls(
+            data = cls(
                 job,
                 tuple(JobSegment(**s) for s in meta["segments"]),
                 seams,
@@ -174,6 +173,33 @@ class JobProgramData:
                 None if io is None else ProcessIo(**io),
                 arrays.get("digital"),
                 arrays.get("analog"),
+                tuple(IoEvent.from_dict(e) for e in meta["events"]),
             )
+            rows, generated = meta["rows"], meta["generated"]
         except Exception as error:  # truncated or foreign: zipfile, zlib, json, keys ...
             raise ValueError(f"{file}: unreadable, not a complete job ({error})") from None
+        why = data._disagreement(rows, generated)
+        if why:
+            raise ValueError(f"{file}: does not belong to {Path(folder) / PLAN_FILE} ({why})")
+        return data
+
+    def _disagreement(self, rows: int, generated: str) -> str:
+        """Why job.npz and plan.npz are not one plan's files ("" when they are)."""
+        n = len(self.job.t)
+        if not self.job.whole_job:
+            return "plan.npz is a one-seam plan"
+        if rows != n or generated != self.job.generated:
+            return f"made with {rows} rows at {generated}, plan.npz has {n} rows made at " + (
+                self.job.generated
+            )
+        ends = [self.segments[0].start] + [s.stop for s in self.segments]
+        if ends[0] != 0 or ends[-1] != n or any(a > b for a, b in itertools.pairwise(ends)):
+            return f"its segments do not cover the {n} rows"
+        for name in ("digital", "analog"):
+            column = getattr(self, name)
+            if column is not None and len(column) != n:
+                return f"its {name} column has {len(column)} rows, not {n}"
+        unknown = {e.seam for e in self.events} - set(self.seam_names)
+        if unknown or {s.seam for s in self.segments if s.seam} != set(self.seam_names):
+            return "its seams and segments disagree"
+        return ""

@@ -5,12 +5,14 @@ Steps: ``JointMove`` (a link: fine-point joint targets, the first being where th
 already is), ``LinearMove`` (approach and retract: the tool frame T in P at the move's
 end, X_PT (4, 4); and its joints for configuration bits), and ``Process`` (a seam: the
 one-seam writers' point selection on the seam's own ProgramData: ``indices`` into its
-samples). A switch sits on the motion whose end point it precedes: ``move`` is the index
-of the target within the step (0 for a LinearMove; m ≥ 1 for the process LIN to point m)
-and ``before_end_m`` its distance before that target along the path [m] (≥ 0), the way
-KRL ``TRIGGER WHEN PATH = −d`` and RAPID ``TriggIO`` measure it. Positions along the path
-are the seam's arc length σ (negative before the start: on the approach; beyond L: on the
-retract), so LIN chords shorter than their arcs by at most the chord tolerance.
+samples). The plan's I/O events (``io_events``) are placed on these motions, never
+recomputed: a switch sits on the motion whose end point it precedes: ``move`` is the
+index of the target within the step (0 for a LinearMove; m ≥ 1 for the process LIN to
+point m) and ``before_end_m`` its distance before that target along the path [m] (≥ 0),
+the way KRL ``TRIGGER WHEN PATH = −d`` and RAPID ``TriggIO`` measure it. A motion holds
+every switch that falls on it, in path order. Positions along the path are the seam's
+arc length σ (negative before the start: on the approach; beyond L: on the retract), so
+LIN chords shorter than their arcs by at most the chord tolerance.
 """
 
 from __future__ import annotations
@@ -23,18 +25,29 @@ from offline_prog.export.densify import densify
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.krl_points import process_points
 from offline_prog.export.program import ProgramData
+from offline_prog.io_events import IoEvent, Signal
 
 
 @dataclasses.dataclass(frozen=True)
 class Switch:
-    """The process output set to ``state`` ``before_end_m`` [m] before target ``move``
-    of its step; ``position_m`` is where that is along the seam's path [m]."""
+    """An I/O event placed on a motion: ``before_end_m`` [m] before target ``move`` of
+    its step; ``event`` the plan's event (output, state, value, position)."""
 
-    output: int
-    state: bool
     move: int
     before_end_m: float
-    position_m: float
+    event: IoEvent
+
+    @property
+    def output(self) -> int:
+        return self.event.output
+
+    @property
+    def state(self) -> bool:
+        return self.event.state
+
+    @property
+    def signal(self) -> Signal:
+        return self.event.signal
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,12 +75,25 @@ class Process:
     max_angle_rad: float
     switches: tuple[Switch, ...] = ()
 
+    def switches_before(self, m: int) -> tuple[Switch, ...]:
+        """The switches on the LIN to point m, in path order."""
+        return tuple(s for s in self.switches if s.move == m)
+
 
 def job_steps(
-    job: JobProgramData, chord_tol_m: float, angle_tol_rad: float, *, style: str = "external_tcp",
+    job: JobProgramData,
+    chord_tol_m: float,
+    angle_tol_rad: float,
+    *,
+    style: str = "external_tcp",
     convention: str = "X_TP",
-) -> list[JointMove | LinearMove | Process]:  # fmt: skip
-    """The job's motion statements in run order, with the process I/O on them."""
+    flow_where_set: bool = False,
+) -> list[JointMove | LinearMove | Process]:
+    """The job's motion statements in run order, with the plan's I/O events on them.
+
+    ``flow_where_set``: place the flow's events where the controller sets them
+    (``IoEvent.set_path_m``: ``lag_s`` ahead, for a controller that does not lead by the
+    lag itself), not at their gate positions (``path_m``, RAPID's ScaleLag leads)."""
     steps, links, rows = [], iter(job.link_waypoints), job.job
     seam_index = {name: k for k, name in enumerate(job.seam_names)}
     for segment in job.segments:
@@ -75,7 +101,6 @@ def job_steps(
             steps.append(JointMove(next(links)))
             continue
         k = seam_index[segment.seam]
-        positions = job.switch_positions(k)
         end = min(segment.stop, len(rows.t) - 1)  # the row where the segment ends
         if segment.kind == "process":
             seam = job.seams[k]
@@ -83,47 +108,49 @@ def job_steps(
             tolerances = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
             idx, chord, angle = process_points(dense.data, style, *tolerances, convention)
             chord, angle = dense.bound(chord, angle)
-            sigma = dense.data.sigma[idx]
-            switches = _on_points(job, positions, sigma)
-            steps.append(Process(segment.seam, dense.data, idx, chord, angle, switches))
+            steps.append(Process(segment.seam, dense.data, idx, chord, angle))
             continue
         start = rows.X_PF[segment.start]
         length = float(np.linalg.norm(rows.X_PF[end, :3, 3] - start[:3, 3]))
         speed = float(job.seams[k].process_speed_m_s)
-        switches = ()
-        if positions is not None and segment.kind == "approach":
-            on = positions[0]
-            if -length - 1e-9 <= on < 0.0:  # on the approach: before the seam's start
-                switches = (Switch(job.process_io.digital_output, True, 0, -on, on),)
-        if positions is not None and segment.kind == "retract":
-            off, total = positions[1], job.seam_lengths_m[k]
-            if total < off <= total + length + 1e-9:  # on the retract: after the seam's end
-                switches = (Switch(job.process_io.digital_output, False, 0,
-                                   total + length - off, off),)  # fmt: skip
         steps.append(
-            LinearMove(
-                segment.kind, segment.seam, rows.X_PF[end], rows.q[end], length, speed, switches
-            )  # fmt: skip
+            LinearMove(segment.kind, segment.seam, rows.X_PF[end], rows.q[end], length, speed)
         )
-    return steps
+    return _with_switches(steps, job, flow_where_set)
 
 
-def _on_points(job: JobProgramData, positions, sigma: np.ndarray) -> tuple[Switch, ...]:
-    """The switches that fall on the seam's own LIN moves (0 < position ≤ L)."""
-    if positions is None:
-        return ()
-    out = []
-    for position, state in zip(positions, (True, False), strict=True):
-        if sigma[0] < position <= sigma[-1] + 1e-9:
-            m = int(np.searchsorted(sigma, position - 1e-12))  # σ[m−1] < position ≤ σ[m]
-            m = min(max(m, 1), len(sigma) - 1)
-            out.append(
-                Switch(
-                    job.process_io.digital_output,
-                    state,
-                    m,
-                    float(sigma[m] - position),
-                    float(position),
-                )  # fmt: skip
-            )
-    return tuple(out)
+def _position(event: IoEvent, flow_where_set: bool) -> float:
+    """Where along the path a program switches the event [m]."""
+    return event.set_path_m if flow_where_set else event.path_m
+
+
+def _with_switches(steps: list, job: JobProgramData, flow_where_set: bool) -> list:
+    """Each seam's events placed on its approach, LIN and retract motions."""
+    out = list(steps)
+    for seam, k in {name: k for k, name in enumerate(job.seam_names)}.items():
+        events = sorted(
+            (e for e in job.events if e.seam == seam),
+            key=lambda e: (_position(e, flow_where_set), e.signal is not Signal.DIGITAL),
+        )
+        if not events:
+            continue
+        # (step index, move, path position at the move's start and end [m]) in order.
+        moves, length = [], job.seam_lengths_m[k]
+        for i, step in enumerate(steps):
+            if isinstance(step, LinearMove) and step.seam == seam:
+                a = -step.length_m if step.kind == "approach" else length
+                moves.append((i, 0, a, a + step.length_m))
+            elif isinstance(step, Process) and step.seam == seam:
+                sigma = step.data.sigma[step.indices]
+                moves += [(i, m, sigma[m - 1], sigma[m]) for m in range(1, len(sigma))]
+        moves.sort(key=lambda move: (move[2], move[3]))
+        placed: dict[int, list[Switch]] = {}
+        for event in events:
+            # The first motion that ends at or past the position (the last one if none).
+            at = _position(event, flow_where_set)
+            i, m, _, b = next((mv for mv in moves if mv[3] >= at - 1e-9), moves[-1])
+            before = max(0.0, float(b - at))
+            placed.setdefault(i, []).append(Switch(m, before, event))
+        for i, switches in placed.items():
+            out[i] = dataclasses.replace(out[i], switches=tuple(switches))
+    return out

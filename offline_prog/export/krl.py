@@ -45,7 +45,6 @@ from offline_prog.export.kuka import (
 )
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
-from offline_prog.robot.model import load_robot
 
 STYLES = ("external_tcp", "flange")
 # "X_TP": the point is P in T, flange = $BASE:POS:inv($TOOL), KSS's rule for every
@@ -167,7 +166,7 @@ def write_krl(
         ValueError: a bad argument, a non-OPW robot, or an unreachable approach/retract.
     """
     _check(name, style, tcp_pose_convention, line_limit, (chord_tol_m, angle_tol_rad))
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
     dense = densify(data, chord_tol_m, angle_tol_rad)

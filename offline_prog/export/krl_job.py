@@ -7,13 +7,18 @@ its ``E6AXIS`` waypoints, fine points), the approach (``LIN`` to the seam's firs
 point), the seam's module (its LIN points, ``C_DIS``, speeds and point choice exactly as
 a one-seam program), the retract (``LIN``), and the last link home.
 
-Process I/O on the path (KSS 8 System Software, "TRIGGER WHEN PATH"): ``TRIGGER WHEN
-PATH = −d DELAY = 0 DO $OUT[n] = TRUE`` before a LIN switches d mm before that motion's
-end point. The output goes on on the approach (``lead_mm`` before the seam's start) and
-off on the seam's LIN that holds ``L − lead_mm``. The flow follows the TCP speed with
-``ANOUT ON $ANOUT[n] = f * $VEL_ACT + o MINIMUM = lo MAXIMUM = hi`` from the approach
-to the retract (``ANOUT OFF`` after it): ``$VEL_ACT`` in m/s and ``$ANOUT`` normalised
-to ±1 = ±10 V, so f = per_mps / 10, o = offset / 10 (the cell's values in volts).
+Process I/O on the path (KSS 8 System Software, "TRIGGER WHEN PATH"), from the plan's
+I/O events: ``TRIGGER WHEN PATH = −d DELAY = 0 DO $OUT[n] = TRUE`` before a LIN switches
+d mm before that motion's end point; every event stands before the LIN that holds it,
+in path order (two on one LIN: two TRIGGERs). The flow follows the TCP speed with one
+``ANOUT ON $ANOUT[n] = <name>_FK * $VEL_ACT + o DELAY = −lag MINIMUM = lo MAXIMUM = hi``
+at the program's start: ``$VEL_ACT`` in m/s and ``$ANOUT`` normalised to ±1 = ±10 V,
+so the factor is per_mps / 10 while the process output is on and 0 otherwise (the
+idle value o = offset / 10), switched by ``TRIGGER ... DO <name>_FK = f`` where the
+plan sets the flow: ``flow.lag_s`` (the dispenser's lag) before the tool reaches the
+positions of ``$OUT[n]`` (``IoEvent.set_path_m``), as the ANOUT's own ``DELAY`` leads
+the speed; no TRIGGER needs a negative DELAY, which the controller would stop at the
+motion's start.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from offline_prog.export.job_steps import JointMove, LinearMove, Process, job_st
 from offline_prog.export.krl import _load, _process_lines, _write
 from offline_prog.export.krl_header import krl_comments
 from offline_prog.export.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
-from offline_prog.robot.model import load_robot
+from offline_prog.io_events import Signal
 
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 100, 100  # links: the planned joint moves at full rate
@@ -51,20 +56,24 @@ def write_krl_job(
     forced: bool = False,
 ) -> list[Path]:
     """Write the job's KRL modules into out_dir; returns the files (main first)."""
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"write_krl: robot {data.robot} is not an OPW arm (family {robot.family})")
     if len(name) > 20 or not name.replace("_", "a").isalnum() or not name[0].isalpha():
         raise ValueError(f"write_krl: name {name!r} is not a KRL name of <= 20 characters")
     job, io = data.job, data.process_io
-    steps = job_steps(data, chord_tol_m, angle_tol_rad)
+    steps = job_steps(data, chord_tol_m, angle_tol_rad, flow_where_set=True)
     src, modules = [], []
     decl = []  # main .dat declarations
     q_home = steps[0].targets[0]
     decl.append(f"DECL E6AXIS XHOME={{{_axes(q_home)}{_ZEROS}}}")
+    flow = io is not None and io.analog_output is not None
+    factor = f"{name.upper()}_FK"  # the flow's factor: live while $OUT is on, else 0
+    if flow:
+        decl.append(f"DECL GLOBAL REAL {factor}=0.0")
+        src += _anout_on(io, factor)
     src += ["; Home", "PTP XHOME"]
     n_link, seam_no = 0, 0
-    flow = io is not None and io.analog_output is not None
     for step in steps:
         if isinstance(step, JointMove):
             n_link += 1
@@ -75,25 +84,14 @@ def write_krl_job(
         elif isinstance(step, LinearMove):
             seam_no += step.kind == "approach"
             label = f"X{step.kind[0].upper()}{seam_no}"  # XA<k> approach end, XR<k> retract end
-            if step.kind == "approach":
-                src.append(f"; Approach of seam {step.seam}: LIN {step.length_m * 1e3:.1f} mm")
-                if flow:
-                    f, o = io.per_mps / ANALOG_FULL_SCALE_V, io.offset / ANALOG_FULL_SCALE_V
-                    lo, hi = io.min / ANALOG_FULL_SCALE_V, io.max / ANALOG_FULL_SCALE_V
-                    src.append(
-                        f"ANOUT ON $ANOUT[{io.analog_output}]={krl_num(f, 6)}*$VEL_ACT+"
-                        f"{krl_num(o, 6)} MINIMUM={krl_num(lo, 4)} MAXIMUM={krl_num(hi, 4)}"
-                    )
-            else:
-                src.append(f"; Retract of seam {step.seam}: LIN {step.length_m * 1e3:.1f} mm")
+            what = "Approach" if step.kind == "approach" else "Retract"
+            src.append(f"; {what} of seam {step.seam}: LIN {step.length_m * 1e3:.1f} mm")
             src.append(f"$VEL.CP={vel_cp(step.speed_m_s):.4f}")
-            src += [_trigger(s) for s in step.switches]
+            src += [_trigger(s, io, factor) for s in step.switches]
             status, turn = status_turn(robot.params, step.q[None])
             pose = krl_frame(np.linalg.inv(step.X_PT))
             decl.append(f"DECL E6POS {label}={{{pose},S {status[0]},T {turn[0]}{_ZEROS}}}")
             src.append(f"LIN {label}")
-            if step.kind == "retract" and flow:
-                src.append(f"ANOUT OFF $ANOUT[{io.analog_output}]")
         else:
             module = f"{name}_{seam_no}"
             src.append(f"; Seam {step.seam}: {len(step.indices) - 1} LIN points in {module}")
@@ -110,10 +108,10 @@ def write_krl_job(
         "$BASE=FIXED_TOOL", "$TOOL=PART_ON_FLANGE", "$IPO_MODE=#TCP", "$ORI_TYPE=#VAR",
         "$ADVANCE=3", f"BAS(#VEL_PTP,{PTP_VEL_PERCENT})", f"BAS(#ACC_PTP,{PTP_ACC_PERCENT})",
         f"$VEL.ORI1={ori:.0f}", f"$VEL.ORI2={ori:.0f}", f"$APO.CDIS={blend_m * 1e3:.3f}",
-        *src, "END",
+        *src, *([f"ANOUT OFF $ANOUT[{io.analog_output}]"] if flow else []), "END",
     ]  # fmt: skip
     main_dat = [
-        f"DEFDAT {name}",
+        f"DEFDAT {name}" + (" PUBLIC" if flow else ""),
         "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
         f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ job.X_EP)}}}",
         f"DECL FRAME FIXED_TOOL={{{krl_frame(job.X_BT)}}}",
@@ -122,19 +120,37 @@ def write_krl_job(
     ]
     files = _write(Path(out_dir), name, head + main_src, head + main_dat)
     for module, step in modules:
-        files += _seam_module(Path(out_dir), module, step, robot, head)
+        files += _seam_module(Path(out_dir), module, step, robot, head, io, factor)
     return files
 
 
-def _trigger(switch) -> str:
-    state = "TRUE" if switch.state else "FALSE"
-    return (
-        f"TRIGGER WHEN PATH={krl_num(-switch.before_end_m * 1e3, 3)} DELAY=0 "
-        f"DO $OUT[{switch.output}]={state} PRIO=-1"
-    )
+def _anout_on(io, factor: str) -> list[str]:
+    """The flow's cyclic output, idle (factor 0) until a TRIGGER makes it live."""
+    o = io.offset / ANALOG_FULL_SCALE_V
+    lo, hi = io.min / ANALOG_FULL_SCALE_V, io.max / ANALOG_FULL_SCALE_V
+    delay = f" DELAY={krl_num(-io.lag_s, 3)}" if io.lag_s > 0 else ""
+    return [
+        f"; Flow: $ANOUT[{io.analog_output}] follows $VEL_ACT while $OUT is on, idle otherwise",
+        f"{factor}=0.0",
+        f"ANOUT ON $ANOUT[{io.analog_output}]={factor}*$VEL_ACT+{krl_num(o, 6)}{delay} "
+        f"MINIMUM={krl_num(lo, 4)} MAXIMUM={krl_num(hi, 4)}",
+    ]
 
 
-def _seam_module(folder: Path, module: str, step: Process, robot, head) -> list[Path]:
+def _trigger(switch, io, factor: str) -> str:
+    """The TRIGGER of one I/O event: $OUT for the process output, the flow's factor
+    for the flow (placed where the plan sets it, ``lag_s`` ahead)."""
+    path = krl_num(-switch.before_end_m * 1e3, 3)
+    if switch.signal is Signal.DIGITAL:
+        state = "TRUE" if switch.state else "FALSE"
+        return f"TRIGGER WHEN PATH={path} DELAY=0 DO $OUT[{switch.output}]={state} PRIO=-1"
+    f = io.per_mps / ANALOG_FULL_SCALE_V if switch.state else 0.0
+    return f"TRIGGER WHEN PATH={path} DELAY=0 DO {factor}={krl_num(f, 6)} PRIO=-1"
+
+
+def _seam_module(
+    folder: Path, module: str, step: Process, robot, head, io, factor: str
+) -> list[Path]:
     """``module.src`` / ``.dat``: the seam's LIN points (the first is where the approach
     ended), with the switches before the LIN whose motion holds them."""
     data, idx = step.data, step.indices
@@ -146,13 +162,11 @@ def _seam_module(folder: Path, module: str, step: Process, robot, head) -> list[
         for n, X, s, t in zip(names, poses, status, turn, strict=True)
     ]
     lines = _process_lines(names, idx, data.tcp_speed, line_limit=10**9)[0]
-    by_move = {s.move: s for s in step.switches}
     body = []
     for line in lines:
         if line.startswith("LIN "):
             m = names.index(line.split()[1])
-            if m in by_move:
-                body.append(_trigger(by_move[m]))
+            body += [_trigger(s, io, factor) for s in step.switches_before(m)]
         body.append(line)
     src = [f"DEF {module}( )", *body, "END"]
     note = [f"; Seam {step.seam}: deviation <= {step.max_chord_m * 1e3:.4f} mm, "
@@ -185,13 +199,15 @@ def _header(data: JobProgramData, steps, forced: bool) -> list[str]:
     ]
     if io is not None and io.digital_output is not None:
         lines.append(
-            f"Process output $OUT[{io.digital_output}]: TRIGGER WHEN PATH, on "
-            f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
-            f"{io.off_lead_m * 1e3:g} mm before its end."
+            f"Process output $OUT[{io.digital_output}]: TRIGGER WHEN PATH at the plan's "
+            f"switch positions (on {io.on_lead_m * 1e3:g} mm before each seam's start, off "
+            f"{io.off_lead_m * 1e3:g} mm before its end)."
         )
     if io is not None and io.analog_output is not None:
         lines.append(
             f"Flow $ANOUT[{io.analog_output}] = ({io.per_mps:g} V per m/s * $VEL_ACT + "
-            f"{io.offset:g} V) / 10 V, within [{io.min:g}, {io.max:g}] V, approach to retract."
+            f"{io.offset:g} V) / 10 V within [{io.min:g}, {io.max:g}] V while the process "
+            f"output is on, {io.idle:g} V otherwise; leads by the dispenser's lag "
+            f"{io.lag_s:g} s."
         )
     return krl_comments(header_lines(data.job, conventions=lines, forced=forced))

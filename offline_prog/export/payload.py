@@ -61,9 +61,9 @@ def payload_note(record: dict | None, X_EP: np.ndarray) -> str:
     """One header line: the payload written, or a warning naming the missing keys."""
     load = payload(record)
     if load is None:
-        missing = [
-            key
-            for key, name in (
+        missing = [  # the cell file's keys, as the user writes them
+            cell_key
+            for key, cell_key in (
                 ("gripper_mass_kg", "gripper.mass_kg"),
                 ("part_mass_kg", "part.mass_kg"),
             )

@@ -85,19 +85,33 @@ class ProgramData:
     q_lower: np.ndarray
     q_upper: np.ndarray
     qd_max: np.ndarray
-    j23_coupled: bool = False  # the controller counts axis 3 as q2 + q3 (ABB IRB 2400)
+    j23_coupled: bool = False  # the controller counts axis 3 as q3 + j23_factor·q2
+    j23_factor: float = 1.0  # +1: ABB (q2 + q3); -1: FANUC (q3 − q2)
+    robots_dir: str = ""  # the folder the plan's robot folder was found in ("": search)
     language: str | None = None  # the controller's program format (robot.yaml)
     payload: dict | None = None  # export.payload.payload_record (None: plan before payloads)
     # The process time law (motion.time_law, and motion.process for time_optimal).
     time_law: str = "sin2"
     sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
     X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
+    # These rows are a whole job's (job.npz beside them holds its segments and I/O).
+    whole_job: bool = False
+
+    def load_robot(self):
+        """The plan's RobotModel: from robots_dir when it still holds the robot, else
+        from the search path (OFFLINE_PROG_ROBOTS, then the bundled robots)."""
+        from offline_prog.robot.model import load_robot
+
+        folder = Path(self.robots_dir) if self.robots_dir else None
+        has = folder is not None and (folder / self.robot / "robot.yaml").is_file()
+        return load_robot(self.robot, folder if has else None)
 
     def controller_column(self, col: dict, prefix: str, j: int) -> np.ndarray:
         """Column ``<prefix><j+1>`` of a trajectory table as the controller counts it
-        (the joint limits apply to that): axis 3 is q2 + q3 on coupled robots."""
+        (the joint limits apply to that): axis 3 is q3 + j23_factor·q2 on coupled robots."""
         values = col[f"{prefix}{j + 1}"]
-        return values + col[f"{prefix}2"] if self.j23_coupled and j == 2 else values
+        coupled = self.j23_coupled and j == 2
+        return values + self.j23_factor * col[f"{prefix}2"] if coupled else values
 
     def packed(self) -> tuple[dict, dict[str, np.ndarray]]:
         """(meta, arrays): the JSON-able header fields and the arrays by name."""

@@ -34,7 +34,7 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
-from offline_prog.robot.model import RobotModel, load_robot
+from offline_prog.robot.model import RobotModel
 
 # Approach / retract along -y of F (y = pressing direction n): none by default, so the
 # program moves only as planned (MoveAbsJ to the plan's first joints); a whole job's
@@ -187,7 +187,7 @@ def write_rapid(
     identifier(module, max_chars=NAME_MAX - 6, what="module")
     if not (chord_tol_m > 0 and angle_tol_rad > 0 and zone_mm >= 0 and approach_m >= 0):
         raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0, zone_mm >= 0, approach_m >= 0")
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     # Controller axis 3 = q2 + q3 where robot.yaml says so (the IRB 2400's J2/J3 linkage).
     j23 = robot.j23_coupled if j23_coupled is None else j23_coupled
     if robot.family != "opw":

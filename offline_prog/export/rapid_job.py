@@ -7,15 +7,17 @@ fine points: the planned, collision-checked joint moves), the approach (``TriggL
 the seam's first point), the seam (``PROC seam_<k>``: ``MoveL`` / ``TriggL`` through the
 one-seam writer's points and speeds), the retract (``MoveL``/``TriggL``); home at the end.
 
-Process I/O on the path (RAPID Instructions, 3HAC050917: ``TriggIO``, ``TriggL``,
-``TriggSpeed``): ``TriggIO t, d \\DOp:=do<n>, 1`` then ``TriggL p, v, t, z, tool`` sets
-the output d mm before the move's end point (distance from the end, no ``\\Start``). The
-output goes on d = lead mm before the approach's end (the seam's start) and off on the
-seam's move that holds L − lead. The flow follows the TCP speed: ``TriggSpeed tFlow, 0
-\\Start, 0.05, ao<n>, k`` on the approach with k = per_mps / 1000 (the logical value of
-``ao<n>`` = k · v_TCP [mm/s], i.e. volts per mm/s); the cell's offset and limits belong
-to the signal's scaling in the I/O configuration (the header says which); a
-``TriggSpeed`` with k = 0 on the retract ends it. Signals are named ``do<n>`` / ``ao<n>``.
+Process I/O on the path from the plan's I/O events (RAPID Instructions, 3HAC050917:
+``TriggIO``, ``TriggL``, ``TriggSpeed``): ``TriggIO t, d \\DOp:=do<n>, 1`` then
+``TriggL p, v, t, z, tool`` sets the output d mm before the move's end point (distance
+from the end, no ``\\Start``); a move holds every event that falls on it (``\\T2``,
+``\\T3``, ...). The flow follows the TCP speed only while the output is on:
+``TriggSpeed tFlowOn, d, lag, ao<n>, k`` at the on switch's position with k = per_mps /
+1000 (the logical value of ``ao<n>`` = k · v_TCP [mm/s], i.e. volts per mm/s) and
+``TriggSpeed tFlowOff, d, lag, ao<n>, 0`` at the off switch's; ScaleLag = the cell's
+``flow.lag_s`` (the dispenser's lag). The offset and limits belong to the signal's
+scaling in the I/O configuration (the header says which): logical 0 is the idle value,
+the offset. Signals are named ``do<n>`` / ``ao<n>``.
 """
 
 from __future__ import annotations
@@ -47,10 +49,17 @@ from offline_prog.export.rapid import (
     segment_speeds_mms,
 )
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
-from offline_prog.robot.model import load_robot
+from offline_prog.io_events import Signal
 
 LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the controller's)
-FLOW_LAG_S = 0.05  # TriggSpeed ScaleLag: the flow equipment's delay [s]
+# The triggdata of each kind of event; a second one of a kind on the same move gets a
+# number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
+TRIGGERS = {
+    (Signal.DIGITAL, True): "tOn",
+    (Signal.DIGITAL, False): "tOff",
+    (Signal.ANALOG, True): "tFlowOn",
+    (Signal.ANALOG, False): "tFlowOff",
+}
 
 
 def write_rapid_job(
@@ -65,7 +74,7 @@ def write_rapid_job(
 ) -> list[Path]:
     """Write ``<module>.mod`` and ``<module>.pgf`` into out_dir; returns the files."""
     identifier(module, max_chars=NAME_MAX - 6, what="module")
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     if robot.family != "opw":
         raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
     job, io = data.job, data.process_io
@@ -80,10 +89,7 @@ def write_rapid_job(
     ]
     if load is not None:
         decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
-    flow = io is not None and io.analog_output is not None
-    digital = io is not None and io.digital_output is not None
-    decls += ["VAR triggdata tOn;", "VAR triggdata tOff;"] * digital
-    decls += ["VAR triggdata tFlow;", "VAR triggdata tFlowEnd;"] * flow
+    triggdata: set[str] = set()  # declared once the moves are written
     z = _list((zone_mm,) * 3 + (zone_mm / 10, zone_mm, zone_mm / 10), 5)[1:-1]
     decls.append(f"LOCAL CONST zonedata zPath := [FALSE,{z}];")
     main = ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * (load is not None)
@@ -115,19 +121,15 @@ def write_rapid_job(
             conf = confdata(robot, step.q[None])[0]
             decls.append(_robtarget(name, step.X_PT, conf))
             speed = speed_name(step.speed_m_s * 1e3)
-            triggers = [_trigg_io(s, main) for s in step.switches]
-            if flow and step.kind == "approach":
-                main.append(f"TriggSpeed tFlow, 0\\Start, {FLOW_LAG_S}, ao{io.analog_output}, "
-                            f"{_num(io.per_mps / 1000.0, 6)};")  # fmt: skip
-                triggers.append("tFlow")
-            if flow and step.kind == "retract":
-                main.append(f"TriggSpeed tFlowEnd, 0, 0, ao{io.analog_output}, 0;")
-                triggers.append("tFlowEnd")
+            triggers = _triggers(step.switches, io, main, triggdata)
             main.append(_move(name, speed, triggers, "fine", tail))
         else:
             proc = f"seam_{seam_no}"
-            procs[proc] = _seam_moves(step, robot, decls, speed_name, tail, zone_mm, proc)
+            procs[proc] = _seam_moves(
+                step, robot, decls, speed_name, tail, zone_mm, proc, io, triggdata
+            )
             main.append(f"{proc};  ! seam {step.seam}")
+    decls += [f"VAR triggdata {name};" for name in sorted(triggdata)]
     header = _header(data, robot, forced)
     body = ["! " + rapid_comment(line) for line in header] + decls
     text = _module_text(module, body, {"main": main, **procs})
@@ -137,12 +139,26 @@ def write_rapid_job(
     return files
 
 
-def _trigg_io(switch, lines: list[str]) -> str:
-    name = "tOn" if switch.state else "tOff"
-    lines.append(
-        f"TriggIO {name}, {_num(switch.before_end_m * 1e3, 3)}\\DOp:=do{switch.output}, "
-        f"{int(switch.state)};"
-    )
+def _triggers(switches, io, lines: list[str], declared: set[str]) -> list[str]:
+    """Define the triggers of one move's I/O events in ``lines`` (each its own
+    triggdata, added to ``declared``); returns their names in path order."""
+    names: list[str] = []
+    for switch in switches:
+        base = TRIGGERS[switch.signal, switch.state]
+        count = sum(name.rstrip("0123456789") == base for name in names)
+        names.append(_trigger(switch, io, lines, base + (str(count + 1) if count else "")))
+    declared.update(names)
+    return names
+
+
+def _trigger(switch, io, lines: list[str], name: str) -> str:
+    """Define the trigger ``name`` of one I/O event in ``lines``; returns its name."""
+    distance = _num(switch.before_end_m * 1e3, 3)
+    if switch.signal is Signal.DIGITAL:
+        lines.append(f"TriggIO {name}, {distance}\\DOp:=do{switch.output}, {int(switch.state)};")
+    else:
+        k = _num(io.per_mps / 1000.0, 6) if switch.state else "0"
+        lines.append(f"TriggSpeed {name}, {distance}, {_num(io.lag_s, 3)}, ao{switch.output}, {k};")
     return name
 
 
@@ -153,18 +169,19 @@ def _move(target: str, speed: str, triggers: list[str], zone: str, tail: str) ->
     return f"TriggL {target}, {speed}, {triggers[0]}{extra}, {zone}{tail}"
 
 
-def _seam_moves(step: Process, robot, decls, speed_name, tail, zone_mm, proc) -> list[str]:
+def _seam_moves(
+    step: Process, robot, decls, speed_name, tail, zone_mm, proc, io, triggdata: set[str]
+) -> list[str]:
     """The seam's moves; its first point is the approach's end (declared there)."""
     data, idx = step.data, step.indices
     conf = confdata(robot, data.q[idx])
     speeds = segment_speeds_mms(data, idx)
-    by_move = {s.move: s for s in step.switches}
     lines = []
     for m in range(1, len(idx)):
         name = f"{proc}_{m}"
         decls.append(_robtarget(name, data.X_PF[idx[m]], conf[m]))
         zone = "fine" if m == len(idx) - 1 or zone_mm == 0 else "zPath"
-        triggers = [_trigg_io(by_move[m], lines)] if m in by_move else []
+        triggers = _triggers(step.switches_before(m), io, lines, triggdata)
         lines.append(_move(name, speed_name(speeds[m - 1]), triggers, zone, tail))
     return lines
 
@@ -184,13 +201,16 @@ def _header(data: JobProgramData, robot, forced: bool) -> list[str]:
     ]
     if io is not None and io.digital_output is not None:
         lines.append(
-            f"Process output do{io.digital_output}: TriggIO on {io.on_lead_m * 1e3:g} mm "
-            f"before each seam's start, off {io.off_lead_m * 1e3:g} mm before its end."
+            f"Process output do{io.digital_output}: TriggIO at the plan's switch positions "
+            f"(on {io.on_lead_m * 1e3:g} mm before each seam's start, off "
+            f"{io.off_lead_m * 1e3:g} mm before its end)."
         )
     if io is not None and io.analog_output is not None:
         lines.append(
-            f"Flow ao{io.analog_output}: TriggSpeed, logical value = "
-            f"{io.per_mps / 1000:g} V per mm/s x TCP speed; set the signal's I/O "
-            f"configuration to add {io.offset:g} V and limit it to [{io.min:g}, {io.max:g}] V."
+            f"Flow ao{io.analog_output}: TriggSpeed while the process output is on, logical "
+            f"value = {io.per_mps / 1000:g} V per mm/s x TCP speed, 0 otherwise (ScaleLag "
+            f"{io.lag_s:g} s: the dispenser's lag); set the signal's I/O configuration to "
+            f"add {io.offset:g} V and limit it to [{io.min:g}, {io.max:g}] V (idle "
+            f"{io.idle:g} V)."
         )
     return header_lines(data.job, conventions=lines, forced=forced)

@@ -61,6 +61,25 @@ def urscript_comment(text: str) -> str:
     return plain_ascii(text)
 
 
+FANUC_COMMENT_MAX = 32  # a TP remark (``! text ;``) holds at most 32 characters
+
+
+def fanuc_comments(text: str) -> list[str]:
+    """Text for FANUC TP remarks (the writer puts ``! `` before and `` ;`` after each):
+    plain ASCII, ``;`` as ``,``, split at spaces into pieces of at most 32 characters."""
+    words, pieces = plain_ascii(text).replace(";", ",").split(), [""]
+    for word in words:
+        while len(word) > FANUC_COMMENT_MAX:
+            pieces += [word[:FANUC_COMMENT_MAX], ""]
+            word = word[FANUC_COMMENT_MAX:]
+        joined = f"{pieces[-1]} {word}".strip()
+        if len(joined) <= FANUC_COMMENT_MAX:
+            pieces[-1] = joined
+        else:
+            pieces.append(word)
+    return [piece for piece in pieces if piece]
+
+
 def rapid_string(text: str) -> str:
     """A RAPID string literal, quotes included: ``"`` and ``\\`` doubled, ≤ 80 chars."""
     body, length = [], 0

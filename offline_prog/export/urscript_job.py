@@ -6,12 +6,14 @@ seam with its approach and retract: the planned joint trajectory resampled to th
 controller period and streamed with ``servoj``, as the one-seam writer does
 (:mod:`offline_prog.export.urscript`).
 
-Process I/O on the path: the digital output is switched (``set_standard_digital_out``)
-just before the first ``servoj`` whose sample has reached the switching position along
-the seam's path (the stream advances by v_TCP · 2 ms, 0.2 mm at 100 mm/s, per command);
-the flow follows the planned TCP speed with ``set_standard_analog_out(n, value / 10 V)``
-(URScript takes the output as a fraction of its 0–10 V range) whenever the value has
-changed by ``ANALOG_STEP_V``.
+Process I/O from the plan's I/O events: an output is set (``set_standard_digital_out``,
+``set_standard_analog_out``) just before the first ``servoj`` whose sample has reached
+the event's time, so the tool is at most v_TCP · period past its position (0.2 mm at
+100 mm/s and 2 ms). The flow, ``set_standard_analog_out(n, value / 10 V)`` (URScript
+takes the output as a fraction of its 0–10 V range), follows the plan's ``ao`` column
+while it is live, interpolated between live samples only (an edge is a step, not a
+ramp), written at each event and whenever it has changed by ``ANALOG_STEP_V``, and
+holds the idle value otherwise.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from offline_prog.export.urscript import (
     _list,
     joints_on_steps,
 )
-from offline_prog.robot.model import load_robot
+from offline_prog.io_events import Signal
 
 ANALOG_RANGE_V = 10.0  # standard analog outputs: 0..10 V as 0..1
 ANALOG_STEP_V = 0.02  # write the flow when it changed by this much
@@ -49,7 +51,7 @@ def write_urscript_job(
 ) -> Path:
     """Write ``out_dir/<name>.script``; returns the file."""
     identifier(name, max_chars=NAME_MAX, what="name")
-    robot = load_robot(data.robot)
+    robot = data.load_robot()
     job, io = data.job, data.process_io
     v_link, a_link = float(robot.qd_max.min()), float(robot.qdd_max.min())
     conventions = [
@@ -102,25 +104,30 @@ def write_urscript_job(
 def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> list[str]:
     """servoj lines over the job's rows of one seam (approach to retract), with I/O."""
     job, io = data.job, data.process_io
-    t = job.t[rows] - job.t[rows][0]
-    grid = np.arange(0.0, t[-1], period_s)
-    grid = np.append(grid, t[-1]) if t[-1] - grid[-1] > 1e-9 else grid
-    q = joints_on_steps(t, job.q[rows], grid)
-    position = np.interp(grid, t, job.sigma[rows])  # along the seam's path [m]
-    switches = {}
-    if (where := data.switch_positions(seam)) is not None:
-        for value, state in zip(where, (True, False), strict=True):
-            i = int(np.searchsorted(position, value - 1e-12))
-            switches[min(i, len(grid) - 1)] = state
-    flow = None
-    if io is not None and io.analog_output is not None and data.analog is not None:
-        flow = np.interp(grid, t, data.analog[rows])
+    name = data.seam_names[seam]
+    t = job.t[rows]
+    grid = np.arange(0.0, t[-1] - t[0], period_s)
+    grid = np.append(grid, t[-1] - t[0]) if t[-1] - t[0] - grid[-1] > 1e-9 else grid
+    q = joints_on_steps(t - t[0], job.q[rows], grid)  # on the checked joint steps
+    grid = grid + t[0]  # the job's clock
+    # Event k is set before the first command whose sample is at or past its time.
+    sets: dict[int, list] = {}
+    for event in data.events:
+        if event.seam == name:
+            i = int(np.searchsorted(grid, event.t_s - 1e-12))
+            sets.setdefault(min(max(i, 1), len(grid) - 1), []).append(event)
+    flow = _flow(data, rows, grid, name)
     lines, last_flow = [], None
     for i in range(1, len(grid)):
-        if i in switches:
-            state = "True" if switches[i] else "False"
-            lines.append(f"  set_standard_digital_out({io.digital_output}, {state})")
-        if flow is not None and (last_flow is None or abs(flow[i] - last_flow) >= ANALOG_STEP_V):
+        for event in sets.get(i, []):
+            if event.signal is Signal.DIGITAL:
+                state = "True" if event.state else "False"
+                lines.append(f"  set_standard_digital_out({event.output}, {state})")
+        if flow is not None and (
+            last_flow is None
+            or abs(flow[i] - last_flow) >= ANALOG_STEP_V
+            or any(e.signal is Signal.ANALOG for e in sets.get(i, []))
+        ):
             last_flow = flow[i]
             lines.append(
                 f"  set_standard_analog_out({io.analog_output}, "
@@ -131,3 +138,22 @@ def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> li
             f"gain={SERVOJ_GAIN})"
         )
     return lines
+
+
+def _flow(data: JobProgramData, rows: slice, grid: np.ndarray, seam: str) -> np.ndarray | None:
+    """(len(grid),) the flow command at the grid times [V]: the plan's ``ao`` column
+    between its live samples while the flow is live (its analog events), else idle."""
+    io = data.process_io
+    if io is None or io.analog_output is None or data.analog is None:
+        return None
+    t, value = data.job.t[rows], data.analog[rows]
+    events = data.seam_events(seam, Signal.ANALOG)
+    out = np.full(len(grid), io.idle)
+    for on, off in zip(events[::2], events[1::2], strict=True):
+        live = (t >= on.t_s) & (t < off.t_s)
+        here = (grid >= on.t_s) & (grid < off.t_s)
+        if live.any():
+            out[here] = np.interp(grid[here], t[live], value[live])
+        else:  # a window shorter than a sample: the event's own value
+            out[here] = on.value
+    return out

@@ -124,22 +124,29 @@ def cartesian_move(
         speed, a_max = speed / (ratio * SLOWDOWN_MARGIN), a_max / (ratio * SLOWDOWN_MARGIN) ** 2
     end = -1 if kind == "approach" else 0  # the sample at the seam
     if not np.isfinite(result.q).all():
-        reason = result.reason or "out of reach"
-        _fail(kind, seam, t, result.sample, f"{reason} on the seam's branch")
+        reason, failure = result.reason or "out of reach", result.kind or Failure.OUT_OF_REACH
+        _fail(kind, seam, t, result.sample, f"{reason} on the seam's branch", failure)
     # The same 2π turns as the seam's joints at the shared end.
     q = result.q + TWO_PI * np.round((q_seam - result.q[end]) / TWO_PI)
     if np.abs(q[end] - q_seam).max() > 1e-6:
-        _fail(kind, seam, t, len(t) - 1 if end else 0, "singularity (the configuration flips)")
+        _fail(
+            kind,
+            seam,
+            t,
+            len(t) - 1 if end else 0,
+            "singularity (the configuration flips)",
+            Failure.SINGULARITY,
+        )
     q_c = robot.controller_joints(q)
     outside = (q_c < robot.q_lower) | (q_c > robot.q_upper)
     if outside.any():
         i, joint = np.argwhere(outside)[0]
-        _fail(kind, seam, t, int(i), f"joint limit on axis {joint + 1}")
+        _fail(kind, seam, t, int(i), f"joint limit on axis {joint + 1}", Failure.JOINT_LIMIT)
     return CartesianMove(
         kind, seam, d, t, q, delta, p_IE_t, R_IE, p_PF - delta[:, None] * u_P, R_PF
     )
 
 
-def _fail(kind: str, seam: str, t: np.ndarray, i: int, reason: str) -> None:
+def _fail(kind: str, seam: str, t: np.ndarray, i: int, reason: str, failure: Failure) -> None:
     message = f"{reason} ({kind} of seam {seam}, t = {t[i]:.3f} s into it)"
-    raise PlanFailedError(PlanFailure(Failure.of(reason), 0.0, float(t[i]), message))
+    raise PlanFailedError(PlanFailure(failure, 0.0, float(t[i]), message))

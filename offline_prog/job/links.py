@@ -178,9 +178,10 @@ def _urdf_bounds(robot: RobotModel) -> tuple[np.ndarray, np.ndarray]:
     """(6,), (6,) a box in URDF joints holding every configuration inside the
     controller's limits (exact unless axes are coupled; validity checks the rest)."""
     lower, upper = robot.q_lower.copy(), robot.q_upper.copy()
-    if robot.j23_coupled:  # q3 = a3 − q2 with a3 the controller's axis 3
-        lower[2] = robot.q_lower[2] - robot.q_upper[1]
-        upper[2] = robot.q_upper[2] - robot.q_lower[1]
+    if robot.j23_coupled:  # q3 = a3 − f·q2 with a3 the controller's axis 3
+        f_q2 = robot.j23_factor * np.array([robot.q_lower[1], robot.q_upper[1]])
+        lower[2] = robot.q_lower[2] - f_q2.max()
+        upper[2] = robot.q_upper[2] - f_q2.min()
     return lower, upper
 
 

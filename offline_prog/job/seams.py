@@ -59,11 +59,11 @@ def reversed_points(points: PathPoints) -> PathPoints:
     order = np.arange(len(points.p_PR))[::-1]
     if points.closed:
         order = np.roll(order, 1)
-    return PathPoints(
-        points.p_PR[order],
-        None if points.normals_P is None else points.normals_P[order],
-        points.closed,
-        None if points.rows is None else points.rows[order],
+    return dataclasses.replace(
+        points,
+        p_PR=points.p_PR[order],
+        normals_P=None if points.normals_P is None else points.normals_P[order],
+        rows=None if points.rows is None else points.rows[order],
     )
 
 

@@ -28,6 +28,7 @@ from offline_prog.job.seams import (
     seam_inputs,
     seam_key,
 )
+from offline_prog.progress import Step
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs, attempt_motion
 
@@ -44,12 +45,13 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
         InputError: naming ``seams[k].<key>``.
         PlanFailedError: a seam cannot be done in any direction (its reason, named).
     """
-    options = []
-    for k, seam in enumerate(job_seams(inputs.cell)):
+    options, seams = [], job_seams(inputs.cell)
+    for k, seam in enumerate(seams):
         directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]
         found, errors = [], []
         for reverse in directions:
-            progress(f"seam {seam.name} ({'reverse' if reverse else 'forward'})")
+            text = f"seam {k + 1}/{len(seams)}: {seam.name} ({'reverse' if reverse else 'forward'})"
+            progress(Step(text, stage="seams", done=k, total=len(seams)))
             try:
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
@@ -73,6 +75,7 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
                 failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
             raise PlanFailedError(failure)
         options.append(found)
+    progress(Step(f"{len(seams)} seams planned", stage="seams", done=len(seams), total=len(seams)))
     return options
 
 
@@ -138,14 +141,23 @@ def _ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMo
     return moves[0], moves[1]
 
 
-def choose_order(inputs: Inputs, options: list[list[SeamOption]], q_home) -> JobOrder:
-    """Seam order and direction (``job.order``) for the least estimated air time."""
+def choose_order(
+    inputs: Inputs, options: list[list[SeamOption]], q_home, progress=lambda message: None
+) -> JobOrder:
+    """Seam order and direction (``job.order``) for the least estimated air time; the
+    search's rounds told to ``progress`` (its budget spent as the bar)."""
     flat = [option for seam in options for option in seam]
     robot = inputs.robot
+
+    def search_round(rounds: int, air_time_s: float, used: int, budget: int) -> None:
+        text = f"seam order: round {rounds}, estimated air time {air_time_s:.2f} s"
+        progress(Step(text, stage="order", done=used, total=budget))
+
     return order_job(
         [(o.seam, o.label, o.q_in, o.q_out) for o in flat], q_home,
         qd_max=robot.qd_max, qdd_max=robot.qdd_max, n_seams=len(options),
         mode=job_config(inputs.cell).order, controller_joints=robot.controller_joints,
+        progress=search_round,
     )  # fmt: skip
 
 
@@ -162,7 +174,8 @@ def job_pieces(
     for option in [*chosen, None]:
         target = option.q_in if option else q_home
         name = f"{previous} -> {option.name if option else 'home'}"
-        progress(f"link {name}")
+        text = f"link {len(links) + 1}/{len(chosen) + 1}: {name}"
+        progress(Step(text, stage="links", done=len(links), total=len(chosen) + 1))
         link = plan_link(
             scene, inputs.robot, q_now, target, clearance=motion.clearance,
             self_clearance=motion.self_clearance, seed=LINK_SEED + len(links),

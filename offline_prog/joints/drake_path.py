@@ -16,6 +16,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.tree import JacobianWrtVariable
 from scipy.interpolate import make_interp_spline
 
+from offline_prog.errors import Failure
 from offline_prog.joints.drake_ik import PoseIk
 from offline_prog.joints.path_ik import MAX_JOINT_STEP_RAD, BranchResult
 from offline_prog.scene.drake_cell import build_drake_cell
@@ -52,10 +53,18 @@ class DrakeIkPath:
         for i in range(len(p_IE)):
             q[i], ok, _, _ = self.ik.solve(p_IE[i], R_IE[i], seed)
             if not ok:
-                return BranchResult(-1, q, False, -np.inf, "out of reach (Drake IK)", i)
+                return BranchResult(
+                    -1, q, False, -np.inf, "out of reach (Drake IK)", i, Failure.OUT_OF_REACH
+                )
             if i and np.abs(q[i] - q[i - 1]).max() > MAX_JOINT_STEP_RAD:
                 return BranchResult(
-                    -1, q, False, -np.inf, "singularity (the configuration flips)", i
+                    -1,
+                    q,
+                    False,
+                    -np.inf,
+                    "singularity (the configuration flips)",
+                    i,
+                    Failure.SINGULARITY,
                 )
             seed = q[i]
         margin = float(
@@ -79,7 +88,13 @@ class DrakeIkPath:
                 starts.append(q0)
         if not starts:
             return BranchResult(
-                -1, np.full((len(grid), 6), np.nan), False, -np.inf, "out of reach (Drake IK)", 0
+                -1,
+                np.full((len(grid), 6), np.nan),
+                False,
+                -np.inf,
+                "out of reach (Drake IK)",
+                0,
+                Failure.OUT_OF_REACH,
             )
         results = [self._solve_along(p_IE, R_IE, q0) for q0 in starts[:MAX_START_BRANCHES]]
         best = max(results, key=lambda r: (r.feasible, r.margin_rad, r.sample))

@@ -54,10 +54,10 @@ NEAR_SINGULAR = {
 
 
 class JointPlanError(PlanFailedError):
-    """The robot cannot follow the path: σ [m], t [s] and why (a PlanFailure)."""
+    """The robot cannot follow the path: σ [m], t [s], why and the kind of failure."""
 
-    def __init__(self, sigma: float, t: float, reason: str):
-        super().__init__(PlanFailure(Failure.of(reason), float(sigma), float(t), reason))
+    def __init__(self, sigma: float, t: float, reason: str, kind: Failure):
+        super().__init__(PlanFailure(kind, float(sigma), float(t), reason))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,8 +141,9 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
     ``path.tool_turn.SmoothTurn``) the tool turns by φ₀ + θ − θ̄ along the path, and
     φ₀ keeps the whole turn within ±bound (if θ − θ̄ spans more than 2·bound, a
     share of it is taken up, about the middle φ₀). Ranked by the joint-limit margin
-    of each φ₀'s best branch (the smaller |φ₀| on ties); the collision check may
-    move on to the next.
+    of each φ₀'s best branch (the smaller |φ₀| on ties; a robot of family drake has no
+    analytic IK to rank with: smallest |φ₀| first); the collision check may move on to
+    the next.
 
     Returns:
         [(φ₀ [rad], the FlangePath built with it), ...], best first.
@@ -171,6 +172,9 @@ def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_r
         else:
             turn = smooth_turn.with_offset(float(phi), scale)
             flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=unit)
+        if robot.family == "drake":  # no analytic IK to rank with: smallest |φ₀| first
+            ranked.append(((True, 0.0), -abs(phi), float(phi), flange))
+            continue
         f = flange(s)
         result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)
@@ -224,7 +228,7 @@ def plan_joint_trajectory(
         path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
-        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason)
+        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason, chosen.kind)
     rates = path.rates(grid, chosen.q)
     # Speed and acceleration limits hold for the controller's joints (a linear map).
     controller = JointRates(
@@ -238,6 +242,7 @@ def plan_joint_trajectory(
             sigma,
             _time_at(retiming.law, sigma),
             f"joint {kinds} limit on axis {joint + 1} ({use:.2f}× the limit) even at reduced speed",
+            Failure.JOINT_RATE_LIMIT,
         )
     trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
     sigma, sd, sdd, _ = retiming.law(trajectory.t)
@@ -256,7 +261,10 @@ def plan_joint_trajectory(
             )
         )
         raise JointPlanError(
-            float(sigma[i]), float(trajectory.t[i]), f"joint limit on axis {joint + 1}"
+            float(sigma[i]),
+            float(trajectory.t[i]),
+            f"joint limit on axis {joint + 1}",
+            Failure.JOINT_LIMIT,
         )
     steps = np.abs(np.diff(q, axis=0))
     i, j = np.unravel_index(np.argmax(steps), steps.shape)

@@ -16,6 +16,7 @@ import dataclasses
 
 import numpy as np
 
+from offline_prog.errors import Failure
 from offline_prog.robot.model import RobotModel
 
 # Largest joint step between neighbouring samples that is still continuous motion
@@ -38,6 +39,7 @@ class BranchResult:
             (negative: the amount by which a limit is exceeded).
         reason: why it is infeasible ("" if feasible), with the sample index.
         sample: index of the first failing sample (−1 if feasible).
+        kind: the kind of failure (None if feasible).
     """
 
     branch: int
@@ -46,6 +48,7 @@ class BranchResult:
     margin_rad: float
     reason: str
     sample: int
+    kind: Failure | None = None
 
 
 def base_poses(X_IB, p_IE: np.ndarray, R_IE: np.ndarray) -> np.ndarray:
@@ -104,7 +107,15 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
         if not reachable[b].all():
             first = int(np.argmin(reachable[b]))
             results.append(
-                BranchResult(b, np.full_like(q[b], np.nan), False, -np.inf, "out of reach", first)
+                BranchResult(
+                    b,
+                    np.full_like(q[b], np.nan),
+                    False,
+                    -np.inf,
+                    "out of reach",
+                    first,
+                    Failure.OUT_OF_REACH,
+                )
             )
             continue
         jumps = np.flatnonzero(
@@ -119,6 +130,7 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
                     margin,
                     "singularity (the configuration flips)",
                     int(jumps[0]) + 1,
+                    Failure.SINGULARITY,
                 )
             )
             continue
@@ -136,6 +148,7 @@ def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
                     margin,
                     f"joint limit on axis {joint + 1}",
                     int(np.argmax(outside)),
+                    Failure.JOINT_LIMIT,
                 )
             )
             continue

@@ -34,6 +34,7 @@ HELD_TIE = 1e-3  # held shares closer than this tie
 # The averaged profile is skipped when it cannot cut the staircase's cycle time by more
 # than this share (nor hold the process speed longer, HELD_TIE).
 SKIP_SHARE = 1e-3
+TIME_INVERSION_POINTS = 20001  # σ ↦ t on the nominal law for a failure's time
 
 
 def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time_law: str,
@@ -54,8 +55,13 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
     if not plain.ok or np.any(plain.speed > np.interp(plain.sigma, rates.sigma, steady)):
         profile = topp_profile(rates, v_steady=steady, **topp)
     if not profile.ok:
-        reason = f"TOPP-RA found no parameterization ({profile.reason})"
-        raise PlanFailedError(PlanFailure(Failure.of(reason), 0.0, 0.0, reason))
+        sigma = profile.failed_at_m
+        reason = (
+            f"joint speed/acceleration limits: TOPP-RA found no parameterization ({profile.reason})"
+        )
+        t_grid = np.linspace(0.0, nominal.duration, TIME_INVERSION_POINTS)
+        t = float(np.interp(sigma, nominal(t_grid)[0], t_grid))  # on the nominal law
+        raise PlanFailedError(PlanFailure(Failure.JOINT_RATE_LIMIT, sigma, t, reason))
     path = dict(v_process=nominal.v_max, a_max=nominal.a_max, j_max=nominal.j_max)
 
     held = SpeedHold(rates, limits=limits, **path)

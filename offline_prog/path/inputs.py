@@ -15,6 +15,7 @@ from offline_prog.config.cell import Cell
 from offline_prog.errors import InputError
 from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
+from offline_prog.path.closing import OpenEndsError
 from offline_prog.path.process_frames import (
     NormalField,
     constant_normal,
@@ -28,15 +29,19 @@ from offline_prog.path.process_frames import (
 class NormalFit:
     """How far the fitted normal field is from the given normals [deg].
 
-    source: "points" (CSV nx,ny,nz: measured), "constant" (path.normal: exact, 0) or
-    "mesh" (part.mesh: not measured, None). worst_row: 1-based CSV data row of the
-    largest angle (row 1 is the first point after the header), or None.
+    source: "points" (CSV nx,ny,nz: measured), "constant" (path.normal: exact, 0),
+    "mesh" (part.mesh: not measured, None) or "cad" (the model's faces at the fit's
+    points: measured). worst_row: 1-based CSV data row of the largest angle (row 1 is
+    the first point after the header), or None. edge_max_error_mm, edge_rms_error_mm:
+    for a cad: seam, the fitted path's distance from the model's exact seam [mm].
     """
 
     source: str
     max_error_deg: float | None
     rms_error_deg: float | None
     worst_row: int | None = None
+    edge_max_error_mm: float | None = None
+    edge_rms_error_mm: float | None = None
 
 
 def _error(file, key, reason) -> InputError:
@@ -85,14 +90,19 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     path = cell.path
     if path.analytic is not None:
         return _analytic_points(file, cell)
+    if path.cad is not None:  # Open CASCADE (seconds to import) only for these
+        from offline_prog.path.cad_source import cad_points
+
+        return cad_points(file, cell)
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
+    close_tolerance_m = path.fit_tolerance_mm * 1e-3
     try:
         if path.points:
             return path_sources.read_csv_points(
                 file.parent / source,
                 units=path.units,
                 closed=path.closed,
-                close_tolerance_m=path.fit_tolerance_mm * 1e-3,
+                close_tolerance_m=close_tolerance_m,
                 seam=path.csv_seam,
             )
         return path_sources.read_dxf_points(
@@ -101,14 +111,16 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
             closed=path.closed,
             units=path.units,
             entity=path.dxf_entity,
+            close_tolerance_m=close_tolerance_m,
         )
-    except path_sources.OpenEndsError as error:
+    except OpenEndsError as error:
         raise _error(
             file,
             "path.closed",
-            f"true, but the ends of {source} are {error.gap_m * 1e3:.3f} mm apart (more than "
-            f"path.fit_tolerance_mm {path.fit_tolerance_mm:g}): end the points where they "
-            "start, or set closed: false",
+            f"true, but the ends of {source} are {error.gap_m * 1e3:.3f} mm apart, more "
+            f"than twice the point spacing there (first step {error.first_step_m * 1e3:.3f} "
+            f"mm, last step {error.last_step_m * 1e3:.3f} mm): a stretch of the contour is "
+            "missing; add its points, or set closed: false",
         ) from None
     except ValueError as error:
         raise _error(file, key, f"{source}: {error}") from None
@@ -134,6 +146,10 @@ def normal_field(file: Path, cell: Cell, points, path: ArcLengthPath) -> NormalF
         )
     if cell.path.normal is not None:
         return constant_normal(np.asarray(cell.path.normal, float))
+    if points.exact is not None:  # a cad: seam: exact normals, fitted to tolerance
+        from offline_prog.path.cad_normal import model_normal
+
+        return model_normal(path, points.normals_P, np.deg2rad(cell.path.normal_tolerance_deg))
     if points.normals_P is not None:
         return spline_normal(path, points.normals_P)
     import trimesh
@@ -154,6 +170,8 @@ def check_normal_fit(file: Path, cell: Cell, points, path: ArcLengthPath, field)
     if points.normals_P is None:
         return NormalFit("mesh", None, None)
     angles = np.rad2deg(normal_fit_angles(path, points.normals_P, field))
+    if points.exact is not None:
+        return _check_cad_fit(file, cell, points, path, angles)
     worst = int(np.argmax(angles))
     row = int(points.rows[worst] if points.rows is not None else worst) + 1
     fit = NormalFit("points", float(angles[worst]), float(np.sqrt(np.mean(angles**2))), row)
@@ -165,5 +183,32 @@ def check_normal_fit(file: Path, cell: Cell, points, path: ArcLengthPath, field)
             f"the fitted surface normal is {fit.max_error_deg:.2f}° off the normal given at "
             f"row {row} of {cell.path.points} (file line {row + 1}), more than {tolerance:g}° "
             f"(RMS {fit.rms_error_deg:.2f}°): check the normals near that row",
+        )
+    return fit
+
+
+def _check_cad_fit(file: Path, cell: Cell, points, path: ArcLengthPath, angles) -> NormalFit:
+    """A cad: seam's fit: normals against the model's, the path against the exact seam."""
+    from offline_prog.path.exact_seam import path_to_reference
+
+    worst = int(np.argmax(angles))
+    edge_max, edge_rms = path_to_reference(points.exact, path)
+    fit = NormalFit(
+        "cad",
+        float(angles[worst]),
+        float(np.sqrt(np.mean(angles**2))),
+        None,
+        edge_max * 1e3,
+        edge_rms * 1e3,
+    )
+    tolerance = cell.path.normal_tolerance_deg
+    if fit.max_error_deg > tolerance:
+        at = np.round(points.p_PR[worst] * 1e3, 2).tolist()
+        raise _error(
+            file,
+            "path.normal_tolerance_deg",
+            f"the fitted surface normal is {fit.max_error_deg:.2f}° off the model's at "
+            f"{at} mm, more than {tolerance:g}°: the normal turns faster than the fit "
+            "follows (lower path.fit_tolerance_mm, or pick another normal face)",
         )
     return fit

@@ -15,30 +15,23 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.constants import UNIT_SCALE
+from offline_prog.path.closing import DUPLICATE_POINT_M, repeats_first
 
 # Analytic and DXF curves are sampled at this spacing before fitting [m].
 CURVE_SAMPLE_SPACING_M = 1e-3
-# Consecutive points closer than this are one point [m].
-DUPLICATE_POINT_M = 1e-9
-
-
-class OpenEndsError(ValueError):
-    """A closed path whose points do not come back to the first: gap_m [m] apart."""
-
-    def __init__(self, gap_m: float, tolerance_m: float):
-        self.gap_m, self.tolerance_m = gap_m, tolerance_m
-        super().__init__(f"the ends are {gap_m * 1e3:.3f} mm apart")
 
 
 @dataclasses.dataclass(frozen=True)
 class PathPoints:
     """Points on the part: p_PR (N, 3) in P [m]; normals_P (N, 3) unit or None;
-    rows (N,) each point's 0-based data row in its source (repeats dropped)."""
+    rows (N,) each point's 0-based data row in its source (repeats dropped); exact: the
+    seam on the part's model (path.exact_seam.ExactSeam) for a cad: seam, else None."""
 
     p_PR: np.ndarray
     normals_P: np.ndarray | None
     closed: bool
     rows: np.ndarray | None = None
+    exact: object | None = None
 
 
 def clean_points(p, normals, *, closed: bool) -> PathPoints:
@@ -63,8 +56,10 @@ def read_csv_points(
 
     With a ``seam`` column the file holds several seams: ``seam`` picks the rows of one
     (in file order); without ``seam`` all rows must name the same one.
-    A closed path's last row repeats its first (within close_tolerance_m [m]); that
-    row is dropped. Otherwise OpenEndsError: closing it would add a stroke no one drew.
+    A closed path's last row may repeat its first (within close_tolerance_m [m]):
+    that row is dropped. Or the rows stop one step short: a gap up to twice the larger
+    of the first and last steps is kept for the periodic fit to close
+    (``path.closing``); a larger one is a missing stretch, OpenEndsError.
     """
     with open(file, newline="") as stream:
         reader = csv.reader(row for row in stream if row.strip() and not row.startswith("#"))
@@ -107,10 +102,7 @@ def read_csv_points(
             line = numbers[int(np.argmin(lengths))] + 2
             raise ValueError(f"line {line}: normal (nx,ny,nz) is zero")
         normals = data[:, 3:] / lengths[:, None]
-    if closed and len(p) > 1:
-        gap = float(np.linalg.norm(p[-1] - p[0]))
-        if gap > close_tolerance_m:
-            raise OpenEndsError(gap, close_tolerance_m)
+    if closed and repeats_first(p, close_tolerance_m):
         p, normals = p[:-1], None if normals is None else normals[:-1]
         numbers = numbers[:-1]
     points = clean_points(p, normals, closed=closed)
@@ -158,11 +150,22 @@ def rounded_rectangle_points(center, size, corner_radius) -> np.ndarray:
 
 
 def read_dxf_points(
-    file: Path, *, layer: str | None, closed: bool, units: str, entity: int | None = None
+    file: Path,
+    *,
+    layer: str | None,
+    closed: bool,
+    units: str,
+    entity: int | None = None,
+    close_tolerance_m: float = DUPLICATE_POINT_M,
 ) -> PathPoints:
     """Sample one path entity (LINE, ARC, CIRCLE, (LW)POLYLINE, SPLINE, ELLIPSE) of a
     DXF file's modelspace, scaled to metres: the only one (optionally on one layer), or
-    the ``entity``-th (0-based, in drawing order) of several."""
+    the ``entity``-th (0-based, in drawing order) of several.
+
+    ``closed`` with an entity not flagged closed: its ends must meet (within
+    close_tolerance_m [m]) or be one vertex step apart (``path.closing``), and the
+    straight closing side is added, as the closed flag would draw it; else
+    OpenEndsError. A flagged entity with ``closed`` false is refused."""
     import ezdxf
 
     try:
@@ -191,11 +194,10 @@ def read_dxf_points(
         or bool(getattr(entity, "closed", False))
         or (getattr(entity, "is_closed", False) is True)
     )
-    if is_closed != closed:
-        raise ValueError(
-            f"the DXF {entity.dxftype()} is {'closed' if is_closed else 'open'} "
-            f"but path.closed is {str(closed).lower()}"
-        )
+    if is_closed and not closed:
+        raise ValueError(f"the DXF {entity.dxftype()} is closed but path.closed is false")
+    if closed and not is_closed and repeats_first(vertices * scale, close_tolerance_m):
+        vertices = vertices[:-1]
     if closed:
         vertices = np.vstack([vertices, vertices[:1]])
     points = resample_polyline(vertices * scale, CURVE_SAMPLE_SPACING_M)

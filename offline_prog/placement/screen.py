@@ -13,7 +13,6 @@ import time
 
 import numpy as np
 
-from offline_prog.errors import Failure
 from offline_prog.joints.path_ik import (
     base_poses,
     branch_results,
@@ -51,7 +50,7 @@ def _screen_seam(seam: SeamView, candidate: Candidate) -> Evaluation:
 
     best = min(results, key=lambda r: (violation(r), -r.margin_rad))
     if not best.feasible:
-        kind = Failure.of(best.reason).value
+        kind = best.kind.value
         return Evaluation(candidate, "screen", CANNOT_FOLLOW, violation(best), best.reason, kind)
     d = singularity_distances(robot, best.q, X_BE)
     singular = float(np.rad2deg(np.arcsin(min(1.0, d["wrist"].min(), d["elbow"].min()))))

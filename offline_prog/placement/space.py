@@ -19,9 +19,9 @@ import numpy as np
 
 from offline_prog.config.cell import Cell, PlaceConfig
 from offline_prog.config.edits import rpy_deg_of
+from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
 from offline_prog.errors import InputError
 
-MAX_BUDGET = 100_000  # full evaluations: 10⁵ × ~0.5 s is a day on one core
 MAX_SCREEN_POINTS = 100_000  # per grasp
 MAX_OFFSET_MM = 10_000.0  # a tool stand 10 m from the robot is a typo
 MAX_ANGLE_DEG = 360.0
@@ -158,7 +158,8 @@ def _pose(value) -> Pose:
 
 
 def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int | None = None):
-    """The checked ``place:`` block, with the command line's budget and seed applied,
+    """The checked ``place:`` block, with the command line's budget and seed applied
+    (the flags are checked by the command line's parser against the same bounds),
     and its search space.
 
     Returns:
@@ -176,14 +177,14 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
     if seed is not None:
         place = dataclasses.replace(place, seed=seed)
     for key, value, high in (
-        ("place.budget", place.budget, MAX_BUDGET),
+        ("place.budget", place.budget, MAX_PLACE_BUDGET),
         ("place.screen_points", place.screen_points, MAX_SCREEN_POINTS),
         ("place.top_k", place.top_k, 1000),
     ):
         if not 1 <= value <= high:
             raise InputError(file, key, f"{value} is outside 1..{high:,}")
-    if place.seed < 0:
-        raise InputError(file, "place.seed", f"{place.seed} is negative")
+    if not 0 <= place.seed <= MAX_PLACE_SEED:
+        raise InputError(file, "place.seed", f"{place.seed} is outside 0..{MAX_PLACE_SEED:,}")
     obstacles = {shape.name for shape in cell.obstacles}
     for i, name in enumerate(place.moves_with_tool):
         if name not in obstacles:

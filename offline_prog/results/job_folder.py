@@ -21,7 +21,7 @@ from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
 from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats
-from offline_prog.export.job_program import JobProgramData, JobSegment, ProcessIo
+from offline_prog.export.job_program import JobProgramData, JobSegment
 from offline_prog.export.program import PLAN_FILE, ProgramData
 from offline_prog.job.records import JobPlan
 from offline_prog.job.seams import job_config, job_seams
@@ -102,6 +102,27 @@ def _segment_times(job: JobPlan) -> dict[str, float]:
     return total
 
 
+def order_search_report(order) -> dict:
+    """report.json ``job.order_search``: how the order (job.order.JobOrder) was found:
+    method, budget and what was used of it, rounds, why it stopped, its time, and the
+    estimated air time it reached against where it started and the lower bound [s]."""
+    search = order.search
+    return {
+        "method": search.method,
+        "budget_link_estimates": search.budget,
+        "used_link_estimates": search.used,
+        "orders_evaluated": search.orders_evaluated,
+        "rounds": search.rounds,
+        "descents": search.descents,
+        "stopped": search.stopped,
+        "min_improvement_s": search.min_improvement_s,
+        "time_s": search.time_s,
+        "air_time_s": order.air_time_s,
+        "start_air_time_s": search.start_air_time_s,
+        "lower_bound_s": search.lower_bound_s,
+    }
+
+
 def job_report(job: JobPlan) -> dict:
     """report.json of a job (SI units unless the key says otherwise)."""
     times, order = _segment_times(job), job.order
@@ -152,6 +173,7 @@ def job_report(job: JobPlan) -> dict:
             "estimated_air_time_s": order.air_time_s,
             "estimated_air_time_given_order_s": order.given_air_time_s,
             "estimated_saving_s": order.saved_s,
+            "order_search": order_search_report(order),
             "cycle_time_s": cycle,
             "process_time_s": times["process"],
             "air_time_s": cycle - times["process"],
@@ -172,7 +194,7 @@ def job_report(job: JobPlan) -> dict:
                 "path_m": e.path_m,
                 "t_s": e.t_s,
             }
-            for e in io_.events
+            for e in io_.switches
         ],
         "seams": [{"seam": o.name, **report(o.plan)} for o in job.chosen],
         **collision_summary(job),
@@ -222,7 +244,8 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
             for fmt in job_formats(data.language):
                 for file in export(data, fmt, folder / PROGRAMS_DIR):
                     files[f"{fmt}:{file.name}"] = file
-        files["report_html"] = write_job_report_html(folder)  # after the programs
+        # After the programs; it names the folder the user gets, not the staged one.
+        files["report_html"] = write_job_report_html(folder, folder_name=out_dir.name)
         preview.wait()
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
@@ -253,26 +276,8 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         X_BT=X_BT,
         X_EP=X_EP,
         tcp_speed=job.tcp_speed,
+        whole_job=True,
     )
-    io = cell.tool.process_io
-    process_io = None
-    if io is not None:
-        process_io = ProcessIo(
-            digital_output=None if io.on is None else io.on.digital_output,
-            on_lead_m=0.0 if io.on is None else io.on.lead_mm * 1e-3,
-            off_lead_m=0.0 if io.off is None else io.off.lead_mm * 1e-3,
-            **(
-                {}
-                if io.flow is None
-                else {
-                    "analog_output": io.flow.analog_output,
-                    "per_mps": io.flow.per_mps,
-                    "offset": io.flow.offset,
-                    "min": io.flow.min,
-                    "max": io.flow.max,
-                }
-            ),
-        )
     return JobProgramData(
         job=rows,
         segments=tuple(JobSegment(g.kind, g.seam, g.start, g.stop) for g in s.segments),
@@ -280,7 +285,8 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
         seam_names=tuple(o.name for o in job.chosen),
         seam_lengths_m=tuple(o.plan.path.length for o in job.chosen),
         link_waypoints=tuple(np.asarray(link.waypoints, dtype=float) for link in job.links),
-        process_io=process_io,
+        process_io=job.io.settings,
         digital=job.io.digital,
         analog=job.io.analog,
+        events=tuple(job.io.events),
     )

@@ -109,6 +109,8 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "q_upper": robot.q_upper,
         "qd_max": robot.qd_max,
         "j23_coupled": robot.j23_coupled,
+        "j23_factor": robot.j23_factor,
+        "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
         "payload": payload_record(cell),
     }
@@ -190,14 +192,15 @@ def write_outputs(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     with staged_folder(out_dir) as folder:
-        files, summary = _write_all(plan, folder)
+        files, summary = _write_all(plan, folder, folder_name=out_dir.name)
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
     return {key: out_dir / path.relative_to(folder) for key, path in files.items()}, summary
 
 
-def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
-    """Every output of the plan, into the (fresh) folder out_dir."""
+def _write_all(plan: Plan, out_dir: Path, *, folder_name: str) -> tuple[dict[str, Path], dict]:
+    """Every output of the plan, into the (fresh, staged) folder out_dir, which the
+    user will see as ``folder_name``."""
     files = {
         "trajectory": out_dir / "trajectory.csv",
         "report": out_dir / "report.json",
@@ -207,14 +210,14 @@ def _write_all(plan: Plan, out_dir: Path) -> tuple[dict[str, Path], dict]:
     files["preview"] = out_dir / "preview.html"
     preview = InParallel(lambda: write_preview_html(plan, files["preview"]))
     try:
-        summary = _write_rest(plan, out_dir, files)
+        summary = _write_rest(plan, out_dir, files, folder_name=folder_name)
         preview.wait()
     finally:
         preview.cancel()  # an error or Ctrl-C here: stop it before the folder goes
     return files, summary
 
 
-def _write_rest(plan: Plan, out_dir: Path, files: dict[str, Path]) -> dict:
+def _write_rest(plan: Plan, out_dir: Path, files: dict[str, Path], *, folder_name: str) -> dict:
     """Everything but preview.html, into ``files``; returns the report."""
     summary = report(plan)
     write_atomic(files["trajectory"], trajectory_csv(plan))
@@ -229,7 +232,8 @@ def _write_rest(plan: Plan, out_dir: Path, files: dict[str, Path]) -> dict:
         for fmt in default_formats(data.language):
             for file in export(data, fmt, out_dir / PROGRAMS_DIR):
                 files[f"{fmt}:{file.name}"] = file
-    files["report_html"] = write_report_html(out_dir)  # after the programs: it lists them
+    # After the programs: it lists them.
+    files["report_html"] = write_report_html(out_dir, folder_name=folder_name)
     return summary
 
 

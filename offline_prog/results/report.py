@@ -197,6 +197,23 @@ def payload_summary(cell) -> dict:
     return {"set": complete, "warning": warning, **record}
 
 
+def cad_summary(points) -> dict | None:
+    """A cad: seam's model facts: what was picked, the exact length [m], the reference's
+    tolerance [mm] and the corners between its edges (cusps of the path); else None."""
+    exact = getattr(points, "exact", None)
+    if exact is None:
+        return None
+    return {
+        "model": exact.model,
+        "length_m": exact.length_m,
+        "reference_tolerance_mm": exact.tolerance_m * 1e3,
+        "corners": [
+            {"p_P_mm": [round(float(v) * 1e3, 3) for v in p], "turn_deg": round(turn, 3)}
+            for p, turn in exact.corners
+        ],
+    }
+
+
 def normal_fit_summary(plan: Plan) -> dict:
     """report.json's normal-fit keys: the angle from the given normals to the fitted
     field [deg] (0 for a constant path.normal, None for normals from part.mesh)."""
@@ -207,6 +224,9 @@ def normal_fit_summary(plan: Plan) -> dict:
         "normal_max_error_deg": None if fit is None else fit.max_error_deg,
         "normal_rms_error_deg": None if fit is None else fit.rms_error_deg,
         "normal_worst_row": None if fit is None else fit.worst_row,
+        # cad: seams: the fitted path's distance from the model's exact seam [mm]
+        "edge_max_error_mm": None if fit is None else fit.edge_max_error_mm,
+        "edge_rms_error_mm": None if fit is None else fit.edge_rms_error_mm,
     }
 
 
@@ -214,7 +234,8 @@ def report(plan: Plan) -> dict:
     """The machine-readable plan summary (SI units unless the key says otherwise)."""
     cell, tr, fitted = plan.cell, plan.trajectory, plan.fitted
     law = tr.law
-    source = next(k for k in ("points", "dxf", "analytic") if getattr(cell.path, k) is not None)
+    sources = ("points", "dxf", "analytic", "cad")
+    source = next(k for k in sources if getattr(cell.path, k) is not None)
     smoothing = None
     if hasattr(plan.flange, "max_deviation_m"):
         smoothing = {
@@ -236,6 +257,7 @@ def report(plan: Plan) -> dict:
             "closed": bool(cell.path.closed),
             "polygon_length_m": fitted.period,
             "length_m": plan.path.length,
+            "cad": cad_summary(plan.points),
         },
         "fit": {
             "degree": fitted.degree,

@@ -25,8 +25,7 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
         f"{traj['n_samples']} samples, speed error "
         f"{traj['chord_speed_max_error_rel'] * 100:.4f} %"
     )
-    if not report["payload"]["set"]:
-        console.print(f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]")
+    print_payload_warning(console, report)
     robot = report["robot_motion"]
     reductions = robot["speed_reductions"]
     console.print(
@@ -66,6 +65,15 @@ def print_summary(console: Console, report: dict, files: dict, seconds: float) -
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")
 
 
+def print_payload_warning(console: Console, report: dict) -> None:
+    """The payload line when the programs do not set it (a seam's or a job's report)."""
+    if not report["payload"]["set"]:
+        console.print(
+            f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]",
+            highlight=False,
+        )
+
+
 def print_job_summary(console: Console, report: dict, files: dict, seconds: float) -> None:
     """A few lines for a job: order, cycle time split, each seam, links, clearance."""
     job = report["job"]
@@ -81,11 +89,21 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         f"  order     {order} ({job['order_mode']}, {job['order_method']}; estimated "
         f"saving {job['estimated_saving_s']:.2f} s against the given order)"
     )
+    search = job["order_search"]
+    if search["method"] == "heuristic":
+        console.print(
+            f"  search    {search['rounds']} rounds, {search['used_link_estimates'] / 1e6:.1f} "
+            f"of {search['budget_link_estimates'] / 1e6:.1f} M link estimates in "
+            f"{search['time_s']:.2f} s, stopped: {search['stopped']}; estimated air "
+            f"{search['air_time_s']:.2f} s from {search['start_air_time_s']:.2f} s (no order "
+            f"below {search['lower_bound_s']:.2f} s)"
+        )
     console.print(
         f"  cycle     {job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
         f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, approach and "
         f"retract {job['approach_retract_time_s']:.2f} s)"
     )
+    print_payload_warning(console, report)
     for seam in report["seams"]:
         console.print(
             f"  seam      {seam['seam']}: {seam['path']['length_m'] * 1e3:.1f} mm, "
@@ -100,6 +118,8 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         + ("no checked pairs" if distance is None else f"min distance {distance * 1e3:.1f} mm, ")
         + ("collision-free" if report["collision_free"] else "FAILS")
     )
+    stages = ", ".join(f"{k} {v:.1f} s" for k, v in report["timings_s"].items() if v >= 0.05)
+    console.print(f"  time      {stages}", highlight=False)
     for name, path in files.items():
         console.print(f"  {name:<9} {path}")
     console.print(f"done in {seconds:.2f} s; outputs in [bold]{files['report'].parent}[/bold]")

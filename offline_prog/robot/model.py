@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.robot import kinematics_opw, kinematics_ur
 from offline_prog.robot.kinematics_opw import OpwParameters
 from offline_prog.robot.kinematics_ur import UrParameters
@@ -30,7 +31,7 @@ ROBOTS_DIR = Path(__file__).resolve().parents[1] / "robots"
 PARAMS_FILE = "robot.yaml"
 _TOP_KEYS = {"vendor", "family", "urdf", "joint_names", "kinematics", "limits", "controller"}
 # Controller program languages a robot record may name (offline_prog.export writes each).
-LANGUAGES = ("krl", "rapid", "urscript")
+LANGUAGES = ("krl", "rapid", "urscript", "fanuc")
 _KINEMATIC_KEYS = {
     "opw": ("a1", "a2", "b", "c1", "c2", "c3", "c4", "offsets_deg", "sign_corrections"),
     "ur": ("d1", "a2", "a3", "d4", "d5", "d6"),
@@ -59,7 +60,10 @@ class RobotModel:
         qddd_max: (6,) joint jerk limits [rad/s^3] (``limits.jerk_deg_s3``, else
             qdd_max / JERK_RAMP_S).
         urdf_path: Absolute path of the URDF.
-        j23_coupled: the controller counts axis 3 as q2 + q3 (see controller_joints).
+        j23_coupled: the controller counts axis 3 from the horizontal, q3 + j23_factor·q2
+            (see controller_joints).
+        j23_factor: +1 (ABB: axis 3 = q2 + q3) or -1 (FANUC's ROS-I URDFs, whose axis 3
+            turns the other way about the same line: J3 = q3 − q2).
         vendor: the maker, e.g. ``"kuka"`` (robot.yaml ``vendor``).
         language: the controller's program format (``krl``, ``rapid``, ``urscript``) or
             None (robot.yaml ``controller.language``).
@@ -78,6 +82,7 @@ class RobotModel:
     urdf_path: Path
     qddd_max: np.ndarray | None = None  # (6,) [rad/s³]; None: qdd_max / JERK_RAMP_S
     j23_coupled: bool = False
+    j23_factor: float = 1.0
     vendor: str = ""
     language: str | None = None
     home_c: np.ndarray | None = None  # (6,) the controller's home axes [rad], or None
@@ -91,13 +96,14 @@ class RobotModel:
         """(..., 6) the joint values the controller counts (and limits) from URDF q.
 
         Equal to q, except on robots whose controller couples axis 3 to axis 2
-        (``controller: {j23_coupled: true}``, e.g. the ABB IRB 2400: axis 3 = q2 + q3).
-        Linear, so it maps joint speeds and accelerations the same way.
+        (``controller: {j23_coupled: true}``, e.g. the ABB IRB 2400: axis 3 = q2 + q3;
+        FANUC: ``j23_factor: -1``, J3 = q3 − q2). Linear, so it maps joint speeds and
+        accelerations the same way.
         """
         if not self.j23_coupled:
             return q
         out = np.array(q, dtype=float, copy=True)
-        out[..., 2] = q[..., 1] + q[..., 2]
+        out[..., 2] = q[..., 2] + self.j23_factor * q[..., 1]
         return out
 
     def urdf_joints(self, q_c: np.ndarray) -> np.ndarray:
@@ -105,7 +111,7 @@ class RobotModel:
         if not self.j23_coupled:
             return q_c
         out = np.array(q_c, dtype=float, copy=True)
-        out[..., 2] = q_c[..., 2] - q_c[..., 1]
+        out[..., 2] = q_c[..., 2] - self.j23_factor * q_c[..., 1]
         return out
 
     def forward(self, q: np.ndarray) -> np.ndarray:
@@ -123,9 +129,10 @@ class RobotModel:
 
 
 def list_robots(robots_dir: Path | None = None) -> list[str]:
-    """Names of the robot folders (those holding a robot.yaml), sorted."""
-    robots_dir = ROBOTS_DIR if robots_dir is None else Path(robots_dir)
-    return sorted(p.parent.name for p in robots_dir.glob(f"*/{PARAMS_FILE}"))
+    """Names of the robot folders (those holding a robot.yaml), sorted; without
+    robots_dir, those on the search path (config.robot_search)."""
+    folders = search_path(ROBOTS_DIR) if robots_dir is None else [Path(robots_dir)]
+    return sorted({name for name, _, _ in robots_in(folders)})
 
 
 def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
@@ -133,8 +140,8 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
 
     Args:
         name: Robot folder name, e.g. ``"ur10e"``.
-        robots_dir: Folder holding the robot folders; default the repository's
-            ``robots/``.
+        robots_dir: Folder holding the robot folders; default the search path
+            (``OFFLINE_PROG_ROBOTS``, then the bundled ``robots/``: config.robot_search).
 
     Returns:
         The robot's model in SI units.
@@ -143,8 +150,8 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         ValueError: One line naming the file, the key and what was expected, when
             the folder, the record or the URDF is missing or a value is invalid.
     """
-    robots_dir = ROBOTS_DIR if robots_dir is None else Path(robots_dir)
-    folder = robots_dir / name
+    folders = search_path(ROBOTS_DIR) if robots_dir is None else [Path(robots_dir)]
+    folder = find_robot(name, folders) or folders[-1] / str(name)
     if not name or Path(name).name != name or name in (".", "..") or not folder.is_dir():
         known = ", ".join(list_robots(robots_dir)) or "none"
         raise ValueError(f"{folder}: no robot folder named {name!r} (known robots: {known})")
@@ -202,6 +209,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         urdf_path=(folder / urdf_name).resolve(),
         qddd_max=_frozen(jerk),
         j23_coupled=_j23_coupled(check, record.get("controller")),
+        j23_factor=_j23_factor(check, record.get("controller")),
         vendor=str(record.get("vendor", "")),
         language=_language(check, record.get("controller")),
         home_c=_home(check, record.get("controller"), position),
@@ -213,12 +221,24 @@ def _j23_coupled(check: _Checker, controller: Any) -> bool:
     if controller is None:
         return False
     check.keys(
-        controller, "controller", required=set(), allowed={"j23_coupled", "language", "home_deg"}
+        controller,
+        "controller",
+        required=set(),
+        allowed={"j23_coupled", "j23_factor", "language", "home_deg"},
     )
     value = controller.get("j23_coupled", False)
     if not isinstance(value, bool):
         check.fail("controller.j23_coupled", value, "true or false")
     return value
+
+
+def _j23_factor(check: _Checker, controller: Any) -> float:
+    """``controller: {j23_factor: 1 | -1}``: the sign of q2 in the controller's axis 3
+    (default 1, ABB)."""
+    value = 1 if controller is None else controller.get("j23_factor", 1)
+    if isinstance(value, bool) or value not in (1, -1):
+        check.fail("controller.j23_factor", value, "1 or -1")
+    return float(value)
 
 
 def _home(check: _Checker, controller: Any, position: np.ndarray) -> np.ndarray | None:

@@ -13,8 +13,8 @@ each pair keeps the distances that decided its class:
   pose, so the margin is far above any clearance);
 - ``check``: everything else; the planner checks only these for self-collision.
 
-The result is written as ``robots/<robot>/self_collision.yaml`` (deterministic for a
-seed) and read by :func:`read_matrix`.
+The result is YAML (deterministic for a seed); the planner reads the robot folder's
+``robots/<robot>/self_collision.yaml`` with :func:`read_matrix`.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 from pydrake.planning import RobotDiagramBuilder
 
-from offline_prog.robot.model import ROBOTS_DIR, RobotModel
+from offline_prog.robot.model import RobotModel
 
 MATRIX_FILE = "self_collision.yaml"
 CLASSES = ("adjacent", "always", "constant", "never", "check")
@@ -182,11 +182,15 @@ def read_matrix(robot_folder: Path) -> list[LinkPair] | None:
     return pairs
 
 
-def write_matrix(robot: RobotModel, *, samples: int, seed: int, robots_dir: Path = ROBOTS_DIR):
-    """Compute and write ``robots_dir/<robot>/self_collision.yaml``; returns (file, pairs)."""
+def write_matrix(robot: RobotModel, file: Path, *, samples: int, seed: int):
+    """Compute the matrix and write it to ``file`` (atomically); returns the pairs.
+
+    The planner reads the robot folder's own ``self_collision.yaml``
+    (:func:`read_matrix`); the command line writes where the user says and tells how
+    to put it there, never over the file shipped with the package unasked.
+    """
     from offline_prog.atomic import write_atomic
 
     pairs = compute_matrix(robot, samples=samples, seed=seed)
-    file = Path(robots_dir) / robot.name / MATRIX_FILE
-    write_atomic(file, matrix_yaml(robot, pairs, samples=samples, seed=seed))
-    return file, pairs
+    write_atomic(Path(file), matrix_yaml(robot, pairs, samples=samples, seed=seed))
+    return pairs

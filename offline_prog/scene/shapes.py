@@ -177,6 +177,14 @@ def cell_geometry(cell: Cell, cell_file: Path) -> CellGeometry:
     if cell.part.mesh:
         scale = _mesh_scale("part.mesh_units", cell.part.mesh_units, cell.part.name)
         part.append(mesh_shape(cell.part.name, base / cell.part.mesh, scale, key="part.mesh"))
+    if cell.part.model:  # STEP (tessellated) or a mesh: the model the seams come from
+        from offline_prog.scene.part_model import model_mesh
+
+        try:
+            mesh_file, scale = model_mesh(cell, base)
+        except ValueError as error:
+            raise ShapeError("part.model", str(error)) from None
+        part.append(mesh_shape(cell.part.name, mesh_file, scale, key="part.model"))
     part += [
         load_shape(c, base, key=f"part.geometry[{i}]") for i, c in enumerate(cell.part.geometry)
     ]

@@ -11,5 +11,8 @@ the changed cell or exports the plan folder exactly as ``offline-prog plan`` wou
 - ``cell_text``: Save: the changed values written into the original file's text;
 - ``scene_view``: the MeshCat scene (cell, coloured path, closest pair, pose at σ);
 - ``panel``: the HTTP panel page and its JSON endpoints;
+- ``guard``: who may drive the panel (Host, Origin, the session's token);
+- ``request``: request bodies and values checked before they reach the session;
+- ``launch``: the ports, the printed URL with its token, the main loop;
 - ``server``: the session loop tying them together.
 """

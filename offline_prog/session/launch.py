@@ -1,9 +1,10 @@
-"""Start a session: MeshCat and the panel on two ports, the URL and the SSH hint, the
-main loop until Ctrl-C (or ``seconds``).
+"""Start a session: MeshCat and the panel on two ports, the URL with its token and the
+SSH hint, the main loop until Ctrl-C (or ``seconds``).
 
 The panel is served on ``port`` and MeshCat on ``port + 1``, both on ``host``
 (localhost by default: nothing is reachable from other machines unless asked; from
-another machine, tunnel both ports over SSH).
+another machine, tunnel both ports over SSH). The panel answers only requests that
+carry the session's token, from its own page and address (see ``guard``).
 """
 
 from __future__ import annotations
@@ -16,22 +17,12 @@ import webbrowser
 from collections.abc import Callable
 from pathlib import Path
 
-from offline_prog.errors import InputError
+from offline_prog.session.guard import Guard, new_token
 from offline_prog.session.panel import serve_panel
 from offline_prog.session.server import FRAME_S, Session
+from offline_prog.viz.local_server import check_free, open_meshcat, url
 
-ANY_HOST = ("0.0.0.0", "*", "")
-
-
-def _check_free(host: str, port: int) -> None:
-    """InputError naming ``--port`` when the port cannot be bound on the host."""
-    family = socket.AF_INET6 if ":" in host else socket.AF_INET
-    with socket.socket(family, socket.SOCK_STREAM) as probe:
-        try:
-            probe.bind(("0.0.0.0" if host in ANY_HOST else host, port))
-        except OSError as error:
-            reason = f"cannot listen: {error.strerror} (the session uses this port and the next)"
-            raise InputError(f"{host}:{port}", "--port", reason) from None
+USES = "the session uses this port and the next"
 
 
 def _has_display() -> bool:
@@ -56,27 +47,22 @@ def run_session(
     Raises:
         InputError: a bad cell file, or a port that is taken.
     """
-    from pydrake.geometry import Meshcat, MeshcatParams
-
     meshcat_port = port + 1
-    for p in (port, meshcat_port):
-        _check_free(host, p)
-    params = MeshcatParams()
-    params.host, params.port = ("*" if host in ANY_HOST else host), meshcat_port
-    params.show_stats_plot = False  # a realtime-rate plot means nothing here
-    meshcat = Meshcat(params)
+    check_free(host, port, uses=USES)
+    meshcat = open_meshcat(host, meshcat_port, uses=USES)
     session = Session(Path(cell_file), meshcat)
-    server = serve_panel(session, "" if host in ANY_HOST else host, port, meshcat_port)
-    shown = socket.gethostname() if host in ANY_HOST else host
-    url = f"http://{shown}:{port}/"
-    say(f"session of {cell_file} at {url} (MeshCat on port {meshcat_port}; Ctrl-C to stop)")
+    token = new_token()
+    guard = Guard.serving(host, port, token)
+    server = serve_panel(session, host, port, meshcat_port, guard=guard)
+    address = url(host, port, f"/?token={token}")
+    say(f"session of {cell_file} at {address} (MeshCat on port {meshcat_port}; Ctrl-C to stop)")
     say(
         f"from another machine: ssh -N -L {port}:localhost:{port} -L {meshcat_port}:"
         f"localhost:{meshcat_port} USER@{socket.gethostname()}, then open "
-        f"http://localhost:{port}/"
+        f"http://localhost:{port}/?token={token}"
     )
     if open_browser and _has_display():
-        webbrowser.open(url)
+        webbrowser.open(address)
     deadline = None if seconds is None else time.monotonic() + seconds
     try:
         while deadline is None or time.monotonic() < deadline:

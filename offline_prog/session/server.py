@@ -27,7 +27,7 @@ from offline_prog.config import cell_text
 from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
 from offline_prog.scene.drake_cell import build_cell_model
-from offline_prog.session import outputs
+from offline_prog.session import outputs, request
 from offline_prog.session.replan import Replanner, SupersededError
 from offline_prog.session.scene_view import SceneView
 from offline_prog.session.state import controls, values, with_value
@@ -37,6 +37,7 @@ log = logging.getLogger(__name__)
 
 SETTLE_S = 0.3  # a control untouched this long has settled: re-plan
 FRAME_S = 1.0 / 30.0  # main-loop period (animation frames)
+ACTIONS = ("plan", "save", "export", "play", "pause", "seek", "auto")
 
 
 class Session:
@@ -105,10 +106,12 @@ class Session:
             }  # fmt: skip
 
     def set_value(self, key: str, text) -> dict:
-        """A typed or slid value: the new state, or refused with a message (state kept)."""
+        """A typed or slid value (text or a number, in the control's unit): the new
+        state, or ``ok: False`` with a one-line message (state kept)."""
         with self.lock:
             try:
-                state = with_value(self.state, str(key), text)
+                key = request.name(key, "key")
+                state = with_value(self.state, key, request.typed(text, key))
             except ValueError as error:
                 self.message = ("refused", f"refused {key} = {str(text)[:40]!r}: {error}")
                 return {"ok": False, "message": self.message[1]}
@@ -119,27 +122,35 @@ class Session:
             return {"ok": True}
 
     def action(self, name: str, value=None) -> dict:
-        """Buttons: plan, save, export, play, pause, seek (σ [mm]), auto (on/off)."""
+        """Buttons: plan, save, export, play, pause (no value); seek (σ [mm], a finite
+        number), auto (true or false). A bad name or value: ``ok: False`` with a
+        one-line message, nothing changed."""
         with self.lock:
-            if name == "plan":
-                self.generation += 1
-                self.plan_now = True
-            elif name in ("save", "export"):
-                self.requests.put((name, self.generation, self.state))
-                self.message = ("info", f"{name}…")
-            elif name in ("play", "pause"):
-                self.playing = name == "play"
-            elif name == "seek":
-                try:
-                    self.seek = float(value) * 1e-3
-                except (TypeError, ValueError):
-                    return {"ok": False, "message": f"σ {value!r} is not a number"}
-                self.playing = False
-            elif name == "auto":
-                self.auto = bool(value)
-            else:
-                return {"ok": False, "message": f"no action {name!r}"}
+            try:
+                self._act(request.name(name, "action"), value)
+            except request.RequestError as error:
+                self.message = ("refused", f"refused: {error}")
+                return {"ok": False, "message": str(error)}
             return {"ok": True}
+
+    def _act(self, name: str, value) -> None:
+        if name not in ACTIONS:
+            raise request.RequestError(f"no action {name[:40]!r} ({', '.join(ACTIONS)})")
+        if name not in ("seek", "auto") and value is not None:
+            raise request.RequestError(f"{name} takes no value (got {str(value)[:40]!r})")
+        if name == "seek":
+            self.seek = request.finite(value, "σ") * 1e-3  # checked first: NaN aborts Drake
+            self.playing = False
+        elif name == "auto":
+            self.auto = request.boolean(value, "auto")
+        elif name == "plan":
+            self.generation += 1
+            self.plan_now = True
+        elif name in ("save", "export"):
+            self.requests.put((name, self.generation, self.state))
+            self.message = ("info", f"{name}…")
+        else:
+            self.playing = name == "play"
 
     # --- the planner thread ------------------------------------------------------------
 

@@ -45,6 +45,8 @@ class ToppProfile:
         duration: rest-to-rest time of that profile [s] (no jerk limit).
         solve_s: wall time of the solve [s].
         ok: TOPP-RA found a parameterization; reason: why not (else "").
+        failed_at_m: where it failed [m]: the grid point whose controllable set is
+            empty or where the forward pass stopped (NaN when ok).
     """
 
     sigma: np.ndarray
@@ -53,6 +55,7 @@ class ToppProfile:
     solve_s: float
     ok: bool
     reason: str = ""
+    failed_at_m: float = float("nan")
 
 
 class _GridPath:
@@ -194,13 +197,32 @@ def topp_profile(
         constraints.append(_speed_curve(np.minimum(v_curve, v_cap), path.dof, a_step))
     start = time.perf_counter()
     solver = algorithm.TOPPRA(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
-    _, sd, _ = solver.compute_parameterization(*ends)
+    _, sd, _, K = solver.compute_parameterization(*ends, return_data=True)
     solve_s = time.perf_counter() - start
     code = solver.problem_data.return_code
     if sd is None or str(code.name) != "Ok":
-        return ToppProfile(sigma, np.zeros_like(sigma), np.inf, solve_s, False, str(code))
+        at = _failed_at(sigma, sd, K)
+        return ToppProfile(
+            sigma,
+            np.zeros_like(sigma),
+            np.inf,
+            solve_s,
+            False,
+            str(getattr(code, "value", code)),
+            at,
+        )
     speed = np.clip(np.asarray(sd, dtype=float), 0.0, v_cap)
     return ToppProfile(sigma, speed, profile_duration(sigma, speed), solve_s, True)
+
+
+def _failed_at(sigma: np.ndarray, sd, K) -> float:
+    """Where a TOPP-RA solve failed [m]: the last grid point whose controllable set is
+    empty (the backward pass ends there), else the first without a forward speed."""
+    if K is not None and np.isnan(K).any():
+        return float(sigma[int(np.flatnonzero(np.isnan(K).any(axis=1))[-1])])
+    if sd is not None and np.isnan(sd).any():
+        return float(sigma[int(np.argmax(np.isnan(sd)))])
+    return float(sigma[0])
 
 
 def resolve_locally(profile: ToppProfile, lowered: list[tuple[float, float]], solve,

@@ -107,9 +107,12 @@ def _table(header: list[str], rows: list[list]) -> str:
     return f'<table class="list"><tr>{head}</tr>{body}</table>'
 
 
-def render_job_report_html(plan_dir: Path) -> str:
-    """The report page of a job's plan folder, as one HTML string."""
+def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) -> str:
+    """The report page of a job's plan folder, as one HTML string; ``folder_name`` as
+    for ``report_html.render_report_html`` (the name the user sees, not the staged
+    folder's)."""
     plan_dir = Path(plan_dir)
+    folder_name = folder_name or plan_dir.name
     report = json.loads((plan_dir / "report.json").read_text())
     col = _columns(plan_dir)
     job = report["job"]
@@ -164,12 +167,13 @@ def render_job_report_html(plan_dir: Path) -> str:
         for p in data["plots"]
     )
     css, script = plot_assets()
-    title = f"Job report: {report.get('name') or plan_dir.name}"
+    title = f"Job report: {report.get('name') or folder_name}"
     return (
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{_e(title)}'
         f"</title><style>{_CSS}{css}</style></head><body><h1>{_e(title)}</h1>"
         f'<p class="sub">{_e(report.get("generator", ""))}, planned '
-        f'{_e(report.get("generated", ""))}</p><h2>Summary</h2><table id="summary">{table}'
+        f"{_e(report.get('generated', ''))}; plan folder {_e(folder_name)}</p><h2>Summary</h2>"
+        f'<table id="summary">{table}'
         f"</table><h2>Seams</h2>{seams}<h2>Links</h2>{links}<h2>Process I/O</h2>{events}"
         f'<h2>Plots</h2><p class="hint">Drag to zoom into a time range, double-click to '
         f"reset.</p>{figures}"
@@ -178,7 +182,7 @@ def render_job_report_html(plan_dir: Path) -> str:
     )
 
 
-def write_job_report_html(plan_dir: Path) -> Path:
+def write_job_report_html(plan_dir: Path, *, folder_name: str | None = None) -> Path:
     target = Path(plan_dir) / REPORT_FILE
-    write_atomic(target, render_job_report_html(plan_dir))
+    write_atomic(target, render_job_report_html(plan_dir, folder_name=folder_name))
     return target

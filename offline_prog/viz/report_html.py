@@ -73,9 +73,14 @@ figure{margin:18px 0} figcaption{color:#444;font-size:14px}
 """
 
 
-def render_report_html(plan_dir: Path) -> str:
-    """The report page of a plan folder, as one HTML string (deterministic)."""
+def render_report_html(plan_dir: Path, *, folder_name: str | None = None) -> str:
+    """The report page of a plan folder, as one HTML string (deterministic).
+
+    ``folder_name``: the plan folder's name as the user will see it (the writer
+    renders into a staged temporary folder swapped in under this name); default
+    ``plan_dir``'s own name."""
     plan_dir = Path(plan_dir)
+    folder_name = folder_name or plan_dir.name
     report, col, data, programs = load_plan_folder(plan_dir)
     fail, note = verdict(report, col, data)
     word = '<span class="fail">FAIL</span>' if fail else '<span class="pass">PASS</span>'
@@ -97,13 +102,13 @@ def render_report_html(plan_dir: Path) -> str:
         "z = b blue), and the flange path in the cell.</figcaption></figure>"
     )
     css, script = plot_assets()
-    title = f"Plan report: {report.get('name') or plan_dir.name}"
+    title = f"Plan report: {report.get('name') or folder_name}"
     return (
         f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{_e(title)}'
         f"</title><style>{_CSS}{css}</style></head><body><h1>{_e(title)}</h1>"
         f'<p class="sub">{_e(report.get("generator", ""))}, '
         f"planned {_e(report.get('generated', ''))}"
-        f"; plan folder {_e(plan_dir.name)}</p><h2>Summary</h2>"
+        f"; plan folder {_e(folder_name)}</p><h2>Summary</h2>"
         f'<table id="summary">{table}</table><h2>Plots</h2><p class="hint">Drag to zoom '
         "into a time range, double-click to reset; the cursor shows every value.</p>"
         f'{figures}<script type="application/json" id="plot-data">{plot_json}</script>'
@@ -111,12 +116,13 @@ def render_report_html(plan_dir: Path) -> str:
     )
 
 
-def write_report_html(plan_dir: Path) -> Path:
-    """Write ``plan_dir/report.html`` (atomically) and return its path.
+def write_report_html(plan_dir: Path, *, folder_name: str | None = None) -> Path:
+    """Write ``plan_dir/report.html`` (atomically) and return its path; folder_name
+    as for :func:`render_report_html`.
 
     Raises:
         ValueError: the folder lacks report.json, trajectory.csv or plan.npz.
     """
     target = Path(plan_dir) / REPORT_FILE
-    write_atomic(target, render_report_html(plan_dir))
+    write_atomic(target, render_report_html(plan_dir, folder_name=folder_name))
     return target

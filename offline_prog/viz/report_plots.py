@@ -86,7 +86,8 @@ def plot_columns(report: dict, col: dict, data: ProgramData, clearance: dict | N
 def _joint_panels(data: ProgramData, rates: bool) -> list[dict]:
     panels = []
     for j, name in enumerate(data.joint_names):
-        coupled = " (controller: q2 + q3)" if data.j23_coupled and j == 2 else ""
+        formula = "q2 + q3" if data.j23_factor > 0 else "q3 − q2"
+        coupled = f" (controller: {formula})" if data.j23_coupled and j == 2 else ""
         low, high = (
             (-data.qd_max[j], data.qd_max[j]) if rates else (data.q_lower[j], data.q_upper[j])
         )

@@ -102,7 +102,12 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ("X_IT: {", "symmetry_axis: w\n  X_IT: {", "tool.symmetry_axis", "use x, y or z"),
     ("model: kuka_kr16_2", "model: no_such_robot", "robot.model", "not a robot folder"),
     ("closed: false", "closed: maybe", "path.closed", "expected bool"),
-    ("closed: false", "closed: true", "path.closed", "ends of path.csv are 78.119 mm apart"),
+    (
+        "closed: false",
+        "closed: true",
+        "path.closed",
+        "ends of path.csv are 78.119 mm apart, more than twice the point spacing",
+    ),
     ("  normal: [0, 0, 1]\n", "", "path.normal", "exactly one way"),
     ("normal: [0, 0, 1]", "normal: [1, 0, 0]", "path.normal", "tangent"),
     ("normal: [0, 0, 1]", "normal: [0, 0, 0]", "path.normal", "zero vector"),

@@ -3,6 +3,7 @@
 import time
 
 import pytest
+import yaml
 from test_cell_errors import BASE, write_cell
 
 from offline_prog.config.cell import load_cell
@@ -103,3 +104,33 @@ def test_long_values_are_cut_in_messages(tmp_path):
 def test_implausible_motion_is_refused(tmp_path, old, new, match):
     with pytest.raises(InputError, match=match):
         plan_cell(write_cell(tmp_path, BASE.replace(old, new)))
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        '"Sealing, on: the plate"',
+        "'demo, on: plate'",
+        '"off: yes, no"',
+        "'{on: 1}'",
+        "|-\n  line one, on: two",
+    ],
+)
+def test_strings_that_look_like_yaml11_booleans_are_kept(tmp_path, name):
+    """YAML 1.2 booleans (true/false only) are parsed, not edited into the text: a
+    string holding ``on:`` comes out as written, and its line is no error."""
+    text = BASE.replace("name: test", f"name: test\ndescription: {name}")
+    cell = load_cell(write_cell(tmp_path, text))
+    assert cell.description == yaml.safe_load(f"v: {name}")["v"]
+    cell = load_cell(write_cell(tmp_path, BASE.replace("name: test", f"name: {name}")))
+    assert cell.name == yaml.safe_load(f"v: {name}")["v"]
+
+
+def test_yaml11_boolean_words_as_keys_and_values(tmp_path):
+    """``on:`` / ``off:`` keys are strings (the process_io contract); a bool field
+    takes only true / false (``closed: yes`` is YAML 1.1 and refused)."""
+    io = "  process_io: {on: {digital_output: 3, lead_mm: 5}, off: {digital_output: 3}}\n"
+    cell = load_cell(write_cell(tmp_path, BASE.replace("tool:\n", "tool:\n" + io)))
+    assert cell.tool.process_io.on.digital_output == 3
+    assert cell.tool.process_io.off.lead_mm == 0.0
+    refused(write_cell(tmp_path, BASE.replace("closed: false", "closed: yes")), "expected bool")

@@ -54,6 +54,7 @@ class Folders(dict):
     def __init__(self, planned_job, work):
         super().__init__()
         self.planned_job, self.work = planned_job, work
+        self.cells = {"krl": CELLS / "seal_job_kr16.yaml"}  # language ↦ its cell file
 
     def __missing__(self, language):
         if language == "krl":
@@ -61,7 +62,8 @@ class Folders(dict):
         else:
             if not (self.work / "data").exists():
                 shutil.copytree(CELLS / "data", self.work / "data")  # path and mesh files
-            job = plan_job(one_seam_job(self.work, *JOBS[language]))
+            self.cells[language] = one_seam_job(self.work, *JOBS[language])
+            job = plan_job(self.cells[language])
             assert job.feasible, job.failure
             folder = self.work / language
             write_job_outputs(job, folder)
@@ -74,9 +76,12 @@ def folders(planned_job, tmp_path_factory):
     return Folders(planned_job, tmp_path_factory.mktemp("jobs"))
 
 
-def asked(data: JobProgramData, k: int) -> tuple[float, float]:
-    """(on, off) positions along seam k's path [m] the cell asks for."""
-    return data.switch_positions(k)
+def asked(cell_file: Path, data: JobProgramData, k: int) -> tuple[float, float]:
+    """(on, off) positions along seam k's path [m] the cell asks for: on ``on.lead_mm``
+    before the seam's start, off ``off.lead_mm`` before its end (L the seam's planned
+    length), from the cell file's own numbers."""
+    io = load_cell(cell_file).tool.process_io
+    return -io.on.lead_mm * 1e-3, data.seam_lengths_m[k] - io.off.lead_mm * 1e-3
 
 
 # --- KRL --------------------------------------------------------------------------------
@@ -136,7 +141,7 @@ def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
     for module, line in run:
         if line.startswith("PTP "):
             q_link = np.deg2rad(axes[[f for f in ptp].index(main[line.split()[1]][1])])
-        elif line.startswith("TRIGGER"):
+        elif line.startswith("TRIGGER") and "DO $OUT[" in line:  # the process output
             pending = (float(re.search(r"PATH=(-?[\d.]+)", line)[1]) * 1e-3, "TRUE" in line)
         elif line.startswith("LIN "):
             name = line.split()[1]
@@ -159,7 +164,7 @@ def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
                 pending = None
     assert sorted(switched) == list(range(len(data.seam_names)))
     for k in switched:
-        on, off = asked(data, k)
+        on, off = asked(folders.cells["krl"], data, k)
         assert switched[k][True] == pytest.approx(on, abs=IO_TOL_M)
         assert switched[k][False] == pytest.approx(off, abs=IO_TOL_M)
     assert_krllint_clean(folder, tmp_path)
@@ -242,7 +247,7 @@ def test_rapid_job_links_approach_retract_and_io(folders):
             for name in re.findall(r"\b(tOn|tOff)\b", line):
                 distance, state = triggs[name]
                 switched[state] = position - distance
-    on, off = asked(data, 0)
+    on, off = asked(folders.cells["rapid"], data, 0)
     assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
     assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
     assert "TriggSpeed tFlow" in text and f"ao{data.process_io.analog_output}" in text
@@ -289,7 +294,7 @@ def test_urscript_job_links_and_io(folders):
                     position = seam.sigma[i]
                 switched[pending] = position
                 pending = None
-    on, off = asked(data, 0)
+    on, off = asked(folders.cells["urscript"], data, 0)
     assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
     assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
     assert any(line.strip().startswith("set_standard_analog_out") for line in lines)

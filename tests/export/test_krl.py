@@ -385,3 +385,22 @@ def test_bad_arguments_are_refused(data, tmp_path, options):
 def test_a_non_opw_robot_is_refused(data, tmp_path):
     with pytest.raises(ValueError, match="not an OPW arm"):
         write_krl(dataclasses.replace(data, robot="ur10e"), tmp_path)
+
+
+@pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
+def test_export_command_sets_the_tcp_pose_convention(planned_folder, tmp_path, convention):
+    """README: ``offline-prog export --tcp-pose-convention X_PF`` writes the inverse
+    points; either reads back to the planned flange poses."""
+    from offline_prog.cli import main
+
+    plan_dir = planned_folder("seal_plate_kr16")[1]
+    flags = [] if convention == "X_TP" else ["--tcp-pose-convention", convention]
+    argv = ["export", str(plan_dir), "--format", "krl", "--out", str(tmp_path), *flags]
+    assert main(argv) == 0
+    motions, settings = read_program(tmp_path, "offline_prog")
+    lin = [m for m in motions if m["kind"] == "LIN"]  # no retract of the writer's own
+    X_BE = flange_poses(lin, settings, "external_tcp", convention)
+    data = ProgramData.load(plan_dir)
+    dp, da = pose_errors(X_BE[[0, -1]], data.X_BE[[0, -1]])
+    assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
+    assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()

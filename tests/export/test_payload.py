@@ -95,3 +95,36 @@ def test_without_payload_every_header_and_the_report_warn(plans, planned_folder,
     report = json.loads((planned_folder("seal_plate_kr16")[1] / "report.json").read_text())
     assert report["payload"]["set"] is False and "PAYLOAD NOT SET" in report["payload"]["warning"]
     assert list(report).index("payload") < 10  # near the top: prominent
+
+
+@pytest.mark.parametrize(
+    ("record", "missing"),
+    [
+        ({}, "gripper.mass_kg / part.mass_kg"),
+        ({k: v for k, v in RECORD.items() if k.startswith("gripper")}, "part.mass_kg"),
+        ({k: v for k, v in RECORD.items() if k.startswith("part")}, "gripper.mass_kg"),
+    ],
+)
+def test_the_warning_names_the_cell_keys(record, missing):
+    from offline_prog.export.payload import payload_note
+
+    note = payload_note(record, np.eye(4))
+    assert note.startswith(f"WARNING: PAYLOAD NOT SET (the cell gives no {missing}): ")
+
+
+def test_a_job_reports_and_prints_the_payload_warning(planned_job):
+    """report.json of a job has the payload entry, and ``plan`` prints its warning."""
+    import io
+
+    from rich.console import Console
+
+    from offline_prog.results.summary import print_job_summary
+
+    _, folder = planned_job("seal_job_kr16")
+    report = json.loads((folder / "report.json").read_text())
+    assert report["payload"]["set"] is False
+    assert "(the cell gives no gripper.mass_kg / part.mass_kg)" in report["payload"]["warning"]
+    assert list(report).index("payload") < 10  # near the top: prominent
+    out = io.StringIO()
+    print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
+    assert f"payload   {report['payload']['warning']}" in out.getvalue()

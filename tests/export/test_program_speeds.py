@@ -36,12 +36,18 @@ def plans(planned_folder):
 def test_written_speeds_are_in_range(plans, tmp_path):
     kuka, abb, ur = plans
     krl = write_krl(kuka, tmp_path / "krl").files[0].read_text()
-    assert all(0 < float(v) <= VEL_CP_MAX_M_S for v in re.findall(r"\$VEL\.CP=([\d.]+)", krl))
+    vel_cp = [float(v) for v in re.findall(r"\$VEL\.CP=([\d.]+)", krl)]
+    assert vel_cp and all(0 < v <= VEL_CP_MAX_M_S for v in vel_cp)
+    # In m/s: the fastest written speed is the cell's process speed (within the 0.1 mm/s
+    # floor of $VEL.CP), not 1000 times it.
+    assert max(vel_cp) == pytest.approx(kuka.process_speed_m_s, abs=1e-4)
     rapid = "".join(f.read_text() for f in write_rapid(abb, tmp_path / "rapid").files)
-    speeds = re.findall(r"speeddata \w+ := \[([\d.]+),", rapid)
-    assert speeds and all(0 < float(v) <= MAX_SPEED_MMS for v in speeds)
+    speeds = [float(v) for v in re.findall(r"speeddata \w+ := \[([\d.]+),", rapid)]
+    assert speeds and all(0 < v <= MAX_SPEED_MMS for v in speeds)
+    assert max(speeds) == pytest.approx(abb.process_speed_m_s * 1e3, abs=0.1)  # mm/s
     ur_text = write_urscript(ur, tmp_path / "ur", mode="movel").file.read_text()
-    assert all(0 < float(v) <= MOVEL_MAX_SPEED_M_S for v in re.findall(r"v=([\d.]+), r=", ur_text))
+    movel = [float(v) for v in re.findall(r"v=([\d.]+), r=", ur_text)]
+    assert movel and all(0 < v <= MOVEL_MAX_SPEED_M_S for v in movel)
 
 
 def test_speeds_beyond_the_controller_are_refused(plans, tmp_path):

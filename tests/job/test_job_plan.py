@@ -108,7 +108,7 @@ def test_process_io_switches_at_the_requested_positions(job):
         assert on_at == pytest.approx(-io.on.lead_mm * 1e-3, abs=IO_TOL_M)
         length = option.plan.path.length
         assert off_at == pytest.approx(length - io.off.lead_mm * 1e-3, abs=IO_TOL_M)
-    events = {(e.seam, e.state): e.path_m for e in plan.io.events}
+    events = {(e.seam, e.state): e.path_m for e in plan.io.switches}
     assert len(events) == 2 * len(plan.chosen)
 
 
@@ -118,7 +118,8 @@ def test_flow_follows_the_tcp_speed_while_on(job):
     on = plan.io.digital.astype(bool)
     expected = np.clip(flow.offset + flow.per_mps * plan.tcp_speed, flow.min, flow.max)
     np.testing.assert_allclose(plan.io.analog[on], expected[on], atol=1e-12)
-    assert np.all(plan.io.analog[~on] == flow.min)
+    # Off: the idle value, the flow at zero speed (README, Process I/O).
+    assert np.all(plan.io.analog[~on] == np.clip(flow.offset, flow.min, flow.max))
 
 
 def test_report_splits_cycle_time(job):

@@ -37,13 +37,16 @@ def test_no_feasible_placement_is_exit_1_with_the_closest_reason_and_outputs(tmp
     file.write_text(file.read_text().replace("x: [700, 1900]", "x: [2300, 2600]"))
     out = tmp_path / "out"
     code = main(["place", str(file), "--out", str(out), "--budget", "3", "--workers", "0"])
-    err = capsys.readouterr().err.strip().splitlines()
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
     assert code == 1 and len(err) == 1 and "no feasible placement in 3 candidates" in err[0]
     assert "out of reach" in err[0]
     data = json.loads((out / "placement.json").read_text())
     assert not data["best"]["feasible"] and data["best"]["failure"] == "out_of_reach"
     assert data["search"]["failures"] == {"out_of_reach": 3}
     assert not (out / "best_preview.html").exists()
+    said = captured.out.strip().splitlines()[-1]
+    assert said.endswith(f"wrote into {out}: placed.yaml, placement.html, placement.json")
 
 
 @pytest.mark.slow  # ~25 s: two searches of 10 candidates, a LocalCluster, one plan
@@ -51,6 +54,10 @@ def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_p
     file = small_search(tmp_path)
     serial, dask = tmp_path / "serial", tmp_path / "dask"
     assert main(["place", str(file), "--out", str(serial), "--budget", "10", "--workers", "0"]) == 0
+    said = capsys.readouterr().out.strip().splitlines()[-1]  # what it wrote, preview too
+    assert said.endswith(
+        f"wrote into {serial}: best_preview.html, placed.yaml, placement.html, placement.json"
+    )
     assert main(["place", str(file), "--out", str(dask), "--budget", "10", "--workers", "2"]) == 0
     ours, theirs = (json.loads((d / "placement.json").read_text()) for d in (serial, dask))
     assert ours["best"] == {**theirs["best"], "evaluation_s": ours["best"]["evaluation_s"]}

@@ -30,6 +30,9 @@ def _variant(tmp_path, old: str, new: str):
         ("yaw: [0, 60]", "yaw: [60, 0]", "place.X_IT.rpy_deg.yaw", "inverted range"),
         ("yaw: [0, 60]", "spin: [0, 60]", "place.X_IT.rpy_deg.spin", "unknown key"),
         ("budget: 200", "budget: 0", "place.budget", "outside 1..100,000"),
+        # numpy takes seeds below 2³², and CMA-ES gets seed + 1 + its restarts
+        ("seed: 0", "seed: 4294967295", "place.seed", "outside 0..2,147,483,647"),
+        ("seed: 0", "seed: -1", "place.seed", "outside 0..2,147,483,647"),
         ("moves_with_tool: [nozzle_stand]", "moves_with_tool: [stand]",
          "place.moves_with_tool[0]", "'stand' is not an obstacle"),
         ("  X_PE:   ", "  X_PE:\n    rpy_deg: {yaw: [-10, 10]}\n  ", "place.X_PE.rpy_deg.yaw",
@@ -46,6 +49,24 @@ def test_bad_place_input_is_one_line_exit_2_nothing_written(
     assert code == 2 and len(err) == 1, err
     assert str(file) in err[0] and key in err[0] and reason in err[0], err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "reason"),
+    [
+        ("--budget", "200000", "'200000': need an integer >= 1 and <= 100000"),
+        ("--budget", "2.5", "'2.5' is not an integer"),
+        ("--seed", "4294967295", "'4294967295': need an integer >= 0 and <= 2147483647"),
+    ],
+)
+def test_a_bad_flag_is_blamed_on_the_flag(tmp_path, capsys, flag, value, reason):
+    """Not on the cell's place.budget / place.seed, which the flag overrides."""
+    with pytest.raises(SystemExit) as stop:
+        main(["place", str(DEMO), flag, value, "--out", str(tmp_path / "o"), "--workers", "0"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert stop.value.code == 2 and len(err) == 1, err
+    assert err[0] == f"error: argument {flag}: {reason} (see offline-prog place --help)"
+    assert not (tmp_path / "o").exists()
 
 
 def test_a_cell_without_place_and_a_budget_flag_of_0_are_refused(tmp_path, capsys):

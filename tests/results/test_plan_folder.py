@@ -160,3 +160,18 @@ def test_staged_folder_swaps_with_or_without_renameat2(tmp_path, monkeypatch, ex
             write_atomic(folder / content, content)
     assert [p.name for p in tmp_path.iterdir()] == ["d"]
     assert [p.name for p in (tmp_path / "d").iterdir()] == ["new"]
+
+
+@pytest.mark.parametrize("kind", ["seam", "job"])
+def test_report_html_names_the_plan_folder_not_the_staged_one(planned_folder, planned_job, kind):
+    """The page is rendered in the staged ``.offline_prog-<pid>-...`` sibling; it names
+    the folder the user opens."""
+    from offline_prog.atomic import TEMP_PREFIX
+
+    if kind == "seam":
+        _, folder = planned_folder("seal_plate_kr16")
+    else:
+        _, folder = planned_job("seal_job_kr16")
+    page = (folder / "report.html").read_text()
+    assert f"; plan folder {folder.name}</p>" in page
+    assert TEMP_PREFIX not in page

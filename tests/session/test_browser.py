@@ -9,7 +9,6 @@ import os
 import re
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -24,26 +23,11 @@ from offline_prog.results.plan_folder import write_outputs
 
 from browser import WEBGL_ARGS, require_chromium
 from conftest import CELLS, REPO
+from live_session import free_port_pair
 
 pytestmark = pytest.mark.slow
 TIMEOUT_MS = 60_000
 MOVE_MM = 20  # the X_IT x slider moved by 20 steps of 1 mm
-
-
-def free_port_pair() -> int:
-    """A port p with p and p + 1 free (the panel and MeshCat)."""
-    for _ in range(50):
-        with socket.socket() as probe:
-            probe.bind(("localhost", 0))
-            port = probe.getsockname()[1]
-        if port < 65535:
-            with socket.socket() as second:
-                try:
-                    second.bind(("localhost", port + 1))
-                    return port
-                except OSError:
-                    continue
-    pytest.skip("no two free neighbouring ports")
 
 
 @pytest.fixture
@@ -58,17 +42,22 @@ def session(tmp_path):
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     line = process.stdout.readline()
-    assert f"at http://localhost:{port}/" in line, (line, process.stderr.read())
+    url = re.search(rf" at (http://localhost:{port}/\?token=[\w-]+) ", line)
+    assert url, (line, process.stderr.read())
     hint = process.stdout.readline()
     assert f"ssh -N -L {port}:localhost:{port} -L {port + 1}:localhost:{port + 1}" in hint
-    yield tmp_path, cell, port, process
+    yield tmp_path, cell, url.group(1), process
     if process.poll() is None:
         process.kill()
         process.wait()
 
 
 def status(page) -> dict:
-    return page.evaluate("fetch('/status').then(r => r.json())")
+    """The session's status as the panel page reads it (with the token of its URL)."""
+    return page.evaluate(
+        "fetch('/status', {headers: {'X-Session-Token': "
+        "new URLSearchParams(location.search).get('token')}}).then(r => r.json())"
+    )
 
 
 def node_pose(frame, path: list[str]) -> RigidTransform:
@@ -87,14 +76,15 @@ def test_session_in_the_browser(session):
     pytest.importorskip("playwright.sync_api", reason="pip install playwright (the test extras)")
     from playwright.sync_api import expect, sync_playwright
 
-    folder, cell, port, process = session
+    folder, cell, url, process = session
+    port = int(url.split(":")[2].split("/")[0])
     chromium = require_chromium()
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(
             executable_path=chromium, args=["--no-sandbox", *WEBGL_ARGS[:2]]
         )
         page = browser.new_page(viewport={"width": 1400, "height": 900})
-        page.goto(f"http://localhost:{port}/")
+        page.goto(url)
         line = page.locator("#status")
         expect(line).to_have_class("feasible", timeout=TIMEOUT_MS)
         first = status(page)
@@ -170,6 +160,21 @@ def test_session_in_the_browser(session):
         assert ours == theirs
         report = json.loads((exported / "report.json").read_text())
         assert report["cell"].endswith("seal_plate_kr16-1.yaml")  # the saved cell
+
+        # Another page in the same browser (MeshCat's, another origin) posts as a web
+        # page may without asking (text/plain, no-cors): refused, the tool stays.
+        other = browser.new_page()
+        other.goto(f"http://localhost:{port + 1}/", wait_until="commit")  # its origin only
+        other.evaluate(
+            """port => fetch(`http://localhost:${port}/set`, {method: "POST", mode: "no-cors",
+                 headers: {"Content-Type": "text/plain"},
+                 body: JSON.stringify({key: "X_IT.x", value: 1234})})""",
+            port,
+        )
+        assert status(page)["values"]["X_IT.x"] == 1000 + MOVE_MM
+        other.goto(f"http://localhost:{port}/")  # the panel without the printed token
+        assert "open the URL the session printed" in other.inner_text("body")
+        other.close()
 
         # A bad typed value: refused in the status line, the session goes on.
         speed = page.locator('input.num[data-key="speed"]')

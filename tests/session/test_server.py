@@ -23,31 +23,74 @@ def run_until(session: Session, done) -> None:
         time.sleep(0.01)
 
 
-@pytest.fixture(scope="module")
-def session():
+def new_session() -> Session:
+    """A session with its first plan shown."""
     session = Session(CELLS / "tape_cylinder_ur10e.yaml", Meshcat())
     run_until(session, lambda: session.snapshot()["current"])
     return session
 
 
-def test_the_first_plan_is_shown_with_its_figures(session):
-    snapshot = session.snapshot()
+@pytest.fixture(scope="module")
+def untouched():
+    """One session for the tests whose requests are all refused; each checks that its
+    own requests changed nothing, so none depends on another's order."""
+    return new_session()
+
+
+@pytest.fixture
+def session():
+    """A session of the test's own: it changes the state."""
+    return new_session()
+
+
+def test_the_first_plan_is_shown_with_its_figures(untouched):
+    snapshot = untouched.snapshot()
     status = snapshot["status"]
     assert status["kind"] == "feasible" and status["line"].startswith("feasible · cycle")
     assert snapshot["duration"] > 0 and snapshot["length"] > 0
     assert status["details"]["samples"]["colliding"] == 0
 
 
-def test_a_bad_value_is_refused_and_the_session_goes_on(session):
-    before = session.snapshot()
-    reply = session.set_value("speed", "-3")
-    after = session.snapshot()
+def test_a_bad_value_is_refused_and_the_session_goes_on(untouched):
+    before = untouched.snapshot()
+    reply = untouched.set_value("speed", "-3")
+    after = untouched.snapshot()
     assert reply["ok"] is False and after["message"]["kind"] == "refused"
     assert "refused speed = '-3': must be > 0" in after["message"]["text"]
     assert after["values"] == before["values"] and after["current"]
-    assert session.action("seek", "abc")["ok"] is False
-    session.step()  # nothing to re-plan
-    assert session.snapshot()["generation"] == before["generation"]
+    assert untouched.action("seek", "abc")["ok"] is False
+    untouched.step()  # nothing to re-plan
+    assert untouched.snapshot()["generation"] == before["generation"]
+
+
+BAD_ACTIONS = [
+    ("seek", "nan", "σ 'nan' is not a finite number"),  # Drake aborts on a NaN pose
+    ("seek", float("inf"), "σ inf is not a finite number"),
+    ("seek", True, "σ True is not a number"),
+    ("auto", "no", "auto 'no' is not true or false"),
+    ("auto", None, "auto None is not true or false"),
+    ("plan", 1, "plan takes no value"),
+    ("jump", None, "no action 'jump'"),
+]
+
+
+def test_a_bad_action_changes_nothing(untouched):
+    for name, value, reason in BAD_ACTIONS:
+        before = untouched.snapshot()
+        reply = untouched.action(name, value)
+        assert reply["ok"] is False and reason in reply["message"], (name, value, reply)
+        untouched.step()
+        after = untouched.snapshot()
+        assert after["message"] == {"kind": "refused", "text": f"refused: {reply['message']}"}
+        for key in ("values", "auto", "generation", "playing", "t", "sigma"):
+            assert after[key] == before[key], (name, value, key)
+
+
+def test_auto_reads_true_and_false(session):
+    for value, auto in (("false", False), (False, False), ("true", True), (True, True)):
+        session.action("auto", not auto)
+        assert session.action("auto", value) == {"ok": True}
+        assert session.snapshot()["auto"] is auto, value
 
 
 def test_an_older_plan_is_never_shown_as_current(session):

@@ -1,0 +1,173 @@
+"""A description's link geometry converted as the bundled robots' was.
+
+For each link on the chain, its ``<visual>`` and ``<collision>`` meshes are read with
+trimesh (STL, OBJ, PLY, GLB; COLLADA needs pycollada), scaled, moved from the mesh's
+``<origin>`` into the link frame (the transform is applied to the vertices, so the
+written URDF's origins are zero) and written as Wavefront OBJ in metres, coordinates
+rounded to 10 µm: ``meshes/visual/<link>.obj`` (+ ``.mtl`` with the URDF material's
+colour, normals split at edges sharper than 30°) and ``meshes/collision/<link>.obj``.
+Drake uses a collision mesh's convex hull, so a concave collision mesh is written as
+CoACD convex pieces ``<link>_<k>.obj`` instead. Nothing is simplified. Each file's
+source, checksum and transform go to ``meshes/SOURCES.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from offline_prog.errors import InputError
+from offline_prog.robot_import.chain import Chain, origin
+from offline_prog.robot_import.sources import resolve_uri
+
+DIGITS = 5  # 10 µm in metres, as the bundled meshes
+SMOOTH_ANGLE_DEG = 30.0
+CONVEX_VOLUME_RATIO = 0.999  # mesh volume / hull volume above this: convex already
+DEFAULT_RGBA = (0.7, 0.7, 0.7, 1.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class MeshSource:
+    """One converted file: the link, its role (visual | collision), the written files
+    (relative to the robot folder), the source file, its sha256, the mesh origin in the
+    link frame (xyz [m], rpy [rad]), scale, triangles and whether it was decomposed."""
+
+    link: str
+    role: str
+    written: tuple[str, ...]
+    source: Path
+    sha256: str
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    scale: tuple[float, float, float]
+    triangles: int
+    pieces: int
+
+
+def convert_meshes(
+    chain: Chain, packages: dict[str, Path], out: Path
+) -> tuple[dict[str, dict[str, list[str]]], list[MeshSource]]:
+    """Write every chain link's meshes under ``out/meshes``.
+
+    Returns:
+        (files, sources): files[link][role] = the written OBJ paths relative to
+        ``out`` (the URDF's ``<mesh filename>``), and one MeshSource per source mesh.
+
+    Raises:
+        InputError: a mesh file that is missing or unreadable, a package not found.
+    """
+    import trimesh
+
+    files: dict[str, dict[str, list[str]]] = {}
+    sources: list[MeshSource] = []
+    links = {link.get("name"): link for link in chain.root.findall("link")}
+    materials = {m.get("name"): m for m in chain.root.findall("material")}
+    for name in chain.links:
+        for role in ("visual", "collision"):
+            meshes, colours = [], []
+            for element in links[name].findall(role):
+                loaded = _load(element, chain, packages, name, role, trimesh)
+                if loaded is None:
+                    continue
+                mesh, source = loaded
+                meshes.append(mesh)
+                colours.append(_rgba(element, materials))
+                sources.append(source)
+            if meshes:
+                written = _write(out, name, role, meshes, colours, trimesh)
+                files.setdefault(name, {})[role] = written
+                for index, source in enumerate(sources[-len(meshes) :]):
+                    sources[-len(meshes) + index] = dataclasses.replace(
+                        source, written=tuple(written), pieces=len(written)
+                    )
+    return files, sources
+
+
+def _load(element: ET.Element, chain: Chain, packages, link: str, role: str, trimesh):
+    geometry = element.find("geometry")
+    mesh_element = geometry.find("mesh") if geometry is not None else None
+    if mesh_element is None:
+        return None  # primitives are kept as they are (see record.write_urdf)
+    uri = mesh_element.get("filename", "")
+    file = resolve_uri(uri, packages, base_dir=chain.file.parent, file=chain.file)
+    scale = np.array([float(s) for s in mesh_element.get("scale", "1 1 1").split()])
+    try:
+        mesh = trimesh.load(file, force="mesh")
+    except Exception as error:  # trimesh raises many kinds for unreadable files
+        raise InputError(
+            chain.file, uri, f"mesh unreadable ({' '.join(str(error).split())})"
+        ) from None
+    if not len(getattr(mesh, "faces", ())):
+        raise InputError(chain.file, uri, "mesh has no triangles")
+    X_LG = origin(element.find("origin"), chain.file, f"link {link} {role}")
+    mesh.apply_scale(scale)
+    mesh.apply_transform(X_LG.GetAsMatrix4())
+    rpy = X_LG.rotation().ToRollPitchYaw().vector()
+    source = MeshSource(
+        link, role, (), file, hashlib.sha256(file.read_bytes()).hexdigest(),
+        tuple(X_LG.translation()), tuple(rpy), tuple(scale), len(mesh.faces), 1,
+    )  # fmt: skip
+    return mesh, source
+
+
+def _rgba(element: ET.Element, materials: dict) -> tuple[float, ...]:
+    material = element.find("material")
+    if material is not None and material.find("color") is None:
+        material = materials.get(material.get("name"), material)
+    colour = material.find("color") if material is not None else None
+    if colour is None:
+        return DEFAULT_RGBA
+    try:
+        return tuple(float(v) for v in colour.get("rgba", "").split())[:4] or DEFAULT_RGBA
+    except ValueError:
+        return DEFAULT_RGBA
+
+
+def _write(out: Path, link: str, role: str, meshes, colours, trimesh) -> list[str]:
+    folder = out / "meshes" / role
+    folder.mkdir(parents=True, exist_ok=True)
+    header = f"# {link}: {role} mesh, metres, in the URDF link frame '{link}' (see ../SOURCES.md)\n"
+    if role == "visual":
+        groups = [(f"m{k}", trimesh.graph.smooth_shade(m, angle=np.radians(SMOOTH_ANGLE_DEG)))
+                  for k, m in enumerate(meshes)]  # fmt: skip
+        (folder / f"{link}.mtl").write_text(header + "".join(
+            f"newmtl {name}\nKa 0 0 0\nKd {r:g} {g:g} {b:g}\nd {a:g}\nKs 0.05 0.05 0.05\nNs 10\n"
+            "illum 2\n\n" for (name, _), (r, g, b, a) in zip(groups, colours, strict=True)
+        ))  # fmt: skip
+        (folder / f"{link}.obj").write_text(header + f"mtllib {link}.mtl\n" + _obj(groups, True))
+        return [f"meshes/visual/{link}.obj"]
+    merged = trimesh.util.concatenate(meshes)
+    hull = merged.convex_hull
+    if merged.is_watertight and merged.volume >= CONVEX_VOLUME_RATIO * hull.volume:
+        pieces = [merged]
+    else:
+        import coacd
+
+        coacd.set_log_level("error")
+        parts = coacd.run_coacd(coacd.Mesh(merged.vertices, merged.faces), seed=0)
+        pieces = [trimesh.Trimesh(v, f, process=False) for v, f in parts]
+    names = [f"{link}.obj"] if len(pieces) == 1 else [f"{link}_{k}.obj" for k in range(len(pieces))]
+    for name, piece in zip(names, pieces, strict=True):
+        (folder / name).write_text(header + _obj([(None, piece)], False))
+    return [f"meshes/collision/{name}" for name in names]
+
+
+def _obj(groups, normals: bool) -> str:
+    """OBJ text of (material or None, mesh) groups; 1-based indices across groups."""
+    lines, base = [], 0
+    for material, mesh in groups:
+        if material:
+            lines.append(f"usemtl {material}")
+        v = np.round(mesh.vertices, DIGITS) + 0.0
+        lines += [f"v {x:g} {y:g} {z:g}" for x, y, z in v]
+        if normals:
+            n = np.round(mesh.vertex_normals, 4) + 0.0
+            lines += [f"vn {x:g} {y:g} {z:g}" for x, y, z in n]
+        f = mesh.faces + base + 1
+        lines += [f"f {a}//{a} {b}//{b} {c}//{c}" if normals else f"f {a} {b} {c}" for a, b, c in f]
+        base += len(v)
+    return "\n".join(lines) + "\n"

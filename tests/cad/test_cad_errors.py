@@ -1,0 +1,119 @@
+"""Bad CAD input ends with one line naming the file, the key and the reason (exit 2);
+a cell without CAD keys never imports Open CASCADE."""
+
+import subprocess
+import sys
+
+import pytest
+from cad_parts import cad_cell, filleted_plate, write_step
+
+from offline_prog.cli import main
+from offline_prog.errors import InputError
+from offline_prog.job.seams import seam_inputs
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.stages import load_inputs
+
+from conftest import CELLS, REPO
+
+LOOP = {"cad": {"loop": {"face_near_mm": [150, 100, 10]}}}
+
+
+@pytest.fixture(scope="module")
+def plate(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("plate")
+    write_step(filleted_plate(), folder / "plate.step")
+    return folder
+
+
+def seam_error(folder, model, seam) -> InputError:
+    file = cad_cell(folder, model, [seam])
+    with pytest.raises(InputError) as error:
+        seam_inputs(load_inputs(file, ROBOTS_DIR), 0)
+    assert "\n" not in str(error.value)
+    return error.value
+
+
+def test_a_file_that_is_not_step(tmp_path):
+    (tmp_path / "part.step").write_text("ISO-10303-21;\nnot really\n")
+    error = seam_error(tmp_path, "part.step", LOOP)
+    assert error.key == "part.model" and "not a readable STEP file" in error.reason
+
+
+def test_a_step_that_is_not_a_solid(tmp_path):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.gp import gp_Pln
+
+    write_step(BRepBuilderAPI_MakeFace(gp_Pln(), 0, 100, 0, 50).Shape(), tmp_path / "sheet.step")
+    error = seam_error(tmp_path, "sheet.step", LOOP)
+    assert error.key == "part.model" and "not a solid" in error.reason
+
+
+def test_a_point_on_the_edge_between_two_faces_is_ambiguous(plate):
+    seam = {"cad": {"loop": {"face_near_mm": [150, 0, 10]}}}
+    error = seam_error(plate, "plate.step", seam)
+    assert error.key == "seams[0].cad.loop.face_near_mm"
+    assert "[150, 0, 10] is ambiguous" in error.reason and "face" in error.reason
+
+
+def test_a_point_far_from_the_model(plate):
+    seam = {"cad": {"loop": {"face_near_mm": [150, 100, 30]}}}
+    error = seam_error(plate, "plate.step", seam)
+    assert error.key == "seams[0].cad.loop.face_near_mm"
+    assert "20.00 mm from the nearest face, more than 5 mm" in error.reason
+
+
+def test_a_chain_whose_edges_do_not_connect(tmp_path):
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+    from OCP.TopoDS import TopoDS_Compound
+
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    builder.Add(compound, BRepPrimAPI_MakeBox(100, 100, 10).Shape())
+    builder.Add(compound, BRepPrimAPI_MakeBox(gp_Pnt(200, 0, 0), 100, 100, 10).Shape())
+    write_step(compound, tmp_path / "two.step")
+    seam = {
+        "cad": {
+            "chain": {"near_mm": [[50, 0, 10], [250, 0, 10]]},
+            "normal": {"face_near_mm": [50, 50, 10]},
+        }
+    }
+    error = seam_error(tmp_path, "two.step", seam)
+    assert error.key == "seams[0].cad.chain.near_mm"
+    assert "do not connect" in error.reason
+
+
+def test_a_chain_needs_its_normal_face(plate):
+    file = cad_cell(plate, "plate.step", [{"cad": {"chain": {"near_mm": [[100, 0, 0]] * 2}}}])
+    with pytest.raises(InputError, match=r"seams\[0\]\.cad\.normal\.face_near_mm: missing"):
+        load_inputs(file, ROBOTS_DIR)
+
+
+def test_the_command_line_says_it_in_one_line(plate, capsys, tmp_path):
+    file = cad_cell(plate, "plate.step", [{"cad": {"loop": {"face_near_mm": [150, 0, 10]}}}])
+    code = main(["plan", str(file), "--out", str(tmp_path / "out")])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1
+    assert "seams[0].cad.loop.face_near_mm" in lines[0] and "ambiguous" in lines[0]
+
+
+def test_a_cell_without_cad_keys_does_not_import_open_cascade():
+    """Open CASCADE takes seconds to import: loading, fitting and building the scene of
+    an ordinary cell (and the command line's modules) must not pull it in."""
+    probe = (
+        "import sys\n"
+        "import offline_prog.cli\n"
+        "from offline_prog.stages import load_inputs, fit_path, build_scene\n"
+        "from offline_prog.robot.model import ROBOTS_DIR\n"
+        f"inputs = load_inputs(__import__('pathlib').Path({str(CELLS / 'seal_plate_kr16.yaml')!r}),"
+        " ROBOTS_DIR)\n"
+        "fit_path(inputs); build_scene(inputs)\n"
+        "print(sorted(m for m in sys.modules if m == 'OCP' or m.startswith('OCP.')"
+        " or m.startswith('offline_prog.cad')))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", probe], cwd=REPO, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"

@@ -1,0 +1,178 @@
+"""Process I/O the plan cannot honour ends with one line and exit 2, nothing written.
+
+Reproductions (issue 24): ``flow.per_mps: -40`` clipped the flow to 0 V on the whole
+seam; on at 100 mm and off at 90 mm were accepted, as was an off switch before the
+seam's start; ``tool.process_io`` on a ``path:`` cell (also with ``job:`` written but
+empty) was ignored without a word.
+"""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from offline_prog.cli import main
+from offline_prog.config.cell import AnalogFlow, DigitalSwitch, ProcessIoConfig
+from offline_prog.io_events import Signal
+from offline_prog.job.assemble import JobSamples, Segment
+from offline_prog.job.process_io import IoPlacementError, io_columns
+
+from conftest import CELLS
+
+IO = (
+    "tool:\n  process_io:\n    on:  {digital_output: 1, lead_mm: 5}\n"
+    "    off: {digital_output: 1, lead_mm: 2}\n"
+    "    flow: {analog_output: 1, per_mps: 40.0, offset: 0.5}\n"
+)
+
+
+def run(capsys, tmp_path, cell_text: str) -> tuple[int, list[str]]:
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(cell_text)
+    capsys.readouterr()
+    code = main(["plan", str(cell), "--out", str(tmp_path / "out")])
+    return code, capsys.readouterr().err.strip().splitlines()
+
+
+def with_cell_dir(text: str) -> str:
+    return text.replace(": data/", f": {CELLS}/data/")
+
+
+@pytest.mark.parametrize(
+    ("flow", "key"),
+    [
+        ("per_mps: -40.0", "tool.process_io.flow.per_mps"),
+        ("per_mps: 0.0", "tool.process_io.flow.per_mps"),
+        ("per_mps: 40.0, lag_s: -0.05", "tool.process_io.flow.lag_s"),
+    ],
+)
+def test_flow_numbers_are_checked(capsys, tmp_path, flow, key):
+    text = (CELLS / "seal_job_kr16.yaml").read_text().replace("per_mps: 40.0", flow, 1)
+    code, err = run(capsys, tmp_path, text)
+    assert code == 2 and len(err) == 1 and f": {key}: " in err[0], err
+
+
+@pytest.mark.parametrize(
+    ("on_lead", "off_lead", "half_mm", "on_mm", "off_mm"),
+    [
+        (-100, 150, 120, 100.0, 90.0),  # the issue's case: off before on on the stripe
+        (5, 250, 120, -5.0, -10.0),  # off 250 mm before the 240 mm stripe's end
+        (0, 2, 0.5, 0.0, -1.0),  # a 1 mm seam with a 2 mm off lead
+    ],
+)
+def test_off_before_on_is_refused_naming_the_seam_and_both_positions(
+    capsys, tmp_path, on_lead, off_lead, half_mm, on_mm, off_mm
+):
+    from export.test_job_io import stripe_cell
+
+    text = stripe_cell(tmp_path, on_lead, off_lead).read_text()
+    text = text.replace(
+        "start: [-120, 80, 0], end: [120, 80, 0]",
+        f"start: [{-half_mm}, 80, 0], end: [{half_mm}, 80, 0]",
+    )
+    code, err = run(capsys, tmp_path, text)
+    assert code == 2 and len(err) == 1, err
+    assert "tool.process_io" in err[0] and "seam stripe" in err[0]
+    assert f"on at {on_mm:.1f} mm and off at {off_mm:.1f} mm" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+# --- the rule itself, on synthetic seams -----------------------------------------------
+
+
+def one_seam(length_m: float, approach_m: float, retract_m: float, speed=0.1, dt=0.004):
+    """JobSamples of link → approach → seam → retract → link at a constant speed, with
+    path_m the signed position along the seam's path [m]."""
+    pieces = [("link", np.zeros(3))]
+    for kind, a, b in (
+        ("approach", -approach_m, 0.0),
+        ("process", 0.0, length_m),
+        ("retract", length_m, length_m + retract_m),
+    ):
+        n = max(2, int(np.ceil((b - a) / (speed * dt))) + 1)
+        pieces.append((kind, np.linspace(a, b, n)[:-1]))
+    pieces.append(("link", np.full(3, np.nan)))
+    path = np.concatenate([p for _, p in pieces])
+    path[:3] = np.nan
+    t = np.arange(len(path)) * dt
+    segments, row = [], 0
+    for kind, p in pieces:
+        seam = "" if kind == "link" else "s"
+        segments.append(Segment(kind, seam, row, row + len(p), row * dt, (row + len(p)) * dt))
+        row += len(p)
+    q = np.zeros((len(t), 6))
+    return JobSamples(t, q, q, path, segments), np.where(np.isnan(path), 0.0, speed)
+
+
+def io_config(on_lead_mm, off_lead_mm, lag_s=0.0) -> ProcessIoConfig:
+    return ProcessIoConfig(
+        on=DigitalSwitch(digital_output=1, lead_mm=on_lead_mm),
+        off=DigitalSwitch(digital_output=1, lead_mm=off_lead_mm),
+        flow=AnalogFlow(analog_output=1, per_mps=40.0, offset=0.5, lag_s=lag_s),
+    )
+
+
+def test_a_1_mm_seam_with_a_2_mm_off_lead_is_refused():
+    """Off 1 mm before the seam's start: the seam would get no material."""
+    samples, speed = one_seam(0.001, 0.05, 0.05)
+    with pytest.raises(IoPlacementError, match=r"seam s: on at 0\.0 mm and off at -1\.0 mm"):
+        io_columns(samples, io_config(0.0, 2.0), {"s": 0.001}, speed)
+    with pytest.raises(IoPlacementError, match=r"never on while the seam"):
+        io_columns(samples, io_config(5.0, 2.0), {"s": 0.001}, speed)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(
+    length_mm=st.floats(1.0, 400.0),
+    approach_mm=st.floats(0.0, 60.0),
+    retract_mm=st.floats(0.0, 60.0),
+    on_lead_mm=st.floats(-450.0, 100.0),
+    off_lead_mm=st.floats(-100.0, 450.0),
+)
+def test_switch_positions_are_the_cells_or_refused(
+    length_mm, approach_mm, retract_mm, on_lead_mm, off_lead_mm
+):
+    """The events sit where the cell's leads put them along the seam, the output is on
+    exactly between them and the flow live only there; any other case is refused."""
+    L, a, r = length_mm * 1e-3, approach_mm * 1e-3, retract_mm * 1e-3
+    samples, speed = one_seam(L, a, r)
+    on, off = -on_lead_mm * 1e-3, L - off_lead_mm * 1e-3  # the cell's numbers
+    valid = -a - 1e-9 <= on < off <= L + r + 1e-9 and on < L and off > 0
+    if not valid:
+        with pytest.raises(IoPlacementError, match=r"seam s: on at .* and off at"):
+            io_columns(samples, io_config(on_lead_mm, off_lead_mm), {"s": L}, speed)
+        return
+    io = io_columns(samples, io_config(on_lead_mm, off_lead_mm), {"s": L}, speed)
+    digital = [e for e in io.events if e.signal is Signal.DIGITAL]
+    assert [e.state for e in digital] == [True, False]
+    assert [e.path_m for e in digital] == [pytest.approx(on), pytest.approx(off)]
+    path = samples.path_m
+    expected = (path >= on - 1e-9) & (path < off - 1e-9)
+    row_step = 0.1 * 0.004  # one sample at 0.1 m/s: a position between two rows
+    disagree = np.flatnonzero(io.digital.astype(bool) != expected)
+    assert all(min(abs(path[i] - on), abs(path[i] - off)) <= row_step for i in disagree)
+    assert np.array_equal(io.analog > 0.5 + 1e-9, io.digital.astype(bool))  # lag 0
+
+
+def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
+    """No on/off: the flow is live while the seam runs; its command leads by lag_s."""
+    samples, speed = one_seam(0.1, 0.03, 0.03)
+    lag = 0.02
+    io = ProcessIoConfig(flow=AnalogFlow(analog_output=1, per_mps=40.0, offset=0.5, lag_s=lag))
+    columns = io_columns(samples, io, {"s": 0.1}, speed)
+    assert columns.digital is None and columns.switches == []
+    live_t = samples.t[columns.analog > 0.5 + 1e-9]
+    process = next(s for s in samples.segments if s.kind == "process")
+    dt = np.diff(samples.t).max()
+    assert live_t[0] == pytest.approx(process.t_start - lag, abs=dt)
+    assert live_t[-1] == pytest.approx(process.t_stop - lag, abs=dt)
+    assert columns.analog.max() == pytest.approx(0.5 + 40.0 * 0.1)
+    assert [(e.state, e.path_m) for e in columns.events] == [(True, 0.0), (False, 0.1)]
+
+
+def test_a_lag_that_leads_before_the_approach_is_refused():
+    """The on switch is 25 mm into the 30 mm approach: 0.25 s at 0.1 m/s to lead in."""
+    samples, speed = one_seam(0.1, 0.03, 0.03)
+    with pytest.raises(IoPlacementError, match=r"flow.lag_s: 0.5 s before seam s's output"):
+        io_columns(samples, io_config(5.0, 2.0, lag_s=0.5), {"s": 0.1}, speed)
+    io_columns(samples, io_config(5.0, 2.0, lag_s=0.2), {"s": 0.1}, speed)  # 20 of 25 mm
