@@ -223,8 +223,8 @@ def main(argv: list[str] | None = None) -> int:
         out = args.out or Path("out") / args.cell.stem
         if args.command == "plan":
             check_out_dir(out)  # before planning: a bad --out is known now
-        # Progress on stderr only while stdout is a terminal: logs and pipes stay clean.
-        # Every cell is a job (path: is a one-seam job).
+        # Every cell is a job (path: one seam). Progress on stderr only while stdout is
+        # a terminal: logs and pipes stay clean.
         with PlanProgress(errors, enabled=console.is_terminal) as progress:
             plan = plan_job(args.cell, progress=progress)
             progress("writing outputs")

@@ -108,8 +108,8 @@ def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> li
     t = job.t[rows]
     grid = np.arange(0.0, t[-1] - t[0], period_s)
     grid = np.append(grid, t[-1] - t[0]) if t[-1] - t[0] - grid[-1] > 1e-9 else grid
-    q = joints_on_steps(t - t[0], job.q[rows], grid)  # on the checked joint steps
     grid = grid + t[0]  # the job's clock
+    q = joints_on_steps(t, job.q[rows], grid)
     # Event k is set before the first command whose sample is at or past its time.
     sets: dict[int, list] = {}
     for event in data.events:

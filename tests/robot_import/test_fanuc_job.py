@@ -1,49 +1,99 @@
 """A whole job on the imported M-20iA as FANUC LS programs, read back: the links go
 through the planned joints (FANUC axes), the positions reconstruct the planned flange
-poses, and the process output switches (DB distance-before) within ±1 mm of the asked
-positions along the path, as the KRL and RAPID job tests check."""
+poses, and the process output switches (DB distance-before) within ±1 mm of the
+positions computed here from the cell's ``lead_mm`` and the seam's length, as the KRL
+and RAPID job tests check. The stripe of issue 24 (``on.lead_mm: -100`` on a 240 mm
+straight seam: on and off on the same motion) keeps both switches, and the program's
+``AO`` values replayed along the path agree with the plan's ``ao`` column."""
 
+import csv
+import dataclasses
 import re
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 from fanuc_reader import joints_from_config, pose, read_ls
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
 
+from offline_prog.config.cell import load_cell
+from offline_prog.export.fanuc_job import write_fanuc_job
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 from offline_prog.robot_import.run import import_robot
 
 IO_TOL_M = 1e-3
 JOINT_TOL_DEG = 1e-3
+FLOW_TOL_V = 0.05  # a motion's AO value against the plan's column on its rows
 IO = (
     "tool:\n  process_io:\n    on:  {digital_output: 2, lead_mm: 3}\n"
     "    off: {digital_output: 2, lead_mm: 4}\n"
     "    flow: {analog_output: 1, per_mps: 30.0, offset: 1.0, min: 0.0, max: 10.0}\n"
 )
+# The stripe of cells/seal_job_kr16.yaml, alone (issue 24's case), on the M-20iA.
+START_P, END_P = np.array([-0.120, 0.080, 0.0]), np.array([0.120, 0.080, 0.0])
+LENGTH_M = float(np.linalg.norm(END_P - START_P))  # 240 mm
+ON_LEAD_MM, OFF_LEAD_MM, PER_MPS, OFFSET_V, LAG_S = -100.0, 2.0, 40.0, 0.5, 0.1
+SPEED_M_S = 0.15
+
+
+def _m20ia(work: Path) -> None:
+    import_robot(
+        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro", name="fanuc_m20ia", out=work / "robots",
+        package_paths=[FANUC], vendor="fanuc", samples=500,
+    )  # fmt: skip
+
+
+def _on_m20ia(text: str) -> str:
+    return text.replace("model: kuka_kr16_2\n", "model: fanuc_m20ia\n  robots_dir: robots\n")
 
 
 @pytest.fixture(scope="module")
 def fanuc_job(tmp_path_factory):
     work = tmp_path_factory.mktemp("fanuc_job")
-    import_robot(
-        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro", name="fanuc_m20ia", out=work / "robots",
-        package_paths=[FANUC], vendor="fanuc", samples=500,
-    )  # fmt: skip
-    text = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
-    text = text.replace("model: kuka_kr16_2\n", "model: fanuc_m20ia\n  robots_dir: robots\n")
+    _m20ia(work)
+    text = _on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
     text = text.replace("motion:", "job: {order: given}\nmotion:", 1).replace("tool:\n", IO, 1)
     cell = work / "seal_job_m20ia.yaml"
     cell.write_text(text)
     job = plan_job(cell)
     assert job.feasible, job.failure
     write_job_outputs(job, work / "out")
-    return JobProgramData.load(work / "out"), work / "out" / "programs", job.robot
+    return JobProgramData.load(work / "out"), work / "out" / "programs", job.robot, cell
+
+
+@pytest.fixture(scope="module")
+def stripe(tmp_path_factory):
+    """(JobProgramData, plan folder, robot) of the stripe with on.lead_mm −100."""
+    work = tmp_path_factory.mktemp("fanuc_stripe")
+    _m20ia(work)
+    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    head, rest = text.split("seams:", 1)
+    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
+    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
+    head = head.replace("lead_mm: 5}", f"lead_mm: {ON_LEAD_MM}}}")
+    head = head.replace("lead_mm: 2}", f"lead_mm: {OFF_LEAD_MM}}}")
+    head = head.replace("min: 0.0, max: 10.0}", f"min: 0.0, max: 10.0, lag_s: {LAG_S}}}")
+    cell = work / "stripe.yaml"
+    cell.write_text(
+        head + "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
+    )
+    io = load_cell(cell).tool.process_io
+    assert (io.on.lead_mm, io.off.lead_mm, io.flow.lag_s) == (ON_LEAD_MM, OFF_LEAD_MM, LAG_S)
+    assert (io.flow.per_mps, io.flow.offset) == (PER_MPS, OFFSET_V)
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, work / "plan")
+    return JobProgramData.load(work / "plan"), work / "plan", job.robot
 
 
 def _run(folder, name="OFFLINE_PROG"):
-    """Motion statements in execution order: (statement, position entry)."""
+    """Statements in execution order: (statement, position entry or None)."""
     out = []
 
     def read(program):
@@ -53,37 +103,24 @@ def _run(folder, name="OFFLINE_PROG"):
                 read(statement.split()[1])
             elif m := re.match(r"([JL]) P\[(\d+)\]", statement):
                 out.append((statement, ls["pos"][int(m[2])]))
-            elif statement.startswith("AO["):
+            elif statement.startswith(("AO[", "DO[")):
                 out.append((statement, None))
 
     read(name)
     return out
 
 
-def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
-    data, folder, robot = fanuc_job
-    _check_job(data, folder, robot)
-    # With a line limit each seam runs as called parts that switch at the same places.
-    from offline_prog.export.formats import export
-
-    files = export(data, "fanuc", tmp_path, line_limit=100)
-    assert len(files) > 2 and all(len(read_ls(f)["mn"]) <= 100 for f in files)
-    _check_job(data, tmp_path, robot)
-
-
-def _check_job(data, folder, robot):
-    run = _run(folder)
-    joints = [np.radians(e["joints"]) for s, e in run if s.startswith("J ")]
-    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
-    np.testing.assert_allclose(
-        np.degrees(joints), np.degrees(robot.controller_joints(np.array(planned))),
-        atol=JOINT_TOL_DEG,
-    )  # fmt: skip
+def _walk(data, folder, robot):
+    """Replays the program: per seam (in run order), the DB switches as (output, state,
+    position [m]) and the L motions as (start, end [m], AO value), positions along the
+    tool's path on the part from the seam's start, from the program's own poses."""
     X_PE, p_BT = np.linalg.inv(data.job.X_EP), data.job.X_BT[:3, 3]
-    here, position, switched, flows, approach = None, 0.0, {}, [], None
-    for statement, entry in run:
+    here, cumulative, ao, seams = None, 0.0, None, []
+    starts = [seam.X_PF[0, :3, 3] for seam in data.seams]  # the seams' planned starts
+    for statement, entry in _run(folder):
         if entry is None:
-            flows.append(float(statement.split("=")[1]))
+            assert statement.startswith("AO["), statement  # no plain DO statements
+            ao = float(statement.split("=")[1])
             continue
         if statement.startswith("J "):
             q = robot.urdf_joints(np.radians(entry["joints"])[None])[0]
@@ -94,22 +131,164 @@ def _check_job(data, folder, robot):
             np.testing.assert_allclose(robot.forward(q[None])[0], X_BE, atol=1e-9)
         X_BP = X_BE @ data.job.X_EP
         p_PT = X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])  # the fixed tool's point on the part
-        if statement.startswith("J "):  # a link ends where the approach starts
-            position, approach = 0.0, None
-        else:  # along the tool's path on the part, from the approach's start
+        if statement.startswith("J "):
+            if seams and "open" in seams[-1]:
+                del seams[-1]["open"]
+            cumulative = 0.0
+        else:
+            if not seams or "open" not in seams[-1]:
+                seams.append({"open": True, "db": [], "moves": []})
             step = np.linalg.norm(p_PT - here)
-            approach = step if approach is None else approach
-            if "DB" in statement:
-                d = float(re.search(r"DB ([\d.]+)mm", statement)[1]) * 1e-3
-                state = re.search(r"DO\[\d+\]=(ON|OFF)", statement)[1] == "ON"
-                switched[state] = position + step - d - approach  # from the seam's start
-            position += step
+            seams[-1]["moves"].append((cumulative, cumulative + step, ao))
+            assert len(re.findall(r"\bDB\b", statement)) <= 1, statement
+            if m := re.search(r"DB ([\d.]+)mm,DO\[(\d+)\]=(ON|OFF)", statement):
+                d = float(m[1]) * 1e-3
+                seams[-1]["db"].append((int(m[2]), m[3] == "ON", cumulative + step - d))
+            cumulative += step
+            start = starts[len(seams) - 1]
+            if "zero" not in seams[-1] and np.linalg.norm(p_PT - start) < 1e-6:
+                seams[-1]["zero"] = cumulative  # the approach ends at the seam's start
         here = p_PT
-    on, off = data.switch_positions(0)
-    assert switched[True] == pytest.approx(on, abs=IO_TOL_M)
-    assert switched[False] == pytest.approx(off, abs=IO_TOL_M)
-    io = data.process_io
-    assert flows[-1] == 0 and all(io.min <= v <= io.max for v in flows)
-    assert max(flows) == pytest.approx(
-        io.offset + io.per_mps * data.job.process_speed_m_s, abs=0.05
+    for seam in seams:
+        zero = seam.pop("zero")
+        seam["db"] = [(n, s, p - zero) for n, s, p in seam["db"]]
+        seam["moves"] = [(a - zero, b - zero, v) for a, b, v in seam["moves"]]
+        seam.pop("open", None)
+    return seams
+
+
+def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
+    data, folder, robot, cell = fanuc_job
+    _check_job(data, folder, robot, cell)
+    # With a line limit each seam runs as called parts that switch at the same places.
+    from offline_prog.export.formats import export
+
+    files = export(data, "fanuc", tmp_path, line_limit=100)
+    assert len(files) > 2 and all(len(read_ls(f)["mn"]) <= 100 for f in files)
+    _check_job(data, tmp_path, robot, cell)
+
+
+def _check_job(data, folder, robot, cell):
+    run = _run(folder)
+    joints = [np.radians(e["joints"]) for s, e in run if s.startswith("J ")]
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(
+        np.degrees(joints), np.degrees(robot.controller_joints(np.array(planned))),
+        atol=JOINT_TOL_DEG,
+    )  # fmt: skip
+    io = load_cell(cell).tool.process_io
+    seams = _walk(data, folder, robot)
+    assert len(seams) == len(data.seam_names)
+    for k, seam in enumerate(seams):
+        on, off = -io.on.lead_mm * 1e-3, data.seam_lengths_m[k] - io.off.lead_mm * 1e-3
+        assert [(n, s) for n, s, _ in seam["db"]] == [(2, True), (2, False)]
+        assert seam["db"][0][2] == pytest.approx(on, abs=IO_TOL_M)
+        assert seam["db"][1][2] == pytest.approx(off, abs=IO_TOL_M)
+        # The flow (lag 0): live from the on switch to the off switch, idle outside.
+        flow = io.flow
+        for a, b, v in seam["moves"]:
+            if b <= on - IO_TOL_M or a >= off + IO_TOL_M:
+                assert v == pytest.approx(flow.offset), (a, b, v)
+            elif on + IO_TOL_M <= a and b <= off - IO_TOL_M:
+                assert flow.offset < v <= flow.max
+    live = [v for seam in seams for _, _, v in seam["moves"] if v > io.flow.offset]
+    assert max(live) == pytest.approx(
+        io.flow.offset + io.flow.per_mps * data.job.process_speed_m_s, abs=0.05
     )
+
+
+def test_fanuc_keeps_both_switches_on_a_straight_seam(stripe, tmp_path):
+    """Issue 24's case: on 100 mm into the stripe, off 2 mm before its end."""
+    data, _, robot = stripe
+    write_fanuc_job(data, tmp_path)
+    (seam,) = _walk(data, tmp_path, robot)
+    on, off = -ON_LEAD_MM * 1e-3, LENGTH_M - OFF_LEAD_MM * 1e-3
+    assert [(n, s) for n, s, _ in seam["db"]] == [(1, True), (1, False)]
+    assert seam["db"][0][2] == pytest.approx(on, abs=IO_TOL_M)
+    assert seam["db"][1][2] == pytest.approx(off, abs=IO_TOL_M)
+    statements = [s for f in tmp_path.glob("*.ls") for s in read_ls(f)["mn"]]
+    assert sum("DO[" in s for s in statements if not s.startswith("!")) == 2  # not the flow
+    # The flow goes live lag_s ahead of the on switch (at the stripe's speed).
+    first = next(a for a, _, v in seam["moves"] if v > OFFSET_V + 0.01)
+    assert first == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
+    last = max(b for _, b, v in seam["moves"] if v > OFFSET_V + 0.01)
+    assert off - SPEED_M_S * LAG_S - IO_TOL_M <= last < off
+
+
+def test_fanuc_flow_replays_the_plans_ao_column(stripe, tmp_path):
+    """Each planned row's ``ao1`` (trajectory.csv) against the AO value the program
+    holds where the tool is at that row (its position from the row's joints)."""
+    data, folder, robot = stripe
+    write_fanuc_job(data, tmp_path)
+    (seam,) = _walk(data, tmp_path, robot)
+    with open(folder / "trajectory.csv") as f:
+        rows = [r for r in csv.DictReader(f) if r["segment"] != "link"]  # the stripe's
+    q = np.array([[float(r[f"q{j}"]) for j in range(1, 7)] for r in rows])  # [rad]
+    X_BP = robot.forward(q) @ data.job.X_EP
+    p_PT = np.einsum("nji,nj->ni", X_BP[:, :3, :3], data.job.X_BT[:3, 3] - X_BP[:, :3, 3])
+    position = (p_PT - START_P) @ (END_P - START_P) / LENGTH_M
+    planned = np.array([float(r["ao1"]) for r in rows])
+    edges = [a for a, _, _ in seam["moves"]]
+    checked = 0
+    for x, ao in zip(position, planned, strict=True):
+        held = [v for a, b, v in seam["moves"] if a < x <= b]
+        if not held or min(abs(x - e) for e in edges) < IO_TOL_M:
+            continue  # at the approach's start, or within 1 mm of an L point
+        checked += 1
+        assert held[0] == pytest.approx(ao, abs=FLOW_TOL_V), x
+    assert checked > 0.5 * len(rows)  # the rest: at rest, or within 1 mm of a point
+    assert planned.max() > OFFSET_V + 1 and min(v for _, _, v in seam["moves"]) == OFFSET_V
+
+
+@settings(max_examples=8, deadline=None, derandomize=True)
+@given(
+    positions_mm=st.lists(st.floats(-25.0, 265.0), min_size=2, max_size=6, unique=True)
+    .map(sorted)
+    .filter(lambda p: len(p) % 2 == 0 and min(np.diff(p)) > 2.0)
+)
+def test_fanuc_switches_where_the_events_say(stripe, positions_mm):
+    """On/off pairs anywhere on the stripe's approach, seam and retract, several on one
+    motion: every one becomes a DB option at its position, in order."""
+    data, _, robot = stripe
+    events = tuple(
+        IoEvent("stripe", Signal.DIGITAL, 1, k % 2 == 0, float(k % 2 == 0), p * 1e-3, 0.0, p * 1e-3)
+        for k, p in enumerate(positions_mm)
+    )
+    data = dataclasses.replace(data, events=events)
+    with tempfile.TemporaryDirectory() as folder:
+        write_fanuc_job(data, Path(folder))
+        (seam,) = _walk(data, Path(folder), robot)
+    assert [s for _, s, _ in seam["db"]] == [k % 2 == 0 for k in range(len(positions_mm))]
+    assert [p for _, _, p in seam["db"]] == [
+        pytest.approx(p * 1e-3, abs=IO_TOL_M) for p in positions_mm
+    ]
+
+
+def test_fanuc_refuses_switches_no_sample_separates(stripe, tmp_path):
+    data, _, _ = stripe
+    events = tuple(
+        IoEvent("stripe", Signal.DIGITAL, 1, state, float(state), x, 0.0, x)
+        for state, x in ((True, 0.1), (False, 0.1 + 1e-5))
+    )
+    with pytest.raises(ValueError, match=r"seam stripe: .* 100\.000 mm and at 100\.010 mm"):
+        write_fanuc_job(dataclasses.replace(data, events=events), tmp_path)
+
+
+def test_plan_refuses_switches_no_sample_separates_in_one_line(tmp_path, capsys):
+    """A cell whose on and off switches lie 0.01 mm apart: no FANUC motion can carry
+    both DB options, so planning stops with one line naming the seam, exit 2."""
+    from offline_prog.cli import main
+
+    _m20ia(tmp_path)
+    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    head, rest = text.split("seams:", 1)
+    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
+    head = head.replace("lead_mm: 5}", "lead_mm: -100}").replace("lead_mm: 2}", "lead_mm: 139.99}")
+    cell = tmp_path / "crowded.yaml"
+    cell.write_text(head + "seams:\n" + seam + rest[rest.index("job:") :])
+    capsys.readouterr()
+    code = main(["plan", str(cell), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "crowded.yaml: tool.process_io: seam stripe:" in err[0]
+    assert "100.000 mm and at 100.010 mm" in err[0]

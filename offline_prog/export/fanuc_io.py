@@ -1,0 +1,190 @@
+"""The plan's I/O events on a seam's FANUC ``L`` points, with FANUC's rules.
+
+FANUC's distance-before motion option (``L P[i] ... DB d mm,DO[n]=ON``) sets the output
+when the TCP comes within d of the motion's destination, and a motion statement takes
+ONE such option. The analog flow is set with plain ``AO[n]=value`` statements, which
+take effect when the statement runs: when the motion after them starts. So a seam's
+chain of ``L`` points (approach, seam, retract) is split at planned samples until
+
+- every analog event (the flow going live or back to idle, at ``IoEvent.set_path_m``:
+  ``lag_s`` ahead, since FANUC does not lead by the dispenser's lag itself) starts a
+  motion: the planned sample nearest its position becomes an ``L`` point;
+- every motion holds at most one digital event: where two fall on one motion, the
+  first planned sample at or after the earlier one becomes an ``L`` point;
+- while the flow is live, the plan's flow (the ``ao`` column: the flow at the speed the
+  tool has ``lag_s`` later) varies by at most ``FLOW_STEP_V`` on a motion (where the
+  tool speeds up or slows down, a planned sample starts a new motion), and the motion's
+  value is the middle of that range.
+
+Every inserted point is a planned sample (trajectory.csv's rows on the approach and
+retract, the seam's densified samples on the seam), so the program still moves through
+the plan. Positions are the seam's path positions σ [m] (negative on the approach,
+beyond L on the retract), as the events'.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+import numpy as np
+
+from offline_prog.io_events import IoEvent, ProcessIo, Signal
+
+SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
+FLOW_STEP_V = 0.05  # a live motion's AO value is within half this of the plan's flow on it
+
+
+@dataclasses.dataclass(frozen=True)
+class Samples:
+    """A seam's planned samples from its approach's start to its retract's end.
+
+    Attributes:
+        sigma: (K,) path position [m], non-decreasing.
+        t: (K,) job time [s].
+        q: (K, 6) URDF joints [rad].
+        X_BP: (K, 4, 4) the part P in the robot base B.
+    """
+
+    sigma: np.ndarray
+    t: np.ndarray
+    q: np.ndarray
+    X_BP: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
+class Motion:
+    """One ``L`` motion from sample ``start`` to sample ``end`` (indices into Samples):
+    ``event`` the digital event it switches (None: none) ``before_end_m`` [m] before
+    its end; ``flow`` the value [V] of the flow output while it runs (None: no flow)."""
+
+    start: int
+    end: int
+    event: IoEvent | None = None
+    before_end_m: float = 0.0
+    flow: float | None = None
+
+
+def place_events(
+    samples: Samples,
+    points: list[int],
+    events: list[IoEvent],
+    *,
+    seam: str,
+    io: ProcessIo | None,
+    flow_at: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> list[Motion]:
+    """The seam's ``L`` motions with its events on them, split at planned samples.
+
+    Args:
+        samples: the seam's planned samples (candidates for ``L`` points).
+        points: sorted indices of the ``L`` points before splitting; ``points[0]`` is
+            where the robot already is (the approach's start).
+        events: the seam's I/O events (the plan's).
+        seam: its name, for errors.
+        io: the process I/O (None: no flow values).
+        flow_at: the live flow's values [V] at job times (n,) [s] (the plan's).
+
+    Returns:
+        The motions in run order (at most one digital event each).
+
+    Raises:
+        ValueError: two digital events fall between the same two planned samples, so
+            no ``L`` point can separate them (names the seam and both positions).
+    """
+    points = sorted(set(points))
+    sigma = samples.sigma
+    analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
+    edges = [(sigma[_split(sigma, points, e.set_path_m)], e.state) for e in analog]
+    digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.path_m)
+    while (pair := _crowded(sigma, points, digital)) is not None:
+        first, second = pair
+        inside = np.flatnonzero(
+            (sigma >= first.path_m - SAME_POINT_M) & (sigma < second.path_m - SAME_POINT_M)
+        )
+        inside = [i for i in inside if all(abs(sigma[i] - sigma[p]) > SAME_POINT_M for p in points)]
+        if not inside:
+            raise ValueError(
+                f"seam {seam}: the output switches at {first.path_m * 1e3:.3f} mm and at "
+                f"{second.path_m * 1e3:.3f} mm along its path with no planned sample "
+                "between them: a FANUC motion takes one DB option"
+            )
+        points = sorted({*points, int(inside[0])})
+    if io is not None and io.analog_output is not None:
+        points = _flow_splits(samples, points, edges, flow_at)
+    on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
+    assert len(on_motion) == len(digital), "one digital event per motion"
+    motions = []
+    for i in range(1, len(points)):
+        a, b = points[i - 1], points[i]
+        event = on_motion.get(i)
+        before = 0.0 if event is None else float(min(sigma[b] - event.path_m, sigma[b] - sigma[a]))
+        motions.append(
+            Motion(a, b, event, max(before, 0.0), _flow(samples, a, b, edges, io, flow_at))
+        )
+    return motions
+
+
+def _live(samples: Samples, a: int, edges) -> bool:
+    """Whether the flow is live on the motion from sample a (the edges before it)."""
+    live = False
+    for position, state in edges:
+        if position <= samples.sigma[a] + SAME_POINT_M:
+            live = state
+    return live
+
+
+def _flow(samples, a, b, edges, io, flow_at) -> float | None:
+    """The flow while the motion a → b runs: live between the edges, else idle."""
+    if io is None or io.analog_output is None:
+        return None
+    if not _live(samples, a, edges):
+        return io.idle
+    values = flow_at(samples.t[a : b + 1])
+    return float(values.max() + values.min()) / 2
+
+
+def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
+    """Points split so the plan's flow varies by at most FLOW_STEP_V on a live motion."""
+    out = [points[0]]
+    for a, b in zip(points, points[1:], strict=False):
+        if _live(samples, a, edges):
+            values = flow_at(samples.t[a : b + 1])
+            start = 0
+            for k in range(1, len(values)):
+                span = values[start : k + 1]
+                moved = samples.sigma[a + k - 1] - samples.sigma[out[-1]] > SAME_POINT_M
+                if span.max() - span.min() > FLOW_STEP_V and k - 1 > start and moved:
+                    start = k - 1  # no L motion of zero length: at rest the flow waits
+                    out.append(a + start)
+        out.append(b)
+    return out
+
+
+def _split(sigma: np.ndarray, points: list[int], position: float) -> int:
+    """Make the planned sample nearest ``position`` an L point (in place); its index."""
+    i = int(np.argmin(np.abs(sigma - position)))
+    for p in points:
+        if abs(sigma[p] - sigma[i]) <= SAME_POINT_M:
+            return p
+    if sigma[points[0]] < sigma[i] < sigma[points[-1]]:
+        points.append(i)
+        points.sort()
+        return i
+    return points[0] if sigma[i] <= sigma[points[0]] else points[-1]
+
+
+def _motion_of(sigma: np.ndarray, points: list[int], position: float) -> int:
+    """The motion (index of its end in points, ≥ 1) that ends at or past position."""
+    for m in range(1, len(points)):
+        if sigma[points[m]] >= position - 1e-9:
+            return m
+    return len(points) - 1
+
+
+def _crowded(sigma, points, digital) -> tuple[IoEvent, IoEvent] | None:
+    """The first two digital events on one motion, in path order (None: none)."""
+    for first, second in zip(digital, digital[1:], strict=False):
+        if _motion_of(sigma, points, first.path_m) == _motion_of(sigma, points, second.path_m):
+            return first, second
+    return None
