@@ -121,66 +121,77 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
     program = plan_dir / "programs" / "OFFLINE_PROG.ls"
     _check_program(program, plan_dir, load_robot("fanuc_m20ia", out))
     # A line limit splits the moves into called sub-programs that run the same points.
-    whole = read_ls(program)["pos"]
+    whole = _targets(program)
     run = subprocess.run(
         [sys.executable, "-m", "offline_prog", "export", str(plan_dir), "--format", "fanuc",
          "--line-limit", "100", "--out", str(tmp_path / "split")],
         cwd=REPO, capture_output=True, text=True, timeout=600,
     )  # fmt: skip
     assert run.returncode == 0, run.stderr
-    main = read_ls(tmp_path / "split" / "OFFLINE_PROG.ls")
-    calls = [s.split()[1] for s in main["mn"] if s.startswith("CALL ")]
-    assert len(calls) > 1 and len(main["mn"]) <= 100
-    points = list(main["pos"].values())
-    for sub in calls:
-        part = read_ls(tmp_path / "split" / f"{sub}.ls")
-        assert len(part["mn"]) <= 100
-        points += list(part["pos"].values())
-    assert [p.get("xyzwpr", p.get("joints")) for p in points] == [
-        p.get("xyzwpr", p.get("joints")) for p in whole.values()
-    ]
+    split = tmp_path / "split"
+    assert len(list(split.glob("*.ls"))) > len(list(program.parent.glob("*.ls")))
+    assert all(len(read_ls(f)["mn"]) <= 100 for f in split.glob("*.ls"))
+    assert _targets(split / "OFFLINE_PROG.ls") == whole
+
+
+def _targets(file: Path, out: list | None = None) -> list:
+    """Every motion's target (xyzwpr or joints) in execution order, calls followed."""
+    out = [] if out is None else out
+    ls = read_ls(file)
+    for statement in ls["mn"]:
+        if statement.startswith("CALL "):
+            _targets(file.with_name(f"{statement.split()[1]}.ls"), out)
+        elif m := re.match(r"[JL] P\[(\d+)\]", statement):
+            entry = ls["pos"][int(m[1])]
+            out.append(entry.get("xyzwpr", entry.get("joints")))
+    return out
 
 
 def _check_program(program: Path, plan_dir: Path, robot):
-    """J to the approach (20 mm off the surface), L onto the first process point, the
-    process points (each the FK of a planned sample, in order), L 20 mm back off."""
+    """The seal demo is a one-seam job (issue 24): every motion of the program (``J`` to
+    joints, ``L`` to a pose, sub-programs followed) goes to a row of trajectory.csv, in
+    order, from the plan's first row (home) to its last (home again): J targets equal a
+    row's joints (FANUC axes) within 1e-3 deg, L poses a row's flange pose (FK)."""
+    import csv
+
     from offline_prog.export.program import ProgramData
 
     data = ProgramData.load(plan_dir)
-    ls = read_ls(program)
-    moves = [s for s in ls["mn"] if s.startswith(("J ", "L "))]
-    assert moves[0].startswith("J P[1]") and moves[-1].endswith("FINE")
-    assert all(re.match(r"L P\[\d+\] \d+mm/sec (CNT100|FINE)", m) for m in moves[1:])
-    X_PE, p_BT = np.linalg.inv(data.X_EP), data.X_BT[:3, 3]
+    with open(plan_dir / "trajectory.csv") as stream:
+        rows = list(csv.DictReader(stream))
+    q_plan = np.array([[float(r[f"q{i}"]) for i in range(1, 7)] for r in rows])
+    X_plan, X_PE = robot.forward(q_plan), np.linalg.inv(data.X_EP)
+    q_axes = np.degrees(robot.controller_joints(q_plan))
+    moves = []
 
-    def tool_in_part(X_BE):  # p_PT: where the fixed tool's origin is on the part
-        X_BP = X_BE @ data.X_EP
-        return X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])
+    def read(file: Path):
+        ls = read_ls(file)
+        for statement in ls["mn"]:
+            if statement.startswith("CALL "):
+                read(file.with_name(f"{statement.split()[1]}.ls"))
+            elif m := re.match(r"([JL]) P\[(\d+)\]", statement):
+                moves.append((m[1], ls["pos"][int(m[2])]))
 
-    start = robot.urdf_joints(np.radians(ls["pos"][1]["joints"])[None])
-    off = np.linalg.norm(tool_in_part(robot.forward(start)[0]) - data.X_PF[0, :3, 3])
-    assert off == pytest.approx(0.020, abs=POSITION_TOL_M)
-    X_plan, i = robot.forward(data.q), 0
-    entries = list(ls["pos"].items())[1:]
-    for k, entry in entries[:-1]:
-        X = pose(entry["xyzwpr"]) @ X_PE  # the written TCP is P (UTOOL[1] = X_EP)
-        q = joints_from_config(robot, X, entry["config"], entry["turns"])
-        # the planned sample this point was written from (points follow the plan in
-        # order): the reconstructed flange pose and joints must equal its FK and joints
-        # (the first one within tolerance: a closed seam ends where it starts)
-        gap = np.linalg.norm(X_plan[i:, :3, 3] - X[:3, 3], axis=1)
-        near = np.flatnonzero(gap <= POSITION_TOL_M)
-        i += int(near[0] if len(near) else np.argmin(gap))
-        assert np.linalg.norm(X_plan[i, :3, 3] - X[:3, 3]) <= POSITION_TOL_M, k
-        R_err = X_plan[i, :3, :3].T @ X[:3, :3]
-        angle = np.degrees(np.arccos(np.clip((np.trace(R_err) - 1) / 2, -1, 1)))
-        assert angle <= ANGLE_TOL_DEG, k
-        assert np.abs(robot.forward(q[None])[0] - X).max() < 1e-9
-        assert np.abs(q - data.q[i]).max() < np.radians(1e-3), k
-    assert np.linalg.norm(X_plan[-1, :3, 3] - X[:3, 3]) <= POSITION_TOL_M  # the plan's end
-    retract = pose(entries[-1][1]["xyzwpr"]) @ X_PE
-    off = np.linalg.norm(tool_in_part(retract) - data.X_PF[-1, :3, 3])
-    assert off == pytest.approx(0.020, abs=POSITION_TOL_M)
+    read(program)
+    assert moves and moves[0][0] == "J"
+    at = 0
+    for k, (kind, entry) in enumerate(moves):
+        if kind == "J":
+            gap = np.abs(q_axes - np.asarray(entry["joints"])).max(axis=1)
+            found = np.flatnonzero(gap <= 1e-3)
+        else:
+            X = pose(entry["xyzwpr"]) @ X_PE  # the written TCP is P (UTOOL[1] = X_EP)
+            q = joints_from_config(robot, X, entry["config"], entry["turns"])
+            assert np.abs(robot.forward(q[None])[0] - X).max() < 1e-9
+            gap = np.linalg.norm(X_plan[:, :3, 3] - X[:3, 3], axis=1)
+            R = np.einsum("nji,jk->nik", X_plan[:, :3, :3], X[:3, :3])
+            angle = np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1) / 2, -1, 1)))
+            found = np.flatnonzero((gap <= POSITION_TOL_M) & (angle <= ANGLE_TOL_DEG))
+        later = found[found >= at]
+        assert len(later), f"motion {k} ({kind}) is not a planned row after row {at}"
+        at = int(later[0])
+    assert 0 in np.flatnonzero(np.abs(q_axes - np.asarray(moves[0][1]["joints"])).max(1) <= 1e-3)
+    assert len(rows) - 1 in found  # the last motion ends where the plan does: home
 
 
 @pytest.mark.parametrize(
