@@ -38,10 +38,11 @@ def with_cell_dir(text: str) -> str:
     return text.replace(": data/", f": {CELLS}/data/")
 
 
-@pytest.mark.parametrize("job", ["", "job:\n"])
-def test_process_io_on_a_path_cell_switches_its_outputs(capsys, tmp_path, job):
-    """A path: cell is a one-seam job (also with an empty job:): its process I/O is
-    planned, not ignored: the output is on along the seam and off at home."""
+def test_process_io_on_a_path_cell_with_an_empty_job_switches_its_outputs(capsys, tmp_path):
+    """A path: cell is a one-seam job, also with ``job:`` written but empty (without
+    it: tests/test_pipeline.py): its process I/O is planned, not ignored: the output is
+    on along the seam and off at home."""
+    job = "job:\n"
     text = (CELLS / "seal_plate_kr16.yaml").read_text().replace("tool:\n", IO, 1)
     code, err = run(capsys, tmp_path, with_cell_dir(text.replace("motion:", job + "motion:", 1)))
     assert code == 0, err

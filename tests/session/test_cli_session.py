@@ -47,6 +47,7 @@ def test_a_bad_cell_is_one_line_exit_2(capsys, tmp_path):
     assert code == 2 and len(err) == 1 and "motion.speed" in err[0], err
 
 
+@pytest.mark.slow  # two session starts (CI runs the slow tests too)
 def test_a_session_restarts_on_the_same_port_right_after_ctrl_c(tmp_path):
     cell = copy_cell("tape_cylinder_ur10e.yaml", tmp_path)
     port = free_port_pair()
@@ -62,6 +63,7 @@ def test_a_session_restarts_on_the_same_port_right_after_ctrl_c(tmp_path):
         assert second.stop() == 130
 
 
+@pytest.mark.slow  # two session starts (CI runs the slow tests too)
 def test_a_session_on_ipv6_loopback(tmp_path):
     try:
         port = free_port_pair("::1")
