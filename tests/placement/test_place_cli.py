@@ -102,8 +102,17 @@ def test_ctrl_c_stops_the_workers_exit_130_one_line_no_folder(tmp_path):
          "--workers", "2"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
     )  # fmt: skip
-    time.sleep(12)  # the cluster is up and screening
-    assert process.poll() is None
+    # Wait until the LocalCluster's worker processes run (they share the command's
+    # process group), then interrupt it while it screens: no fixed 12 s sleep.
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and process.poll() is None:
+        group = subprocess.run(["pgrep", "-g", str(process.pid)], capture_output=True, text=True)
+        if len(group.stdout.split()) >= 3:  # the command and its 2 worker processes
+            break
+        time.sleep(0.2)
+    assert process.poll() is None, process.communicate()[1]
+    assert len(group.stdout.split()) >= 3, "the cluster's workers never started"
+    time.sleep(3.0)  # the workers have imported the planner and take candidates
     os.killpg(process.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
     try:
         _, err = process.communicate(timeout=30)
