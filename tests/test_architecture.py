@@ -1,6 +1,7 @@
 """The house shows its design: layer contracts hold, no import circles, small modules."""
 
 import ast
+import subprocess
 import sys
 from pathlib import Path
 
@@ -74,6 +75,19 @@ def test_modules_are_small_or_say_why():
             too_long.append(f"{file.relative_to(PACKAGE.parent)} ({lines} lines)")
     listed = ", ".join(too_long)
     assert not too_long, f"modules over {MAX_MODULE_LINES} lines without a reason: {listed}"
+
+
+def test_code_is_ruff_formatted():
+    """`ruff format` decides the layout of the package, its tests and scripts (what CI runs)."""
+    pytest.importorskip("ruff")
+    root = PACKAGE.parent
+    done = subprocess.run(
+        [sys.executable, "-m", "ruff", "format", "--check", "offline_prog", "tests", "scripts"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, "run `python3 -m ruff format .`:\n" + done.stdout + done.stderr
 
 
 def test_robot_descriptions_are_package_data():
