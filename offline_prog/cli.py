@@ -25,10 +25,21 @@ EXIT_INTERNAL = 3
 EXIT_INTERRUPTED = 130  # Ctrl-C, as shells report SIGINT
 # OSErrors the user's machine causes, not our code: exit 2 naming the path.
 USER_ERRNOS = {
-    errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.ENOTDIR,
-    errno.EISDIR, errno.EEXIST, errno.ENOENT, errno.ENAMETOOLONG, errno.EMFILE, errno.EXDEV,
-    errno.ELOOP, errno.EIO,
-}  # fmt: skip
+    errno.EACCES,
+    errno.EPERM,
+    errno.ENOSPC,
+    errno.EDQUOT,
+    errno.EROFS,
+    errno.ENOTDIR,
+    errno.EISDIR,
+    errno.EEXIST,
+    errno.ENOENT,
+    errno.ENAMETOOLONG,
+    errno.EMFILE,
+    errno.EXDEV,
+    errno.ELOOP,
+    errno.EIO,
+}
 
 
 def _export_options(args) -> dict:
@@ -102,8 +113,11 @@ def _run_place(args, console: Console, errors: Console) -> str:
     from offline_prog.placement.run import place_cell
 
     out = args.out or Path("out") / f"{args.cell.stem}_place"
-    labels = {"screen": "screening (path IK)", "plan": "planning candidates",
-              "outputs": "writing outputs"}  # fmt: skip
+    labels = {
+        "screen": "screening (path IK)",
+        "plan": "planning candidates",
+        "outputs": "writing outputs",
+    }
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
     with Progress(*columns, console=errors, transient=True) as bar:
         tasks = {}
@@ -114,9 +128,14 @@ def _run_place(args, console: Console, errors: Console) -> str:
             bar.update(tasks[stage], completed=done)
 
         data = place_cell(
-            args.cell, out, budget=args.budget, seed=args.seed, workers=args.workers,
-            scheduler=args.scheduler, progress=progress,
-        )  # fmt: skip
+            args.cell,
+            out,
+            budget=args.budget,
+            seed=args.seed,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=progress,
+        )
     from offline_prog.atomic import read_manifest
 
     best, cut, engine = data["best"], data["cycle_time_cut"], data["engine"]
@@ -208,8 +227,14 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "session":
             from offline_prog.session.launch import run_session
 
-            run_session(args.cell, host=args.host, port=args.port, seconds=args.seconds,
-                        open_browser=not args.no_browser, say=console.print)  # fmt: skip
+            run_session(
+                args.cell,
+                host=args.host,
+                port=args.port,
+                seconds=args.seconds,
+                open_browser=not args.no_browser,
+                say=console.print,
+            )
             return 0
         if args.command == "place":  # no feasible placement: outputs written, exit 1
             failed = _run_place(args, console, errors)

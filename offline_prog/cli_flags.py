@@ -80,10 +80,12 @@ def parser() -> argparse.ArgumentParser:
     plan = commands.add_parser("plan", help="plan a cell and write the outputs")
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
     plan.add_argument(
-        "--out", type=Path, default=None,
+        "--out",
+        type=Path,
+        default=None,
         help="output folder (default: out/<file stem>, e.g. out/seal_plate_kr16 for "
         "cells/seal_plate_kr16.yaml)",
-    )  # fmt: skip
+    )
     plan.add_argument(
         "--preview", action="store_true", help="also show the plan in MeshCat (see `preview`)"
     )
@@ -114,15 +116,19 @@ def parser() -> argparse.ArgumentParser:
     )
     matrix.add_argument("robot", help="robot folder name, e.g. ur10e")
     matrix.add_argument(
-        "--samples", type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
-        default=10_000, help="configurations (10000)",
-    )  # fmt: skip
+        "--samples",
+        type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
+        default=10_000,
+        help="configurations (10000)",
+    )
     matrix.add_argument("--seed", type=int, default=0, help="random seed (0)")
     matrix.add_argument(
-        "--out", type=Path, default=Path("."),
+        "--out",
+        type=Path,
+        default=Path("."),
         help="file, or folder for self_collision.yaml (default: the current folder); "
         "the planner reads the one in the robot's folder",
-    )  # fmt: skip
+    )
     export = commands.add_parser("export", help="re-export programs from a finished plan")
     export.add_argument("plan_dir", type=Path, help="folder written by `offline-prog plan`")
     export.add_argument(
@@ -180,16 +186,19 @@ def _session_flags(commands) -> None:
     )
     session.add_argument("cell", type=Path, help="work-cell YAML file")
     session.add_argument(
-        "--port", type=_number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT - 1),
+        "--port",
+        type=_number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT - 1),
         default=7000,
         help="panel port (default 7000); MeshCat uses the next one",
-    )  # fmt: skip
+    )
     session.add_argument("--host", default="localhost", help=HOST_HELP)
     session.add_argument("--no-browser", action="store_true", help="do not open a browser")
     session.add_argument(
-        "--seconds", type=_number(float, low=0.0, inclusive=True), default=None,
+        "--seconds",
+        type=_number(float, low=0.0, inclusive=True),
+        default=None,
         help="stop after this long (default: until Ctrl-C)",
-    )  # fmt: skip
+    )
 
 
 def _place_flags(commands) -> None:
@@ -199,26 +208,35 @@ def _place_flags(commands) -> None:
     )
     place.add_argument("cell", type=Path, help="work-cell YAML file with a place: block")
     place.add_argument(
-        "--out", type=Path, default=None,
+        "--out",
+        type=Path,
+        default=None,
         help="output folder (default: out/<file stem>_place)",
-    )  # fmt: skip
+    )
     place.add_argument(
-        "--budget", type=_number(int, low=1, inclusive=True, high=MAX_PLACE_BUDGET), default=None,
+        "--budget",
+        type=_number(int, low=1, inclusive=True, high=MAX_PLACE_BUDGET),
+        default=None,
         help="candidates through the planning pipeline (default: place.budget)",
-    )  # fmt: skip
+    )
     place.add_argument(
-        "--seed", type=_number(int, low=0, inclusive=True, high=MAX_PLACE_SEED), default=None,
+        "--seed",
+        type=_number(int, low=0, inclusive=True, high=MAX_PLACE_SEED),
+        default=None,
         help="search seed (default: place.seed)",
-    )  # fmt: skip
+    )
     where = place.add_mutually_exclusive_group()
     where.add_argument(
-        "--workers", type=_number(int, low=0, inclusive=True, high=1024), default=None,
+        "--workers",
+        type=_number(int, low=0, inclusive=True, high=1024),
+        default=None,
         help="Dask LocalCluster workers (default: one per core; 0: this process, no Dask)",
-    )  # fmt: skip
+    )
     where.add_argument(
-        "--scheduler", default=None,
+        "--scheduler",
+        default=None,
         help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
-    )  # fmt: skip
+    )
 
 
 def _import_flags(robot_commands) -> None:
@@ -229,21 +247,27 @@ def _import_flags(robot_commands) -> None:
     imp.add_argument("description", type=Path, help="the robot's .urdf or .xacro file")
     imp.add_argument("--name", required=True, help="the robot folder's name, e.g. fanuc_m20ia")
     imp.add_argument(
-        "--package-path", type=Path, action="append",
+        "--package-path",
+        type=Path,
+        action="append",
         help="a folder holding ROS packages (package.xml), for package:// and $(find); "
         "repeatable (default: the folder above the description's package)",
-    )  # fmt: skip
+    )
     imp.add_argument(
-        "--vendor", default="other", choices=("fanuc", "kuka", "abb", "universal_robots", "other"),
+        "--vendor",
+        default="other",
+        choices=("fanuc", "kuka", "abb", "universal_robots", "other"),
         help="the maker: chooses the controller language (default other: none)",
-    )  # fmt: skip
+    )
     imp.add_argument("--out", type=Path, default=None, help="ROBOTS_DIR to write into (./robots)")
     imp.add_argument("--base", default="base_link", help="the chain's base link (base_link)")
     imp.add_argument("--tip", default="tool0", help="the chain's flange link (tool0)")
     imp.add_argument(
-        "--samples", type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
-        default=10_000, help="self-collision configurations (10000)",
-    )  # fmt: skip
+        "--samples",
+        type=_number(int, low=1, inclusive=True, high=MAX_MATRIX_SAMPLES),
+        default=10_000,
+        help="self-collision configurations (10000)",
+    )
     imp.add_argument("--force", action="store_true", help="replace an existing robot folder")
 
 

@@ -38,10 +38,15 @@ def run_robots(args, console: Console) -> None:
     used = robot.urdf_path.parent / MATRIX_FILE
     console.print(
         f"wrote {file} ({args.samples} samples, seed {args.seed}). The planner reads "
-        f"{used}" + ("" if file.resolve() == used.resolve() else
-                     f"; to plan with this matrix, copy it there: cp {file} {used}"),
-        highlight=False, markup=False,
-    )  # fmt: skip
+        f"{used}"
+        + (
+            ""
+            if file.resolve() == used.resolve()
+            else f"; to plan with this matrix, copy it there: cp {file} {used}"
+        ),
+        highlight=False,
+        markup=False,
+    )
 
 
 def _run_import(args, console: Console) -> None:
@@ -56,10 +61,16 @@ def _run_import(args, console: Console) -> None:
     out = args.out or Path("robots")
     with Console(stderr=True).status(f"importing {args.description.name}"):
         result = import_robot(
-            args.description, name=args.name, out=out, package_paths=args.package_path or [],
-            vendor=args.vendor, base=args.base, tip=args.tip, samples=args.samples,
+            args.description,
+            name=args.name,
+            out=out,
+            package_paths=args.package_path or [],
+            vendor=args.vendor,
+            base=args.base,
+            tip=args.tip,
+            samples=args.samples,
             force=args.force,
-        )  # fmt: skip
+        )
     p = result.params
     if p is not None:
         keys = ("d1", "a2", "a3", "d4", "d5", "d6") if robot_family(p) == "ur" else OPW_KEYS
@@ -76,5 +87,8 @@ def _run_import(args, console: Console) -> None:
         console.print("  kinematics  no closed form fits: Drake InverseKinematics (family drake)")
     check = sum(pair.kind == "check" for pair in result.pairs)
     console.print(f"  self-collision  {len(result.pairs)} link pairs, {check} checked")
-    console.print(f"wrote {result.folder} (cells: robot: {{model: {args.name}, robots_dir: {out}}} "
-                  f"or {ENV_VAR}={out.resolve()})", highlight=False)  # fmt: skip
+    console.print(
+        f"wrote {result.folder} (cells: robot: {{model: {args.name}, robots_dir: {out}}} "
+        f"or {ENV_VAR}={out.resolve()})",
+        highlight=False,
+    )

@@ -100,10 +100,13 @@ def bench_command(cell: Path, runs: int = 5) -> None:
             "offline_prog.results.job_folder; print(time.perf_counter() - t)"
         )
         imports = statistics.median(
-            float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
-                                 text=True).stdout)
+            float(
+                subprocess.run(
+                    [sys.executable, "-c", code], check=True, capture_output=True, text=True
+                ).stdout
+            )
             for _ in range(3)
-        )  # fmt: skip
+        )
         parts = {"interpreter + imports": imports}
         plan = plan_job(cell)  # what the command plans: a path: cell is a one-seam job
         parts.update({f"plan: {k}": v for k, v in plan.timings_s.items()})
@@ -142,9 +145,14 @@ def bench_collision(cells: list[Path]) -> None:
         ):
             drake = build_cell_model(plan.cell, file, robot)
             check = functools.partial(
-                check_trajectory, drake, q, traj.t, traj.s, clearance=motion.clearance,
+                check_trajectory,
+                drake,
+                q,
+                traj.t,
+                traj.s,
+                clearance=motion.clearance,
                 self_clearance=motion.self_clearance,
-            )  # fmt: skip
+            )
             seconds, result = best_of(3, check)
             rates[model] = len(q) / seconds
             print(

@@ -76,10 +76,18 @@ def main() -> None:
     for k in range(args.pairs):
         start = time.perf_counter()
         link = plan_link(
-            scene, robot, ends[2 * k], ends[2 * k + 1], clearance=CLEARANCE,
-            self_clearance=CLEARANCE, seed=args.seed + k, time_budget_s=args.budget,
-            rate_hz=250.0, name=f"pair {k}", checker=checker,
-        )  # fmt: skip
+            scene,
+            robot,
+            ends[2 * k],
+            ends[2 * k + 1],
+            clearance=CLEARANCE,
+            self_clearance=CLEARANCE,
+            seed=args.seed + k,
+            time_budget_s=args.budget,
+            rate_hz=250.0,
+            name=f"pair {k}",
+            checker=checker,
+        )
         times.append(time.perf_counter() - start)
         if link.ok:
             durations.append(link.duration_s)

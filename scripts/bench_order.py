@@ -67,14 +67,20 @@ def main() -> None:
         q_home = home_pose(inputs, scene)
         start = time.perf_counter()
         options = seam_options(
-            inputs, scene, lambda k, r, i, s: plan_seam(i, s, StageTimer(lambda _: None)),
+            inputs,
+            scene,
+            lambda k, r, i, s: plan_seam(i, s, StageTimer(lambda _: None)),
             lambda _: None,
-        )  # fmt: skip
+        )
         planning = time.perf_counter() - start
     flat = [(o.seam, o.label, o.q_in, o.q_out) for seam in options for o in seam]
     robot, n = inputs.robot, len(options)
-    limits = {"qd_max": robot.qd_max, "qdd_max": robot.qdd_max, "n_seams": n,
-              "controller_joints": robot.controller_joints}  # fmt: skip
+    limits = {
+        "qd_max": robot.qd_max,
+        "qdd_max": robot.qdd_max,
+        "n_seams": n,
+        "controller_joints": robot.controller_joints,
+    }
     start = time.perf_counter()
     brute, _ = brute_force_order(flat, q_home, **limits)
     t_brute = time.perf_counter() - start

@@ -84,8 +84,10 @@ def throughput(file: Path) -> None:
     rng = np.random.default_rng(0)
     batch = [space.candidate(x, 0) for x in rng.uniform(0.1, 0.9, (THROUGHPUT_CANDIDATES, 4))]
     rates = {}
-    for name, make in (("serial", lambda: SerialEngine(payload)),
-                       ("LocalCluster 2", lambda: DaskEngine(payload, workers=2))):  # fmt: skip
+    for name, make in (
+        ("serial", lambda: SerialEngine(payload)),
+        ("LocalCluster 2", lambda: DaskEngine(payload, workers=2)),
+    ):
         engine = make()
         try:
             engine.map("screen", batch[:1])  # serial: load the cell (Dask workers have)
@@ -100,8 +102,10 @@ def throughput(file: Path) -> None:
     efficiency = rates["LocalCluster 2"] / (2 * rates["serial"])
     print(f"  parallel efficiency on 2 workers: {efficiency:.2f} (acceptance ≥ 0.8)")
     minutes = 1e4 * cost / (16 * efficiency) / 60
-    print(f"  cost per candidate {cost:.2f} s; 10⁴ candidates on 16 cores at this efficiency: "
-          f"{minutes:.1f} min ({1e4 * cost / 16 / 60:.1f} min at efficiency 1)")  # fmt: skip
+    print(
+        f"  cost per candidate {cost:.2f} s; 10⁴ candidates on 16 cores at this efficiency: "
+        f"{minutes:.1f} min ({1e4 * cost / 16 / 60:.1f} min at efficiency 1)"
+    )
 
 
 def bad_input(folder: Path) -> None:
@@ -122,11 +126,15 @@ def bad_input(folder: Path) -> None:
         start = time.perf_counter()
         done = subprocess.run(
             [sys.executable, "-m", "offline_prog", "place", *args, "--out", str(folder / "o")],
-            capture_output=True, text=True, timeout=120,
-        )  # fmt: skip
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         lines = done.stderr.strip().splitlines()
-        print(f"  {name:<22} exit {done.returncode}, {len(lines)} line, "
-              f"{time.perf_counter() - start:4.1f} s: {lines[-1] if lines else ''}")  # fmt: skip
+        print(
+            f"  {name:<22} exit {done.returncode}, {len(lines)} line, "
+            f"{time.perf_counter() - start:4.1f} s: {lines[-1] if lines else ''}"
+        )
 
 
 def main() -> None:
@@ -140,22 +148,28 @@ def main() -> None:
         data = search(OUT_OF_REACH, folder / "oor", args.budget)
         show("seal_out_of_reach_kr16", data)
         replan = plan_job(folder / "oor" / "placed.yaml")  # a path: cell: a one-seam job
-        print(f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
-              f"cycle {replan.samples.t[-1]:.2f} s")  # fmt: skip
+        print(
+            f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
+            f"cycle {replan.samples.t[-1]:.2f} s"
+        )
         show("seal_plate_kr16", search(seal_with_place(folder), folder / "seal", args.budget))
         data = search(JOB, folder / "job", min(args.budget, JOB_BUDGET))
         show("seal_job_far_kr16 (job)", data)
         replan = plan_job(folder / "job" / "placed.yaml")
-        print(f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
-              f"cycle {replan.samples.t[-1]:.2f} s")  # fmt: skip
+        print(
+            f"{'':<24} plan placed.yaml: feasible {replan.feasible}, "
+            f"cycle {replan.samples.t[-1]:.2f} s"
+        )
         bests = []
         for seed in range(args.seeds):
             data = search(FAR, folder / f"far{seed}", args.budget, seed=seed)
             show(f"seal_far_kr16 seed {seed}", data)
             bests.append(data["best"]["cycle_time_s"])
         spread = (max(bests) - min(bests)) / min(bests)
-        print(f"{args.seeds} seeds: best cycle {min(bests):.3f} … {max(bests):.3f} s, "
-              f"spread {100 * spread:.2f} % (acceptance ≤ 2 %)")  # fmt: skip
+        print(
+            f"{args.seeds} seeds: best cycle {min(bests):.3f} … {max(bests):.3f} s, "
+            f"spread {100 * spread:.2f} % (acceptance ≤ 2 %)"
+        )
         print(json.dumps(data["engine"]))
         print("== throughput (seal_far_kr16, the same 32 candidates) ==")
         throughput(FAR)

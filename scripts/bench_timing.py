@@ -79,9 +79,12 @@ def held_where_feasible(plan) -> tuple[float, float]:
     within ±0.5 %, feasible share of the path)."""
     robot, tr, motion = plan.robot, plan.trajectory, plan.cell.motion
     hold = SpeedHold(
-        path_rates(plan, 5000), v_process=motion.speed, a_max=motion.max_acceleration,
-        j_max=motion.max_jerk, limits=(robot.qd_max, robot.qdd_max, robot.jerk_limits),
-    )  # fmt: skip
+        path_rates(plan, 5000),
+        v_process=motion.speed,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
+        limits=(robot.qd_max, robot.qdd_max, robot.jerk_limits),
+    )
     return hold.on_samples(tr.law_position, tr.tcp_speed)
 
 
@@ -112,8 +115,9 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
 
     robot, motion = plan.robot, plan.cell.motion
     rates = path_rates(plan, 5000)
-    nominal = sin2_time_law(rates.sigma[-1], v_max=motion.speed,
-                            a_max=motion.max_acceleration, j_max=motion.max_jerk)  # fmt: skip
+    nominal = sin2_time_law(
+        rates.sigma[-1], v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+    )
     best = {}
     for _ in range(5):
         for process in ("constant_speed", "cycle_time"):
@@ -123,9 +127,12 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
             best[process] = min(best.get(process, np.inf), elapsed)
             assert timing.feasible
         profile = topp_profile(
-            rates, qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=motion.speed,
+            rates,
+            qd_max=robot.qd_max,
+            qdd_max=robot.qdd_max,
+            v_cap=motion.speed,
             a_path=motion.max_acceleration,
-        )  # fmt: skip
+        )
         best["topp"] = min(best.get("topp", np.inf), profile.solve_s)
     return best["topp"], best["constant_speed"], best["cycle_time"]
 
@@ -158,8 +165,10 @@ def bench_timing(cells: list[str] = ONE_SEAM_CELLS) -> None:
         topp = held.joints.retiming.topp_plain_s
         topp_jerk = held.joints.retiming.topp.duration  # with the steady jerk limit
         print(f"\n{name}: path {held.path.length * 1e3:.0f} mm at {inputs.cell.motion.speed} m/s")
-        print(f"  {'law':<28} {'cycle [s]':>9} {'/TOPP-RA':>9} {'/sin²':>7} {'held ±0.5%':>11} "
-              f"{'vel use':>8} {'acc use':>8} {'jerk use':>8}")  # fmt: skip
+        print(
+            f"  {'law':<28} {'cycle [s]':>9} {'/TOPP-RA':>9} {'/sin²':>7} {'held ±0.5%':>11} "
+            f"{'vel use':>8} {'acc use':>8} {'jerk use':>8}"
+        )
         print(f"  {'TOPP-RA (no jerk stage)':<28} {topp:9.3f}")
         print(f"  {'TOPP-RA + steady jerk limit':<28} {topp_jerk:9.3f} {topp_jerk / topp:9.3f}")
         for label, plan in (

@@ -109,11 +109,23 @@ def start(folder: Path, cell: Path, port: int, *, host: str | None = None) -> Li
     ``folder``; returns once it printed its URL (fails the test with its stderr if not)."""
     flags = ["--host", host] if host else []
     process = subprocess.Popen(
-        [sys.executable, "-m", "offline_prog", "session", str(cell), "--port", str(port),
-         "--no-browser", *flags],
-        cwd=folder, env={**os.environ, "PYTHONPATH": str(REPO)},
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "session",
+            str(cell),
+            "--port",
+            str(port),
+            "--no-browser",
+            *flags,
+        ],
+        cwd=folder,
+        env={**os.environ, "PYTHONPATH": str(REPO)},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     line = process.stdout.readline()
     if " at http://" not in line:
         process.kill()

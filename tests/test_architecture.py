@@ -1,15 +1,17 @@
 """The house shows its design: layer contracts hold, no import circles, small modules."""
 
 import ast
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "offline_prog"
-MAX_MODULE_LINES = 300
-# A longer module says why in its docstring, starting with this phrase.
-LONG_MODULE_REASON = "Longer than 300 lines because"
+# Formatted lines (`ruff format` decides the layout): a module that grows past this is split
+# by concept, not squeezed; one that cannot be says why in its docstring, with this phrase.
+MAX_MODULE_LINES = 400
+LONG_MODULE_REASON = f"Longer than {MAX_MODULE_LINES} lines because"
 
 
 def test_layer_contracts_hold():
@@ -71,7 +73,21 @@ def test_modules_are_small_or_say_why():
         doc = ast.get_docstring(ast.parse(file.read_text())) or ""
         if lines > MAX_MODULE_LINES and LONG_MODULE_REASON not in doc:
             too_long.append(f"{file.relative_to(PACKAGE.parent)} ({lines} lines)")
-    assert not too_long, "modules over 300 lines without a reason: " + ", ".join(too_long)
+    listed = ", ".join(too_long)
+    assert not too_long, f"modules over {MAX_MODULE_LINES} lines without a reason: {listed}"
+
+
+def test_code_is_ruff_formatted():
+    """`ruff format` decides the layout of the package, its tests and scripts (what CI runs)."""
+    pytest.importorskip("ruff")
+    root = PACKAGE.parent
+    done = subprocess.run(
+        [sys.executable, "-m", "ruff", "format", "--check", "offline_prog", "tests", "scripts"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, "run `python3 -m ruff format .`:\n" + done.stdout + done.stderr
 
 
 def test_robot_descriptions_are_package_data():

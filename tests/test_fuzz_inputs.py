@@ -19,11 +19,35 @@ from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
 
 HOSTILE_VALUES = [
-    ".nan", ".inf", "-.inf", "-1", "0", "1e308", "1.0e+6", "1e6", "100", "''", "[]", "{}",
-    "[1, 2, 3, 4]", "!Rpy {deg: [0, 0, 0]}", "*undefined", "&a [*a]", "\"x\\ny\"",
-    "\"\\u2028;%\\\"\"", "yes", "null", "~", "0x10", "'\\x00'", "[[[[[[[[[[]]]]]]]]]]",
-    "é", "9" * 400, "-0.0", "2.5e-320",
-]  # fmt: skip
+    ".nan",
+    ".inf",
+    "-.inf",
+    "-1",
+    "0",
+    "1e308",
+    "1.0e+6",
+    "1e6",
+    "100",
+    "''",
+    "[]",
+    "{}",
+    "[1, 2, 3, 4]",
+    "!Rpy {deg: [0, 0, 0]}",
+    "*undefined",
+    "&a [*a]",
+    '"x\\ny"',
+    '"\\u2028;%\\""',
+    "yes",
+    "null",
+    "~",
+    "0x10",
+    "'\\x00'",
+    "[[[[[[[[[[]]]]]]]]]]",
+    "é",
+    "9" * 400,
+    "-0.0",
+    "2.5e-320",
+]
 
 
 def mutate_yaml(rng, text: str) -> bytes:

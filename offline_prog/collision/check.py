@@ -79,8 +79,13 @@ class _Pairs:
             self.ids.append((r.id_A, r.id_B))
             shape_of.append(self.names.index((a.name, b.name)))
             # How fast the distance can change per unit of motion bound (0: both fixed).
-            c.append(0.0 if a.body in fixed and b.body in fixed else
-                     1.0 if a.body in fixed or b.body in fixed else 2.0)  # fmt: skip
+            c.append(
+                0.0
+                if a.body in fixed and b.body in fixed
+                else 1.0
+                if a.body in fixed or b.body in fixed
+                else 2.0
+            )
         self.shape_of, self.c = np.array(shape_of, dtype=int), np.array(c)
         robot = {label.name for label in cell.labels.values() if label.owner == "robot"}
         # Robot link vs robot link: held to the self-clearance, per shape pair s.
@@ -235,9 +240,17 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         a, b = pairs.names[s[k]]
         e = None if np.isnan(exact[k]) else float(exact[k])
         return PairMinimum(
-            a, b, pairs.groups[s[k]], float(dist[k]), float(at_index(sigma, x[k])),
-            float(at_index(t, x[k])), float(x[k]), float(drake[k]), max(0.0, -float(dist[k])), e,
-        )  # fmt: skip
+            a,
+            b,
+            pairs.groups[s[k]],
+            float(dist[k]),
+            float(at_index(sigma, x[k])),
+            float(at_index(t, x[k])),
+            float(x[k]),
+            float(drake[k]),
+            max(0.0, -float(dist[k])),
+            e,
+        )
 
     bounds = np.flatnonzero(np.r_[True, s[1:] != s[:-1], True]) if len(s) else [0]
     minima, stretches = [], []
@@ -246,10 +259,20 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         for a, b in true_runs(dist[lo:hi] < limit[lo:hi]):
             worst = entry(lo + a + int(np.argmin(dist[lo + a : lo + b])))
             first, last = entry(lo + a), entry(lo + b - 1)
-            stretches.append(CollisionStretch(
-                worst.a, worst.b, worst.group, first.sample, last.sample,
-                first.sigma_m, last.sigma_m, first.t_s, last.t_s, worst,
-            ))  # fmt: skip
+            stretches.append(
+                CollisionStretch(
+                    worst.a,
+                    worst.b,
+                    worst.group,
+                    first.sample,
+                    last.sample,
+                    first.sigma_m,
+                    last.sigma_m,
+                    first.t_s,
+                    last.t_s,
+                    worst,
+                )
+            )
     measured = np.bincount(s[x == np.floor(x)], minlength=len(pairs.names))  # per pair
     for pair in minima:  # a pair pruned somewhere: its minimum there is only bounded
         index = pairs.names.index((pair.a, pair.b))
@@ -267,8 +290,16 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
             notes.append(f"{pair.a} vs {pair.b} at σ = {pair.sigma_m:.4f} m: {pair.note}")
     overlaps = [k for k in np.lexsort((dist, x)) if dist[k] < -TOUCH_TOL_M]
     first = entry(overlaps[0]) if overlaps else None
-    stretch = next((r for r in stretches if first and (r.a, r.b) == (first.a, first.b)
-                    and r.sample_start <= first.sample <= r.sample_end), None)  # fmt: skip
+    stretch = next(
+        (
+            r
+            for r in stretches
+            if first
+            and (r.a, r.b) == (first.a, first.b)
+            and r.sample_start <= first.sample <= r.sample_end
+        ),
+        None,
+    )
     # The closest approach of what moves; the fixed layout (a base on its floor) is
     # listed with the pairs and fails only by overlapping.
     moving = [m for m in minima if not pairs.is_fixed[pairs.names.index((m.a, m.b))]]
@@ -292,8 +323,19 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
     violated = violation is not None and margin[(violation.a, violation.b)] < 0
     violation_clearance = clear_s[pairs.names.index((violation.a, violation.b))] if violated else 0
     return CollisionResult(
-        clearance, not violated, float(min_distance), closest, minima,
-        minima[:n_worst], stretches, below, first, list(cell.allowed_contact),
+        clearance,
+        not violated,
+        float(min_distance),
+        closest,
+        minima,
+        minima[:n_worst],
+        stretches,
+        below,
+        first,
+        list(cell.allowed_contact),
         failure_message(first, stretch, violation if violated else None, violation_clearance),
-        notes, stats, self_clearance, cell.skipped_self_pairs,
-    )  # fmt: skip
+        notes,
+        stats,
+        self_clearance,
+        cell.skipped_self_pairs,
+    )

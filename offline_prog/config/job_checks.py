@@ -118,16 +118,18 @@ def _check_leads(file: Path, cell: Cell, io) -> None:
         room_off = seam.retract.distance_mm * (seam.retract.kind != "none")
         if io.on is not None and io.on.lead_mm > room_on:
             raise _error(
-                file, "tool.process_io.on.lead_mm",
+                file,
+                "tool.process_io.on.lead_mm",
                 f"{io.on.lead_mm:g} mm before the start of {name} is beyond its approach "
                 f"({room_on:g} mm)",
-            )  # fmt: skip
+            )
         if io.off is not None and -io.off.lead_mm > room_off:
             raise _error(
-                file, "tool.process_io.off.lead_mm",
+                file,
+                "tool.process_io.off.lead_mm",
                 f"{-io.off.lead_mm:g} mm after the end of {name} is beyond its retract "
                 f"({room_off:g} mm)",
-            )  # fmt: skip
+            )
 
 
 def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
@@ -136,8 +138,11 @@ def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
     if io is None:
         return
     ranges = OUTPUT_RANGES.get(language, {"digital_output": (0, 9999), "analog_output": (0, 9999)})
-    for name, kind in (("on", "digital_output"), ("off", "digital_output"),
-                       ("flow", "analog_output")):  # fmt: skip
+    for name, kind in (
+        ("on", "digital_output"),
+        ("off", "digital_output"),
+        ("flow", "analog_output"),
+    ):
         part = getattr(io, name)
         if part is None:
             continue

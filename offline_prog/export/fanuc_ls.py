@@ -141,9 +141,10 @@ def write_fanuc(
     off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
     approach = f"{approach_m * 1e3:g} mm along -y of F" if off else "none"
     conventions.append(
-        f"Approach/retract: {approach}" + (" (OUT OF REACH)" if approach_m and not off else "")
+        f"Approach/retract: {approach}"
+        + (" (OUT OF REACH)" if approach_m and not off else "")
         + f", L at {APPROACH_SPEED_MMS} mm/sec, not collision-checked."
-    )  # fmt: skip
+    )
     conventions += payload_conventions(data)
     header = header_lines(data, conventions=conventions, forced=forced)
     start = [

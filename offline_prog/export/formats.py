@@ -136,10 +136,12 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
 
 
 # The options each job writer takes (the rest are one-seam options: refused by name).
-_JOB_OPTIONS = {"krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m", "tcp_pose_convention"},
-                "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
-                "urscript": {"name", "period_s"},
-                "fanuc": {"chord_tol_m", "angle_tol_rad", "name", "line_limit"}}  # fmt: skip
+_JOB_OPTIONS = {
+    "krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m", "tcp_pose_convention"},
+    "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
+    "urscript": {"name", "period_s"},
+    "fanuc": {"chord_tol_m", "angle_tol_rad", "name", "line_limit"},
+}
 
 
 def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:

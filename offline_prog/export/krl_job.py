@@ -114,13 +114,24 @@ def write_krl_job(
     main_src = [
         f"DEF {name}( )",
         *(f"EXT {m}( )" for m, _ in modules),
-        ";FOLD INI", "BAS(#INITMOV,0)", ";ENDFOLD (INI)",
+        ";FOLD INI",
+        "BAS(#INITMOV,0)",
+        ";ENDFOLD (INI)",
         *([line for line in _load(job).splitlines() if line]),
-        "$BASE=FIXED_TOOL", "$TOOL=PART_ON_FLANGE", "$IPO_MODE=#TCP", "$ORI_TYPE=#VAR",
-        "$ADVANCE=3", f"BAS(#VEL_PTP,{PTP_VEL_PERCENT})", f"BAS(#ACC_PTP,{PTP_ACC_PERCENT})",
-        f"$VEL.ORI1={ori:.0f}", f"$VEL.ORI2={ori:.0f}", f"$APO.CDIS={blend_m * 1e3:.3f}",
-        *src, *([f"ANOUT OFF $ANOUT[{io.analog_output}]"] if flow else []), "END",
-    ]  # fmt: skip
+        "$BASE=FIXED_TOOL",
+        "$TOOL=PART_ON_FLANGE",
+        "$IPO_MODE=#TCP",
+        "$ORI_TYPE=#VAR",
+        "$ADVANCE=3",
+        f"BAS(#VEL_PTP,{PTP_VEL_PERCENT})",
+        f"BAS(#ACC_PTP,{PTP_ACC_PERCENT})",
+        f"$VEL.ORI1={ori:.0f}",
+        f"$VEL.ORI2={ori:.0f}",
+        f"$APO.CDIS={blend_m * 1e3:.3f}",
+        *src,
+        *([f"ANOUT OFF $ANOUT[{io.analog_output}]"] if flow else []),
+        "END",
+    ]
     main_dat = [
         f"DEFDAT {name}" + (" PUBLIC" if flow else ""),
         "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
@@ -187,8 +198,10 @@ def _seam_module(
             body += [_trigger(s, io, factor) for s in step.switches_before(m)]
         body.append(line)
     src = [f"DEF {module}( )", *body, "END"]
-    note = [f"; Seam {step.seam}: deviation <= {step.max_chord_m * 1e3:.4f} mm, "
-            f"{np.rad2deg(step.max_angle_rad):.4f} deg from the plan"]  # fmt: skip
+    note = [
+        f"; Seam {step.seam}: deviation <= {step.max_chord_m * 1e3:.4f} mm, "
+        f"{np.rad2deg(step.max_angle_rad):.4f} deg from the plan"
+    ]
     dat = [f"DEFDAT {module}", "EXT BAS (BAS_COMMAND :IN,REAL :IN )", *decls[1:], "ENDDAT"]
     # XP1 is the approach's end (main .dat XA<k>): the first LIN here goes to XP2.
     return _write(folder, module, head + note + src, head + note + dat)

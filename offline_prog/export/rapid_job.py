@@ -195,7 +195,7 @@ def _header(data: JobProgramData, robot, forced: bool) -> list[str]:
         "on the part.",
         "Axes: URDF joints"
         + (", axis 3 = q2 + q3 (J2/J3 linkage)" if robot.j23_coupled else "")
-        + ".",  # fmt: skip
+        + ".",
         f"Links: MoveAbsJ to fine points ({LINK_SPEED}); approach, seams, retract: MoveL / "
         "TriggL at the planned speeds.",
     ]

@@ -71,8 +71,10 @@ def write_urscript_job(
             f"Flow: standard analog out {io.analog_output} = ({io.offset:g} V + "
             f"{io.per_mps:g} V per m/s x v_TCP) / 10 V, within [{io.min:g}, {io.max:g}] V."
         )
-    lines = [f"# {urscript_comment(line)}" for line in header_lines(job, conventions=conventions,
-                                                                     forced=forced)]  # fmt: skip
+    lines = [
+        f"# {urscript_comment(line)}"
+        for line in header_lines(job, conventions=conventions, forced=forced)
+    ]
     lines.append(f"def {name}():")
     if (load := payload(job.payload)) is not None:
         mass, p_EC = load.total(job.X_EP)

@@ -33,15 +33,21 @@ def home_pose(inputs: Inputs, scene: DrakeCell) -> np.ndarray:
         if outside.any():
             j = int(np.argmax(outside))
             raise InputError(
-                inputs.file, key, f"axis {j + 1} = {home.joints_deg[j]:g}° is outside its limits "
+                inputs.file,
+                key,
+                f"axis {j + 1} = {home.joints_deg[j]:g}° is outside its limits "
                 f"[{np.rad2deg(robot.q_lower[j]):g}, {np.rad2deg(robot.q_upper[j]):g}]°",
-            )  # fmt: skip
+            )
     q = robot.urdf_joints(q_c)
     motion = inputs.cell.motion
     check = check_trajectory(
-        scene, q[None, :], np.zeros(1), np.zeros(1),
-        clearance=motion.clearance, self_clearance=motion.self_clearance,
-    )  # fmt: skip
+        scene,
+        q[None, :],
+        np.zeros(1),
+        np.zeros(1),
+        clearance=motion.clearance,
+        self_clearance=motion.self_clearance,
+    )
     if not check.collision_free:
         where = "job.home" if home is None else key
         hint = "; give job.home.joints_deg" if home is None else ""

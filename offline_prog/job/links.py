@@ -97,8 +97,9 @@ def plan_link(
     def failed(reason: str) -> LinkMotion:
         failure = PlanFailure(Failure.COLLISION, 0.0, 0.0, f"collision: link {name}: {reason}")
         empty = np.zeros((0, 6))
-        return LinkMotion(name, "", np.zeros(0), empty, empty, empty,
-                          time.perf_counter() - started, failure)  # fmt: skip
+        return LinkMotion(
+            name, "", np.zeros(0), empty, empty, empty, time.perf_counter() - started, failure
+        )
 
     for end, q in (("start", q_start), ("goal", q_goal)):
         if not checker.clear(q):
@@ -114,8 +115,16 @@ def plan_link(
     nearest = min(
         checker.min_distance(q_k) for q_k in q[:: max(1, len(q) // MIN_CLEARANCE_SAMPLES)]
     )
-    return LinkMotion(name, method, t, q, qd, waypoints, time.perf_counter() - started,
-                      min_clearance_m=float(nearest))  # fmt: skip
+    return LinkMotion(
+        name,
+        method,
+        t,
+        q,
+        qd,
+        waypoints,
+        time.perf_counter() - started,
+        min_clearance_m=float(nearest),
+    )
 
 
 def _ompl_path(robot, checker, q_start, q_goal, seed, time_budget_s) -> np.ndarray | None:

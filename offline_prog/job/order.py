@@ -95,10 +95,18 @@ class JobOrder:
 
 
 def order_job(
-    options, q_home, *, qd_max, qdd_max, n_seams: int, mode: str = "auto",
-    controller_joints=None, budget: int = SEARCH_BUDGET,
-    min_improvement_s: float = MIN_IMPROVEMENT_S, progress: SearchProgress | None = None,
-) -> JobOrder:  # fmt: skip
+    options,
+    q_home,
+    *,
+    qd_max,
+    qdd_max,
+    n_seams: int,
+    mode: str = "auto",
+    controller_joints=None,
+    budget: int = SEARCH_BUDGET,
+    min_improvement_s: float = MIN_IMPROVEMENT_S,
+    progress: SearchProgress | None = None,
+) -> JobOrder:
     """Choose one option per seam and the seam order (``mode`` auto) or keep the given
     order (``given``) for the least estimated link time.
 

@@ -94,8 +94,9 @@ def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
     variants = []
     for other in others:
         try:
-            attempt = attempt_motion(inputs, scene, plan.tool_rotation_rad, plan.flange,
-                                     other.branch)  # fmt: skip
+            attempt = attempt_motion(
+                inputs, scene, plan.tool_rotation_rad, plan.flange, other.branch
+            )
         except PlanFailedError:
             continue
         if attempt.collisions.collision_free:
@@ -106,7 +107,7 @@ def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
                     trajectory=attempt.joints.trajectory,
                     collisions=attempt.collisions,
                     clearance_profile=None,
-                )  # fmt: skip
+                )
             )
     return variants
 
@@ -136,7 +137,7 @@ def _ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMo
                 a_max=motion.max_acceleration,
                 j_max=motion.max_jerk,
                 rate_hz=motion.sample_rate_hz,
-            )  # fmt: skip
+            )
         )
     return moves[0], moves[1]
 
@@ -154,11 +155,15 @@ def choose_order(
         progress(Step(text, stage="order", done=used, total=budget))
 
     return order_job(
-        [(o.seam, o.label, o.q_in, o.q_out) for o in flat], q_home,
-        qd_max=robot.qd_max, qdd_max=robot.qdd_max, n_seams=len(options),
-        mode=job_config(inputs.cell).order, controller_joints=robot.controller_joints,
+        [(o.seam, o.label, o.q_in, o.q_out) for o in flat],
+        q_home,
+        qd_max=robot.qd_max,
+        qdd_max=robot.qdd_max,
+        n_seams=len(options),
+        mode=job_config(inputs.cell).order,
+        controller_joints=robot.controller_joints,
         progress=search_round,
-    )  # fmt: skip
+    )
 
 
 def job_pieces(
@@ -177,14 +182,22 @@ def job_pieces(
         text = f"link {len(links) + 1}/{len(chosen) + 1}: {name}"
         progress(Step(text, stage="links", done=len(links), total=len(chosen) + 1))
         link = plan_link(
-            scene, inputs.robot, q_now, target, clearance=motion.clearance,
-            self_clearance=motion.self_clearance, seed=LINK_SEED + len(links),
-            time_budget_s=job_config(inputs.cell).link_time_s, rate_hz=motion.sample_rate_hz,
-            name=name, checker=checker,
-        )  # fmt: skip
+            scene,
+            inputs.robot,
+            q_now,
+            target,
+            clearance=motion.clearance,
+            self_clearance=motion.self_clearance,
+            seed=LINK_SEED + len(links),
+            time_budget_s=job_config(inputs.cell).link_time_s,
+            rate_hz=motion.sample_rate_hz,
+            name=name,
+            checker=checker,
+        )
         if not link.ok:  # the direct move stands in: the check shows where it collides
-            t, q, qd = timed_polyline(inputs.robot, np.array([q_now, target]),
-                                      motion.sample_rate_hz)  # fmt: skip
+            t, q, qd = timed_polyline(
+                inputs.robot, np.array([q_now, target]), motion.sample_rate_hz
+            )
             link = dataclasses.replace(link, t=t, q=q, qd=qd, waypoints=np.array([q_now, target]))
         links.append(link)
         nan = np.full(len(link.t), np.nan)

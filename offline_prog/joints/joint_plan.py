@@ -121,8 +121,9 @@ class BranchPath:
         v2 = f.ddp_IE * (ds**2)[:, None] + f.dp_IE * dds[:, None]
         V1 = np.hstack([w1 @ R_BI.T, v1 @ R_BI.T])
         V2 = np.hstack([w2 @ R_BI.T, v2 @ R_BI.T])
-        dq, ddq = joint_path_rates(urdf_chain(self.robot.urdf_path, self.robot.joint_names),
-                                   q, V1, V2)  # fmt: skip
+        dq, ddq = joint_path_rates(
+            urdf_chain(self.robot.urdf_path, self.robot.joint_names), q, V1, V2
+        )
         return JointRates(sigma, q, dq, ddq)
 
 
@@ -131,8 +132,9 @@ ROTATION_STEP_RAD = np.deg2rad(5.0)
 ROTATION_TRIAL_POINTS = 400
 
 
-def tool_rotations(robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y",
-                   smooth_turn=None):  # fmt: skip
+def tool_rotations(
+    robot: RobotModel, X_IB, path, normal, *, X_IT, X_PE, bound_rad, axis="y", smooth_turn=None
+):
     """Turns φ₀ ∈ [−bound, bound] of a symmetric tool about its axis, best first.
 
     The process frame is laid onto T·R_axis(φ₀) instead of T, which a tool

@@ -37,16 +37,18 @@ SKIP_SHARE = 1e-3
 TIME_INVERSION_POINTS = 20001  # σ ↦ t on the nominal law for a failure's time
 
 
-def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time_law: str,
-            process: str):  # fmt: skip
+def path_timing(
+    robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time_law: str, process: str
+):
     """The time law under the joint limits: TOPP-RA plus the jerk stage, or sin²
     plateaus (``joint_timing.retime``)."""
     if time_law == "sin2":
         return retime(rates, nominal, qd_max=robot.qd_max, qdd_max=robot.qdd_max)
     start = time.perf_counter()
     limits = (robot.qd_max, robot.qdd_max, robot.jerk_limits)
-    topp = dict(qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=nominal.v_max,
-                a_path=nominal.a_max)  # fmt: skip
+    topp = dict(
+        qd_max=robot.qd_max, qdd_max=robot.qdd_max, v_cap=nominal.v_max, a_path=nominal.a_max
+    )
     plain = topp_profile(rates, **topp)
     steady = steady_jerk_limit(rates, limits)
     # Where the plain profile already keeps the steady jerk limit it is the answer with
@@ -67,19 +69,19 @@ def path_timing(robot: RobotModel, rates: JointRates, nominal: Sin2TimeLaw, time
     held = SpeedHold(rates, limits=limits, **path)
     timing = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
     speed_held = held(timing.law)  # measured once per law: the choice and the report
-    if not (timing.feasible and _cannot_win(timing, speed_held, profile, nominal, process,
-                                            held)):  # fmt: skip
+    if not (timing.feasible and _cannot_win(timing, speed_held, profile, nominal, process, held)):
         filtered = filtered_timing(rates, profile, limits=limits, **path)
         if filtered is not None:
             filtered_held = held(filtered.law)
-            if not timing.feasible or _better(filtered, filtered_held, timing, speed_held,
-                                              process):  # fmt: skip
+            if not timing.feasible or _better(filtered, filtered_held, timing, speed_held, process):
                 timing = dataclasses.replace(filtered, process=process, topp=profile)
                 speed_held = filtered_held
     return dataclasses.replace(
-        timing, topp_plain_s=plain.duration, speed_held=speed_held,
+        timing,
+        topp_plain_s=plain.duration,
+        speed_held=speed_held,
         solve_s=time.perf_counter() - start,
-    )  # fmt: skip
+    )
 
 
 def without_joint_limits(law, time_law: str) -> tuple[float, bool]:
@@ -103,8 +105,7 @@ def without_joint_limits(law, time_law: str) -> tuple[float, bool]:
     return float(trajectory.duration), bool(top >= law.v_max * (1.0 - 1e-9))
 
 
-def _cannot_win(staircase, staircase_held, profile, nominal, process: str,
-                held: SpeedHold) -> bool:  # fmt: skip
+def _cannot_win(staircase, staircase_held, profile, nominal, process: str, held: SpeedHold) -> bool:
     """The averaged profile (``filtered_stage``) cannot beat the staircase, by bounds:
     its profile is TOPP-RA's under tighter limits, so never above ``profile``, and it
     runs the profile's duration plus its window T = a/j. Its speed is an average of

@@ -61,8 +61,16 @@ class SmoothTurn:
         scale: the share of θ − θ̄ taken up (< 1 where the free rotation is too small).
     """
 
-    def __init__(self, path: ArcLengthPath, normal: NormalField, *, axis: str, width_m: float,
-                 offset_rad: float = 0.0, scale: float = 1.0):  # fmt: skip
+    def __init__(
+        self,
+        path: ArcLengthPath,
+        normal: NormalField,
+        *,
+        axis: str,
+        width_m: float,
+        offset_rad: float = 0.0,
+        scale: float = 1.0,
+    ):
         if not (np.isfinite(width_m) and width_m > 0):
             raise ValueError(f"tool turn: width must be > 0 m, got {width_m}")
         self.path, self.normal, self.axis = path, normal, "xyz".index(axis)

@@ -118,9 +118,11 @@ def placed_cell(ctx: Context, candidate: Candidate) -> Cell:
     """The cell with the candidate's X_IT and X_PE and the carried obstacles moved."""
     state = dataclasses.replace(
         ctx.initial,
-        p_IT=candidate.X_IT[0], rpy_IT_deg=candidate.X_IT[1],
-        p_PE=candidate.X_PE[0], rpy_PE_deg=candidate.X_PE[1],
-    )  # fmt: skip
+        p_IT=candidate.X_IT[0],
+        rpy_IT_deg=candidate.X_IT[1],
+        p_PE=candidate.X_PE[0],
+        rpy_PE_deg=candidate.X_PE[1],
+    )
     cell = apply(ctx.inputs.cell, ctx.initial, state)
     moved = moved_obstacles(ctx, candidate)
     if not moved:

@@ -65,8 +65,12 @@ class SerialEngine:
     def __init__(self, payload: CellPayload):
         self.payload = payload
 
-    def map(self, stage: str, candidates: Sequence[Candidate],
-            done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip
+    def map(
+        self,
+        stage: str,
+        candidates: Sequence[Candidate],
+        done: Callable[[int], None] = lambda n: None,
+    ) -> list[Evaluation]:
         results = []
         for candidate in candidates:
             results += run_chunk(stage, [candidate], self.payload)
@@ -85,8 +89,9 @@ class DaskEngine:
         InputError: the scheduler cannot be reached within CONNECT_TIMEOUT_S.
     """
 
-    def __init__(self, payload: CellPayload, *, workers: int | None = None,
-                 scheduler: str | None = None):  # fmt: skip
+    def __init__(
+        self, payload: CellPayload, *, workers: int | None = None, scheduler: str | None = None
+    ):
         import dask
         from dask.distributed import Client, LocalCluster
 
@@ -106,9 +111,12 @@ class DaskEngine:
             n = workers or os.cpu_count() or 1
             with dask.config.set(WORKER_CONFIG):
                 self.cluster = LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
                     silence_logs=quiet,
-                )  # fmt: skip
+                )
             self.client = Client(self.cluster)
             self.scheduler = "LocalCluster"
         try:
@@ -116,15 +124,20 @@ class DaskEngine:
             self.workers = len(addresses)
             self.payload = self.client.scatter(payload, broadcast=True, hash=False)
             # Every worker loads the cell now, in parallel (not on its first candidate).
-            loads = [self.client.submit(_load, self.payload, workers=[a], pure=False)
-                     for a in addresses]  # fmt: skip
+            loads = [
+                self.client.submit(_load, self.payload, workers=[a], pure=False) for a in addresses
+            ]
             self.client.gather(loads)
         except BaseException:  # Ctrl-C or a worker's error: no cluster left running
             self.close()
             raise
 
-    def map(self, stage: str, candidates: Sequence[Candidate],
-            done: Callable[[int], None] = lambda n: None) -> list[Evaluation]:  # fmt: skip
+    def map(
+        self,
+        stage: str,
+        candidates: Sequence[Candidate],
+        done: Callable[[int], None] = lambda n: None,
+    ) -> list[Evaluation]:
         from dask.distributed import as_completed
 
         size = SCREEN_CHUNK if stage == "screen" else 1

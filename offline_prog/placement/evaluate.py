@@ -45,8 +45,12 @@ def plan_candidate(ctx: Context, candidate: Candidate) -> JobPlan:
 def _seam_terms(plans: list[Plan]) -> dict:
     """The objective terms a job's seams (or the one seam) give."""
     joints = [p.joints for p in plans]
-    singular = [j.singularities[k]["distance"] for j in joints for k in ("wrist", "elbow")
-                if k in j.singularities]  # fmt: skip
+    singular = [
+        j.singularities[k]["distance"]
+        for j in joints
+        for k in ("wrist", "elbow")
+        if k in j.singularities
+    ]
     length = sum(p.path.length for p in plans)
     slowed = [sum(b - a for a, b, _ in j.retiming.reductions) for j in joints]
     worst = int(np.argmax(slowed))
@@ -70,12 +74,25 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
         length = ctx.seams[0].fit.path.length
         done = error.failure.sigma_m / length if len(ctx.seams) == 1 else 0.0
         screened = screen(ctx, candidate)
-        return Evaluation(candidate, "plan", CANNOT_FOLLOW, screened.violation + 1.0 - done,
-                          str(error.failure), error.failure.kind.value,
-                          seconds=time.perf_counter() - start)  # fmt: skip
+        return Evaluation(
+            candidate,
+            "plan",
+            CANNOT_FOLLOW,
+            screened.violation + 1.0 - done,
+            str(error.failure),
+            error.failure.kind.value,
+            seconds=time.perf_counter() - start,
+        )
     except InputError as error:
-        return Evaluation(candidate, "plan", REFUSED, 1.0, error.reason, "refused",
-                          seconds=time.perf_counter() - start)  # fmt: skip
+        return Evaluation(
+            candidate,
+            "plan",
+            REFUSED,
+            1.0,
+            error.reason,
+            "refused",
+            seconds=time.perf_counter() - start,
+        )
     seams, t = plan.seams, plan.samples.t
     duration = float(t[-1] - t[0])
     air = duration - sum(float(p.trajectory.duration) for p in seams)

@@ -126,8 +126,7 @@ def cycle_time_cut(result: Placement, tool=None) -> dict:
     return out
 
 
-def placement_json(result: Placement, space: SearchSpace, place, engine: dict,
-                   tool=None) -> dict:  # fmt: skip
+def placement_json(result: Placement, space: SearchSpace, place, engine: dict, tool=None) -> dict:
     return {
         "best": terms(result.best),
         "baseline": terms(result.baseline),
@@ -146,13 +145,13 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict,
                     "unit": "m" if a.kind == "translation" else "deg",
                 }
                 for a in space.axes
-            ],  # fmt: skip
+            ],
             "grasps": [_pose(g) for g in space.grasps],
             # Infeasible candidates by kind (errors.Failure values, or "refused").
             "failures": dict(
                 collections.Counter(e.failure for e in result.evaluated if not e.feasible)
             ),
-        },  # fmt: skip
+        },
         "engine": engine,
     }
 

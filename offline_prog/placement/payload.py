@@ -51,8 +51,11 @@ def data_file_keys(cell: Cell) -> dict[str, str]:
                 keys[f"{key}.{name}"] = getattr(path, name)
         if path.cad is not None and path.cad.file:
             keys[f"{key}.cad.file"] = path.cad.file
-    for owner, shapes in (("obstacles", cell.obstacles), ("part.geometry", cell.part.geometry),
-                          ("tool.geometry", cell.tool.geometry)):  # fmt: skip
+    for owner, shapes in (
+        ("obstacles", cell.obstacles),
+        ("part.geometry", cell.part.geometry),
+        ("tool.geometry", cell.tool.geometry),
+    ):
         for i, shape in enumerate(shapes):
             if shape.shape == "mesh" and shape.mesh:
                 keys[f"{owner}.{i}.mesh"] = shape.mesh
@@ -68,9 +71,11 @@ def cell_payload(file: Path, cell: Cell) -> CellPayload:
     found = {key: Path(os.path.abspath(cell_path.parent / name)) for key, name in keys.items()}
     paths = [cell_path, *sorted(set(found.values()))]
     root = Path(os.path.commonpath([p.parent for p in paths]))
-    text = with_values(cell_path.read_text(), {}, {
-        key: os.path.relpath(path, cell_path.parent) for key, path in found.items()
-    })  # fmt: skip
+    text = with_values(
+        cell_path.read_text(),
+        {},
+        {key: os.path.relpath(path, cell_path.parent) for key, path in found.items()},
+    )
     files = [(cell_path.relative_to(root).as_posix(), text.encode())]
     files += [(p.relative_to(root).as_posix(), p.read_bytes()) for p in paths[1:]]
     digest = hashlib.sha256()

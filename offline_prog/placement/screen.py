@@ -30,8 +30,9 @@ def _screen_seam(seam: SeamView, candidate: Candidate) -> Evaluation:
     inputs, fit, s = seam.inputs, seam.fit, seam.screen_s
     robot = inputs.robot
     try:
-        flange = FlangePath(fit.path, fit.normal, X_IT=rigid(candidate.X_IT),
-                            X_PE=rigid(candidate.X_PE))  # fmt: skip
+        flange = FlangePath(
+            fit.path, fit.normal, X_IT=rigid(candidate.X_IT), X_PE=rigid(candidate.X_PE)
+        )
         f = flange(s)
     except NormalTangentError as error:
         return Evaluation(candidate, "screen", REFUSED, 1.0, str(error), "refused")
@@ -54,10 +55,16 @@ def _screen_seam(seam: SeamView, candidate: Candidate) -> Evaluation:
         return Evaluation(candidate, "screen", CANNOT_FOLLOW, violation(best), best.reason, kind)
     d = singularity_distances(robot, best.q, X_BE)
     singular = float(np.rad2deg(np.arcsin(min(1.0, d["wrist"].min(), d["elbow"].min()))))
-    return Evaluation(candidate, "screen", FEASIBLE, 0.0, "",
-                      cycle_time_s=speed_limited_time(seam, best.q),
-                      joint_limit_margin_deg=float(np.rad2deg(best.margin_rad)),
-                      singularity_margin_deg=singular)  # fmt: skip
+    return Evaluation(
+        candidate,
+        "screen",
+        FEASIBLE,
+        0.0,
+        "",
+        cycle_time_s=speed_limited_time(seam, best.q),
+        joint_limit_margin_deg=float(np.rad2deg(best.margin_rad)),
+        singularity_margin_deg=singular,
+    )
 
 
 def screen(ctx: Context, candidate: Candidate) -> Evaluation:

@@ -55,12 +55,18 @@ def _cma(space: SearchSpace, start: Evaluation, seed: int):
     import cma
 
     options = {
-        "bounds": [0.0, 1.0], "popsize": POPULATION, "seed": seed + 1,  # cma: 0 is random
-        "verbose": -9, "tolx": CMA_TOL_X,
+        "bounds": [0.0, 1.0],
+        "popsize": POPULATION,
+        "seed": seed + 1,  # cma: 0 is random
+        "verbose": -9,
+        "tolx": CMA_TOL_X,
         # Ranks are told (0 … 7 every generation): the best value never changes, so
         # the tests on function values would stop the run after 10 generations.
-        "tolfun": 0, "tolfunhist": 0, "tolstagnation": 10**9, "tolflatfitness": 10**9,
-    }  # fmt: skip
+        "tolfun": 0,
+        "tolfunhist": 0,
+        "tolstagnation": 10**9,
+        "tolflatfitness": 10**9,
+    }
     x0 = np.clip(np.asarray(start.candidate.x, dtype=float), 0.05, 0.95)
     return cma.CMAEvolutionStrategy(x0, SIGMA0, options)
 

@@ -20,9 +20,13 @@ SIZE, PAD = 560, 50  # SVG size and margin [px]
 FAST, SLOW = (68, 1, 84), (253, 231, 37)
 # Infeasible candidates by failure kind (errors.Failure values, "refused").
 FAILURE_COLORS = {
-    "out_of_reach": "#d62728", "joint_limit": "#ff7f0e", "joint_rate_limit": "#bcbd22",
-    "singularity": "#9467bd", "collision": "#8c564b", "refused": "#7f7f7f",
-}  # fmt: skip
+    "out_of_reach": "#d62728",
+    "joint_limit": "#ff7f0e",
+    "joint_rate_limit": "#bcbd22",
+    "singularity": "#9467bd",
+    "collision": "#8c564b",
+    "refused": "#7f7f7f",
+}
 
 
 def _colour(t: float, low: float, high: float) -> str:
@@ -109,21 +113,38 @@ def render_placement_html(result: Placement, data: dict, preview: str | None) ->
         )
     )
     header = [
-        "#", "feasible", "cycle [s]", "limit margin [°]", "singularity [°]", "clearance [mm]",
-        "X_IT translation [m]", "X_IT rpy [°]", "grasp", "reason",
-    ]  # fmt: skip
+        "#",
+        "feasible",
+        "cycle [s]",
+        "limit margin [°]",
+        "singularity [°]",
+        "clearance [mm]",
+        "X_IT translation [m]",
+        "X_IT rpy [°]",
+        "grasp",
+        "reason",
+    ]
 
     def number(v, digits=2):
         return "" if v is None else f"{v:.{digits}f}"
 
     rows = [
-        _row([k + 1, c["feasible"], number(c["cycle_time_s"]),
-              number(c["joint_limit_margin_deg"], 1), number(c["singularity_margin_deg"], 1),
-              number(c["clearance_mm"], 1),
-              ", ".join(f"{v:.4f}" for v in c["X_IT"]["translation"]),
-              ", ".join(f"{v:.2f}" for v in c["X_IT"]["rpy_deg"]), c["grasp"], c["reason"]])
+        _row(
+            [
+                k + 1,
+                c["feasible"],
+                number(c["cycle_time_s"]),
+                number(c["joint_limit_margin_deg"], 1),
+                number(c["singularity_margin_deg"], 1),
+                number(c["clearance_mm"], 1),
+                ", ".join(f"{v:.4f}" for v in c["X_IT"]["translation"]),
+                ", ".join(f"{v:.2f}" for v in c["X_IT"]["rpy_deg"]),
+                c["grasp"],
+                c["reason"],
+            ]
+        )
         for k, c in enumerate(data["candidates"])
-    ]  # fmt: skip
+    ]
     engine = data["engine"]
     frame = (
         f'<h2>Best placement</h2><iframe src="{html.escape(preview)}" width="900" height="560" '

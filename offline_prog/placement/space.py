@@ -200,9 +200,11 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
             part = 0 if axis.kind == "translation" else 1
             if len({g[part][axis.index] for g in grasps}) > 1:  # a range sets the value
                 raise InputError(
-                    file, axis.key, "the grasps differ on this axis and a range would make "
+                    file,
+                    axis.key,
+                    "the grasps differ on this axis and a range would make "
                     "them one: give the axis by range or by candidates, not both",
-                )  # fmt: skip
+                )
             axes.append(axis)
     if not axes and len(grasps) == 1:
         raise InputError(file, "place", "nothing to search: name a range or several grasps")

@@ -49,12 +49,22 @@ def flange_table(job: JobPlan) -> np.ndarray:
     p, R = X_IE[:, :3, 3], X_IE[:, :3, :3]
     v = np.gradient(p, s.t, axis=0)
     W = np.gradient(R, s.t, axis=0) @ np.swapaxes(R, 1, 2)  # skew(w) = Ṙ Rᵀ
-    w = 0.5 * np.stack([W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0],
-                        W[:, 1, 0] - W[:, 0, 1]], axis=1)  # fmt: skip
+    w = 0.5 * np.stack(
+        [W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0], W[:, 1, 0] - W[:, 0, 1]], axis=1
+    )
     table = np.column_stack(
-        [s.t, s.path_m, p, tait_bryan_xyz(R), v, w, np.gradient(v, s.t, axis=0),
-         job.tcp_speed, np.gradient(w, s.t, axis=0)]
-    )  # fmt: skip
+        [
+            s.t,
+            s.path_m,
+            p,
+            tait_bryan_xyz(R),
+            v,
+            w,
+            np.gradient(v, s.t, axis=0),
+            job.tcp_speed,
+            np.gradient(w, s.t, axis=0),
+        ]
+    )
     by_seam = {option.name: option.plan.trajectory for option in job.chosen}
     for segment in s.segments:
         if segment.kind == "process":

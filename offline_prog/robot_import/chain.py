@@ -95,9 +95,11 @@ def _limit(joint: ET.Element, file: Path, name: str) -> tuple[float, float, floa
         values[key] = value
     if values["lower"] is None or values["upper"] is None or values["lower"] >= values["upper"]:
         raise InputError(
-            file, f"joint {name} limit", "needs numeric lower < upper [rad] (got "
+            file,
+            f"joint {name} limit",
+            "needs numeric lower < upper [rad] (got "
             f"{limit.get('lower')!r}, {limit.get('upper')!r})",
-        )  # fmt: skip
+        )
     velocity = values["velocity"] if values["velocity"] and values["velocity"] > 0 else None
     return values["lower"], values["upper"], velocity
 
@@ -147,8 +149,10 @@ def _joint(element: ET.Element, file: Path) -> ChainJoint:
     key = f"joint {name}"
     axis = _floats(
         element.find("axis").get("xyz") if element.find("axis") is not None else "1 0 0",
-        3, file, f"{key} axis",
-    )  # fmt: skip
+        3,
+        file,
+        f"{key} axis",
+    )
     if kind not in PASSIVE and np.linalg.norm(axis) < 1e-12:
         raise InputError(file, f"{key} axis", "zero axis")
     lower, upper, velocity = _limit(element, file, name) if kind in REVOLUTE else (0, 0, None)

@@ -107,9 +107,16 @@ def derive_opw(chain: Chain) -> OpwParameters | None:
     theta += [t4, t5, t6]
     offsets = tuple(_wrap(-t) for t in theta)
     params = OpwParameters(
-        a1=_clean(a1), a2=_clean(a2), b=_clean(b), c1=_clean(c1), c2=_clean(c2),
-        c3=_clean(c3), c4=_clean(c4), offsets=offsets, sign_corrections=tuple(signs),
-    )  # fmt: skip
+        a1=_clean(a1),
+        a2=_clean(a2),
+        b=_clean(b),
+        c1=_clean(c1),
+        c2=_clean(c2),
+        c3=_clean(c3),
+        c4=_clean(c4),
+        offsets=offsets,
+        sign_corrections=tuple(signs),
+    )
     return params if opw_matches(chain, params) else None
 
 

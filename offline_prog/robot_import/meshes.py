@@ -108,9 +108,17 @@ def _load(element: ET.Element, chain: Chain, packages, link: str, role: str, tri
     mesh.apply_transform(X_LG.GetAsMatrix4())
     rpy = X_LG.rotation().ToRollPitchYaw().vector()
     source = MeshSource(
-        link, role, (), file, hashlib.sha256(file.read_bytes()).hexdigest(),
-        tuple(X_LG.translation()), tuple(rpy), tuple(scale), len(mesh.faces), 1,
-    )  # fmt: skip
+        link,
+        role,
+        (),
+        file,
+        hashlib.sha256(file.read_bytes()).hexdigest(),
+        tuple(X_LG.translation()),
+        tuple(rpy),
+        tuple(scale),
+        len(mesh.faces),
+        1,
+    )
     return mesh, source
 
 
@@ -132,12 +140,18 @@ def _write(out: Path, link: str, role: str, meshes, colours, trimesh) -> list[st
     folder.mkdir(parents=True, exist_ok=True)
     header = f"# {link}: {role} mesh, metres, in the URDF link frame '{link}' (see ../SOURCES.md)\n"
     if role == "visual":
-        groups = [(f"m{k}", trimesh.graph.smooth_shade(m, angle=np.radians(SMOOTH_ANGLE_DEG)))
-                  for k, m in enumerate(meshes)]  # fmt: skip
-        (folder / f"{link}.mtl").write_text(header + "".join(
-            f"newmtl {name}\nKa 0 0 0\nKd {r:g} {g:g} {b:g}\nd {a:g}\nKs 0.05 0.05 0.05\nNs 10\n"
-            "illum 2\n\n" for (name, _), (r, g, b, a) in zip(groups, colours, strict=True)
-        ))  # fmt: skip
+        groups = [
+            (f"m{k}", trimesh.graph.smooth_shade(m, angle=np.radians(SMOOTH_ANGLE_DEG)))
+            for k, m in enumerate(meshes)
+        ]
+        (folder / f"{link}.mtl").write_text(
+            header
+            + "".join(
+                f"newmtl {name}\nKa 0 0 0\nKd {r:g} {g:g} {b:g}\nd {a:g}\n"
+                "Ks 0.05 0.05 0.05\nNs 10\nillum 2\n\n"
+                for (name, _), (r, g, b, a) in zip(groups, colours, strict=True)
+            )
+        )
         (folder / f"{link}.obj").write_text(header + f"mtllib {link}.mtl\n" + _obj(groups, True))
         return [f"meshes/visual/{link}.obj"]
     merged = trimesh.util.concatenate(meshes)

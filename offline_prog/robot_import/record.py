@@ -34,10 +34,12 @@ def write_urdf(chain: Chain, files: dict, out: Path, name: str) -> Path:
     """``out/<name>.urdf``: the chain with the converted meshes (origins zero)."""
     rename = {chain.base: "base_link", chain.tip: "tool0"}
     robot = ET.Element("robot", name=name)
-    robot.append(ET.Comment(
-        f" {name}: imported by `offline-prog robots import` from {chain.file.name}; "
-        "sources and checks in README.md, meshes/SOURCES.md "
-    ))  # fmt: skip
+    robot.append(
+        ET.Comment(
+            f" {name}: imported by `offline-prog robots import` from {chain.file.name}; "
+            "sources and checks in README.md, meshes/SOURCES.md "
+        )
+    )
     links = {link.get("name"): link for link in chain.root.findall("link")}
     for link_name in chain.links:
         source = links[link_name]

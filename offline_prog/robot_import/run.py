@@ -95,9 +95,14 @@ def import_robot(
         limits, notes = record.limits_record(chain)
         controller = _controller(chain, vendor, params, limits)
         text = record.robot_yaml(
-            name=name, chain=chain, vendor=vendor, params=params, limits=limits, notes=notes,
+            name=name,
+            chain=chain,
+            vendor=vendor,
+            params=params,
+            limits=limits,
+            notes=notes,
             controller=controller,
-        )  # fmt: skip
+        )
         (staging / PARAMS_FILE).write_text(text)
         _load_staged(staging, name)
         if target.exists():
@@ -109,9 +114,19 @@ def import_robot(
     robot = load_robot(name, Path(out))
     pairs = write_matrix(robot, target / MATRIX_FILE, samples=samples, seed=0)
     (target / "README.md").write_text(
-        readme_text(name=name, chain=chain, vendor=vendor, params=params, fk=fk, notes=notes,
-                    controller=controller, packages=packages, pairs=pairs, samples=samples)
-    )  # fmt: skip
+        readme_text(
+            name=name,
+            chain=chain,
+            vendor=vendor,
+            params=params,
+            fk=fk,
+            notes=notes,
+            controller=controller,
+            packages=packages,
+            pairs=pairs,
+            samples=samples,
+        )
+    )
     return ImportResult(target, robot, params, fk, pairs)
 
 

@@ -215,9 +215,17 @@ def build_drake_cell(
         )
     diagram = builder.Build()
     return DrakeCell(
-        diagram, plant, model, X_IB, X_IT, X_PE, labels, list(allowed_contact), visualizer,
+        diagram,
+        plant,
+        model,
+        X_IB,
+        X_IT,
+        X_PE,
+        labels,
+        list(allowed_contact),
+        visualizer,
         skipped,
-    )  # fmt: skip
+    )
 
 
 def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel, meshcat=None) -> DrakeCell:

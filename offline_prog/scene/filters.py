@@ -42,8 +42,11 @@ def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_conta
         if label.owner in owners and plant.GetBodyByName(label.body).index() in fixed:
             owners[label.owner].append(geometry_id)
     base_ids = [g for g in plant.GetCollisionGeometriesForBody(base)]
-    for a, b in ((base_ids, owners["obstacle"]), (base_ids, owners["tool"]),
-                 (owners["tool"], owners["obstacle"])):  # fmt: skip
+    for a, b in (
+        (base_ids, owners["obstacle"]),
+        (base_ids, owners["tool"]),
+        (owners["tool"], owners["obstacle"]),
+    ):
         if a and b:
             manager.Apply(CollisionFilterDeclaration().AllowBetween(GeometrySet(a), GeometrySet(b)))
     by_name = ids_by_name(labels)

@@ -111,15 +111,25 @@ def _classify(low: float, high: float, samples: int) -> tuple[str, float, float,
     if high <= 0.0:
         return "always", low, high, f"in contact in all {samples} samples (meshes overlap)"
     if high - low < CONSTANT_SPREAD_M:
-        return "constant", low, high, (
-            f"distance varies by {(high - low) * 1e3:.3f} mm < "
-            f"{CONSTANT_SPREAD_M * 1e3:.1f} mm: a model artefact, not a hazard"
-        )  # fmt: skip
+        return (
+            "constant",
+            low,
+            high,
+            (
+                f"distance varies by {(high - low) * 1e3:.3f} mm < "
+                f"{CONSTANT_SPREAD_M * 1e3:.1f} mm: a model artefact, not a hazard"
+            ),
+        )
     if low > NEVER_MARGIN_M:
-        return "never", low, high, (
-            f"never closer than {low * 1e3:.0f} mm in {samples} samples "
-            f"(margin {NEVER_MARGIN_M * 1e3:.0f} mm)"
-        )  # fmt: skip
+        return (
+            "never",
+            low,
+            high,
+            (
+                f"never closer than {low * 1e3:.0f} mm in {samples} samples "
+                f"(margin {NEVER_MARGIN_M * 1e3:.0f} mm)"
+            ),
+        )
     return "check", low, high, f"as close as {low * 1e3:.1f} mm: checked"
 
 
@@ -171,7 +181,7 @@ def read_matrix(robot_folder: Path) -> list[LinkPair] | None:
                 p["min_distance_m"],
                 p["max_distance_m"],
                 str(p["reason"]),
-            )  # fmt: skip
+            )
             for p in record["pairs"]
         ]
     except (yaml.YAMLError, KeyError, TypeError) as error:

@@ -78,9 +78,12 @@ class SceneView:
             mask = worst == k
             if mask.any():
                 self.meshcat.SetLineSegments(
-                    f"{self.part}/session/path/{k}", start[mask].T, end[mask].T, LINE_WIDTH,
+                    f"{self.part}/session/path/{k}",
+                    start[mask].T,
+                    end[mask].T,
+                    LINE_WIDTH,
                     Rgba(*rgba),
-                )  # fmt: skip
+                )
         self.meshcat.SetLine(
             f"{self.part}/session/outdated", p_PF[index].T, LINE_WIDTH, Rgba(*OUTDATED_COLOR)
         )

@@ -84,16 +84,21 @@ class Session:
                 "shown_generation": self.shown_generation,
                 "current": current,
                 "busy": None if self.running is None else self.running[1],
-                "status": self.plan_line if current else {
+                "status": self.plan_line
+                if current
+                else {
                     "kind": "planning",
                     "line": "re-planning… (the plan shown is for earlier values)"
-                    if self.shown_generation else "planning…",
-                },  # fmt: skip
+                    if self.shown_generation
+                    else "planning…",
+                },
                 "shown": self.plan_line,
                 "message": {"kind": self.message[0], "text": self.message[1]},
                 "values": values(self.state),
-                "controls": [dataclasses.asdict(c) for c in
-                             controls(self.replanner.initial, self.replanner.seam_names)],
+                "controls": [
+                    dataclasses.asdict(c)
+                    for c in controls(self.replanner.initial, self.replanner.seam_names)
+                ],
                 "seams": self.replanner.seam_names,
                 "auto": self.auto,
                 "playing": self.playing,
@@ -103,7 +108,7 @@ class Session:
                 "length": length,
                 "saved": None if self.last_saved is None else str(self.last_saved),
                 "exported": None if self.last_exported is None else str(self.last_exported),
-            }  # fmt: skip
+            }
 
     def set_value(self, key: str, text) -> dict:
         """A typed or slid value (text or a number, in the control's unit): the new

@@ -40,8 +40,11 @@ def _status(result, timing: str, details: dict) -> dict:
             )
             return {"kind": "failed", "line": line, "details": details}
         details["reason"] = result.error
-        return {"kind": "error", "line": f"cannot plan: {result.error} · {timing}",
-                "details": details}  # fmt: skip
+        return {
+            "kind": "error",
+            "line": f"cannot plan: {result.error} · {timing}",
+            "details": details,
+        }
     collisions, joints = plan.collisions, plan.joints
     margin_deg = float(np.rad2deg(np.min(joints.margin_rad)))
     closest = collisions.closest

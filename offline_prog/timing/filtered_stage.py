@@ -136,9 +136,16 @@ def filtered_timing(
 
     def solve(span=None, ends=(0.0, 0.0)):
         return topp_profile(
-            rates, qd_max=shared[0], qdd_max=shared[1], v_cap=v_process, a_path=a_max,
-            v_steady=v_curve, a_curve=a_curve, span=span, ends=ends,
-        )  # fmt: skip
+            rates,
+            qd_max=shared[0],
+            qdd_max=shared[1],
+            v_cap=v_process,
+            a_path=a_max,
+            v_steady=v_curve,
+            a_curve=a_curve,
+            span=span,
+            ends=ends,
+        )
 
     profile, lowered = solve(), []
     for _ in range(MAX_ROUNDS):

@@ -32,8 +32,7 @@ class SpeedHold:
         limits: (qd_max, qdd_max, qddd_max), each (6,).
     """
 
-    def __init__(self, rates: JointRates, *, v_process: float, a_max: float, j_max: float,
-                 limits):  # fmt: skip
+    def __init__(self, rates: JointRates, *, v_process: float, a_max: float, j_max: float, limits):
         self.v, self.length = v_process, float(rates.sigma[-1])
         self.sigma, self.steady = rates.sigma, static_limit(rates, with_jerk(rates), limits)
         nominal = sin2_time_law(self.length, v_max=v_process, a_max=a_max, j_max=j_max)
@@ -74,9 +73,10 @@ class SpeedHold:
             return float("nan"), 0.0
         v = self.v
         feasible = (
-            (sigma >= self.cruise[0]) & (sigma <= self.cruise[1])
+            (sigma >= self.cruise[0])
+            & (sigma <= self.cruise[1])
             & (np.interp(sigma, self.sigma, self.steady) >= v)
-        )  # fmt: skip
+        )
         held = feasible & (np.abs(speed - v) <= HOLD * v)
         ds = np.abs(np.diff(sigma))
         room = float(np.sum(ds * (feasible[1:] & feasible[:-1])))

@@ -113,11 +113,18 @@ def topp_grid(sigma: np.ndarray, ramp: float, most: int) -> np.ndarray:
     acceleration, σ̇ ∝ √σ: else a slow process's ramp takes a whole grid step).
     """
     last = len(sigma) - 1
-    count = min(max(int(np.ceil(sigma[-1] / TOPP_GRID_SPACING_M)) + 1, TOPP_MIN_GRID_POINTS),
-                most, len(sigma))  # fmt: skip
+    count = min(
+        max(int(np.ceil(sigma[-1] / TOPP_GRID_SPACING_M)) + 1, TOPP_MIN_GRID_POINTS),
+        most,
+        len(sigma),
+    )
     ends = min(ramp, 0.5 * sigma[-1]) * np.linspace(0.0, 1.0, RAMP_POINTS) ** 2
-    near = np.concatenate([np.searchsorted(sigma, ends, "left"),  # nearest the ends
-                           np.searchsorted(sigma, sigma[-1] - ends, "right") - 1])  # fmt: skip
+    near = np.concatenate(
+        [
+            np.searchsorted(sigma, ends, "left"),  # nearest the ends
+            np.searchsorted(sigma, sigma[-1] - ends, "right") - 1,
+        ]
+    )
     uniform = np.linspace(0, last, count).round().astype(int)
     return np.unique(np.concatenate([uniform, np.clip(near, 0, last)]))
 
@@ -189,8 +196,9 @@ def topp_profile(
         np.hstack([rates.dq[keep], ones]),
         np.hstack([rates.ddq[keep], 0 * ones]),
     )
-    constraints = list(_joint_constraints(tuple(np.append(qd_max, v_cap)),
-                                          tuple(np.append(qdd_max, a_path))))  # fmt: skip
+    constraints = list(
+        _joint_constraints(tuple(np.append(qd_max, v_cap)), tuple(np.append(qdd_max, a_path)))
+    )
     if v_steady is not None or a_curve is not None:
         v_curve = np.full(len(sigma), v_cap) if v_steady is None else v_steady[keep]
         a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)
@@ -225,8 +233,9 @@ def _failed_at(sigma: np.ndarray, sd, K) -> float:
     return float(sigma[0])
 
 
-def resolve_locally(profile: ToppProfile, lowered: list[tuple[float, float]], solve,
-                    reach: float) -> ToppProfile:  # fmt: skip
+def resolve_locally(
+    profile: ToppProfile, lowered: list[tuple[float, float]], solve, reach: float
+) -> ToppProfile:
     """TOPP-RA again after its limit curves were lowered on the σ stretches
     ``lowered``, re-solving only around them; exact.
 

@@ -57,8 +57,12 @@ def job_preview_scene(job) -> tuple[StaticScene, dict]:
         rows = slice(segment.start, min(segment.stop + 1, len(p_IE)))
         color = LINK_COLOR if segment.kind == "link" else FLANGE_COLOR
         scene.set_lines(f"/offline_prog/flange_path/{k}_{segment.kind}", p_IE[rows], color)
-    scene.set_camera(*camera(transform(job.cell.robot.X_IB).translation(),
-                             transform(job.cell.tool.X_IT).translation()))  # fmt: skip
+    scene.set_camera(
+        *camera(
+            transform(job.cell.robot.X_IB).translation(),
+            transform(job.cell.tool.X_IT).translation(),
+        )
+    )
     q = np.column_stack([np.interp(times, job.samples.t, job.samples.q[:, j]) for j in range(6)])
     paths, poses = body_poses(drake, bodies, q)
     scene.set_animation(paths, times, poses, PREVIEW_FPS, scales=scales)
@@ -99,8 +103,9 @@ def show_job(job, meshcat) -> dict:
     for k, segment in enumerate(job.samples.segments):
         rows = slice(segment.start, min(segment.stop + 1, len(X_IE)))
         color = LINK_COLOR if segment.kind == "link" else FLANGE_COLOR
-        meshcat.SetLine(f"/offline_prog/flange_path/{k}_{segment.kind}",
-                        X_IE[rows, :3, 3].T, 2.0, Rgba(*color))  # fmt: skip
+        meshcat.SetLine(
+            f"/offline_prog/flange_path/{k}_{segment.kind}", X_IE[rows, :3, 3].T, 2.0, Rgba(*color)
+        )
     diagram, plant = drake.diagram, drake.plant
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyContextFromRoot(context)

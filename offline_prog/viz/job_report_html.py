@@ -70,7 +70,7 @@ def _plots(report: dict, col: dict) -> dict:
                 "color": "#2e7d32" if name[0] == "d" else "#c62828",
             }
             for name in io
-        ],  # fmt: skip
+        ],
     }
     joints = {
         "title": "joint positions",
@@ -97,7 +97,7 @@ def _plots(report: dict, col: dict) -> dict:
                 "panels": [joints],
                 "caption": "Joint positions over the whole job, home to home.",
             },
-        ],  # fmt: skip
+        ],
     }
 
 
@@ -126,38 +126,68 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
     order = ", ".join(f"{o['seam']} ({o['direction']})" for o in job["order"])
     summary = [
         ("Result", word),
-        ("Order", f"{order}: {job['order_mode']} ({job['order_method']}), estimated "
-                  f"saving {job['estimated_saving_s']:.2f} s against the given order"),
-        ("Cycle time", f"{job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
-                       f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, "
-                       f"approach and retract {job['approach_retract_time_s']:.2f} s)"),
-        ("Clearance", "none checked" if report["min_distance_m"] is None
-         else f"min distance {report['min_distance_m'] * 1e3:.1f} mm"),
+        (
+            "Order",
+            f"{order}: {job['order_mode']} ({job['order_method']}), estimated "
+            f"saving {job['estimated_saving_s']:.2f} s against the given order",
+        ),
+        (
+            "Cycle time",
+            f"{job['cycle_time_s']:.2f} s: process {job['process_time_s']:.2f} s, "
+            f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, "
+            f"approach and retract {job['approach_retract_time_s']:.2f} s)",
+        ),
+        (
+            "Clearance",
+            "none checked"
+            if report["min_distance_m"] is None
+            else f"min distance {report['min_distance_m'] * 1e3:.1f} mm",
+        ),
         ("Programs", ", ".join(programs) or "none (the plan failed)"),
-    ]  # fmt: skip
-    table = "".join(f"<tr><th>{_e(k)}</th><td>{v if k == 'Result' else _e(v)}</td></tr>"
-                    for k, v in summary)  # fmt: skip
+    ]
+    table = "".join(
+        f"<tr><th>{_e(k)}</th><td>{v if k == 'Result' else _e(v)}</td></tr>" for k, v in summary
+    )
     seams = _table(
         ["seam", "length [mm]", "time [s]", "fit max error [mm]", "min clearance [mm]"],
         [
-            [s["seam"], f"{s['path']['length_m'] * 1e3:.1f}",
-             f"{s['trajectory']['duration_s']:.2f}", f"{s['fit']['max_error_mm']:.4f}",
-             "" if s["min_distance_m"] is None else f"{s['min_distance_m'] * 1e3:.1f}"]
+            [
+                s["seam"],
+                f"{s['path']['length_m'] * 1e3:.1f}",
+                f"{s['trajectory']['duration_s']:.2f}",
+                f"{s['fit']['max_error_mm']:.4f}",
+                "" if s["min_distance_m"] is None else f"{s['min_distance_m'] * 1e3:.1f}",
+            ]
             for s in report["seams"]
         ],
-    )  # fmt: skip
+    )
     links = _table(
         ["link", "method", "time [s]", "joint path [deg]", "waypoints", "min clearance [mm]"],
-        [[k["name"], k["method"] or f"FAILED: {k['failure']}", f"{k['duration_s']:.2f}",
-          f"{np.rad2deg(k['length_rad']):.1f}", k["waypoints"],
-          "" if k["min_clearance_m"] is None else f"{k['min_clearance_m'] * 1e3:.1f}"]
-         for k in report["links"]],
-    )  # fmt: skip
+        [
+            [
+                k["name"],
+                k["method"] or f"FAILED: {k['failure']}",
+                f"{k['duration_s']:.2f}",
+                f"{np.rad2deg(k['length_rad']):.1f}",
+                k["waypoints"],
+                "" if k["min_clearance_m"] is None else f"{k['min_clearance_m'] * 1e3:.1f}",
+            ]
+            for k in report["links"]
+        ],
+    )
     events = _table(
         ["seam", "output", "state", "position along the path [mm]", "t [s]"],
-        [[e["seam"], e["digital_output"], e["state"], f"{e['path_m'] * 1e3:.2f}",
-          f"{e['t_s']:.3f}"] for e in report["process_io"]],
-    )  # fmt: skip
+        [
+            [
+                e["seam"],
+                e["digital_output"],
+                e["state"],
+                f"{e['path_m'] * 1e3:.2f}",
+                f"{e['t_s']:.3f}",
+            ]
+            for e in report["process_io"]
+        ],
+    )
     data = _plots(report, col)
     text = json.dumps(data, separators=(",", ":"), allow_nan=False)
     text = text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")

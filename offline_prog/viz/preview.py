@@ -221,8 +221,12 @@ def preview_scene(plan, *, near_collision: np.ndarray | None = None) -> tuple[St
     part = part_node(drake.plant, bodies)
     scene.set_lines(f"{part}/processing_path", extra.p_P_path, PATH_COLOR)
     for axis, segments in enumerate(extra.triads):
-        scene.set_lines(f"{part}/frames/{'xyz'[axis]}", segments.reshape(-1, 3), AXIS_COLORS[axis],
-                        segments=True)  # fmt: skip
+        scene.set_lines(
+            f"{part}/frames/{'xyz'[axis]}",
+            segments.reshape(-1, 3),
+            AXIS_COLORS[axis],
+            segments=True,
+        )
     scene.set_lines("/offline_prog/flange_path", extra.p_I_flange, FLANGE_COLOR)
     count = 0
     for name, color, points in extra.markers:
@@ -262,9 +266,12 @@ def show_plan(plan, meshcat: Meshcat, *, near_collision: np.ndarray | None = Non
     meshcat.SetLine(f"{part}/processing_path", extra.p_P_path.T, 3.0, Rgba(*PATH_COLOR))
     for axis, segments in enumerate(extra.triads):
         meshcat.SetLineSegments(
-            f"{part}/frames/{'xyz'[axis]}", segments[:, 0].T, segments[:, 1].T, 2.0,
+            f"{part}/frames/{'xyz'[axis]}",
+            segments[:, 0].T,
+            segments[:, 1].T,
+            2.0,
             Rgba(*AXIS_COLORS[axis]),
-        )  # fmt: skip
+        )
     meshcat.SetLine("/offline_prog/flange_path", extra.p_I_flange.T, 2.0, Rgba(*FLANGE_COLOR))
     count = 0
     for name, color, points in extra.markers:

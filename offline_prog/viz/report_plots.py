@@ -128,14 +128,24 @@ def plot_specs(report: dict, data: ProgramData, columns: dict) -> list[dict]:
         "bands": slowdown_bands(report),
     }
     specs = [
-        ("pose", "Flange trajectory in I (as the paper's fig. 5): position, Tait-Bryan angles "
-         "R = Rx(α)Ry(β)Rz(γ), linear and angular velocity and acceleration.", 2, pose),
-        ("speed", f"Speed at the {ref} against the command: the speed limit, lowered where "
-         "the joint limits forced a speed reduction; time-optimal slowdowns are shaded, "
-         "each named by its limiting joint and constraint.", 1, [speed]),
+        (
+            "pose",
+            "Flange trajectory in I (as the paper's fig. 5): position, Tait-Bryan angles "
+            "R = Rx(α)Ry(β)Rz(γ), linear and angular velocity and acceleration.",
+            2,
+            pose,
+        ),
+        (
+            "speed",
+            f"Speed at the {ref} against the command: the speed limit, lowered where "
+            "the joint limits forced a speed reduction; time-optimal slowdowns are shaded, "
+            "each named by its limiting joint and constraint.",
+            1,
+            [speed],
+        ),
         ("joints", "Joint positions with their limits (dashed).", 3, _joint_panels(data, False)),
         ("rates", "Joint velocities with their limits (dashed).", 3, _joint_panels(data, True)),
-    ]  # fmt: skip
+    ]
     groups = [name for name in columns if name.startswith("distance:")]
     if groups:
         series = [
@@ -147,9 +157,14 @@ def plot_specs(report: dict, data: ProgramData, columns: dict) -> list[dict]:
             series.append({**_limit("clearance", report["clearance_m"] * 1e3), "color": "#ef6c00"})
         panel = {"x": "clearance_t", "ylabel": "minimum distance [mm]", "series": series}
         specs.append(
-            ("distance", "Minimum distance over time per pair group (robot, part, tool, "
-             "obstacles), against the required clearance.", 1, [panel])
-        )  # fmt: skip
+            (
+                "distance",
+                "Minimum distance over time per pair group (robot, part, tool, "
+                "obstacles), against the required clearance.",
+                1,
+                [panel],
+            )
+        )
     return [{"id": i, "caption": c, "columns": n, "panels": p} for i, c, n, p in specs]
 
 
@@ -159,8 +174,9 @@ def slowdown_bands(report: dict) -> list[dict]:
     bands = []
     for slow in report["robot_motion"].get("slowdowns", []):
         joint = f"J{slow['joint']} " if slow["joint"] is not None else ""
-        bands.append({"t0": slow["t_start_s"], "t1": slow["t_end_s"],
-                      "label": joint + slow["constraint"]})  # fmt: skip
+        bands.append(
+            {"t0": slow["t_start_s"], "t1": slow["t_end_s"], "label": joint + slow["constraint"]}
+        )
     return bands
 
 
@@ -203,9 +219,11 @@ def _svg_view(lines: list[tuple[np.ndarray, str, float]], labels, axes: tuple[in
         d = " ".join(f"{a:.1f},{b:.1f}" for a, b in xy(p))
         body.append(f'<polyline points="{d}" fill="none" stroke="{color}" stroke-width="{width}"/>')
     for p, text in labels:
-        (a, b), = xy(p[None])  # fmt: skip
-        body.append(f'<circle cx="{a:.1f}" cy="{b:.1f}" r="3"/><text x="{a + 5:.1f}" '
-                    f'y="{b - 5:.1f}">{text}</text>')  # fmt: skip
+        ((a, b),) = xy(p[None])
+        body.append(
+            f'<circle cx="{a:.1f}" cy="{b:.1f}" r="3"/><text x="{a + 5:.1f}" '
+            f'y="{b - 5:.1f}">{text}</text>'
+        )
     names = "xyz"
     full = size + 2 * pad
     return (

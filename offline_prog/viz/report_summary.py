@@ -96,45 +96,88 @@ _RM, _STEP, _RED = (
     "robot_motion.largest_joint_step",
     "robot_motion.speed_reductions",
 )
-# fmt: off
 ROWS = (
     ("Cell", "{name} ({cell})"),
     ("Robot", "{robot}, IK branch {robot_motion.branch:d}"),
-    ("Tool", "{tool}, turned {robot_motion.tool_rotation_deg:.1f °} about its axis "
-     "({robot_motion.tool_turn_deg.0:.1f °} to {robot_motion.tool_turn_deg.1:.1f °} along "
-     "the path)"),
+    (
+        "Tool",
+        "{tool}, turned {robot_motion.tool_rotation_deg:.1f °} about its axis "
+        "({robot_motion.tool_turn_deg.0:.1f °} to {robot_motion.tool_turn_deg.1:.1f °} along "
+        "the path)",
+    ),
     ("Part", "{part}"),
     ("Path length", "{path.length_m:.4f m} ({path.source}, {path.n_points:d} points)"),
-    ("Fit error", "max {fit.max_error_mm:.4f mm}, RMS {fit.rms_error_mm:.4f mm} (tolerance "
-     "{fit.tolerance_mm:.3f mm}; degree {fit.degree:d}, {fit.n_control_points:d} control "
-     "points)"),
-    ("Cycle time", "{trajectory.duration_s:.3f s} (without joint limits "
-     "{robot_motion.cycle_time_without_joint_limits_s:.3f s})"),
-    ("Speed command", "{motion.limits.speed_m_s:.4f m/s} at the {motion.speed_reference}, "
-     "reached {motion.top_speed_m_s:.4f m/s}; acceleration "
-     "{motion.limits.max_acceleration_m_s2:.3f m/s²}, jerk {motion.limits.max_jerk_m_s3:.2f m/s³}"),
-    ("TCP speed held", "max deviation {trajectory.tcp_speed_max_error_rel:.2g %} of the top "
-     "speed; chord check {trajectory.chord_speed_max_error_rel:.2g %}"),
-    ("Flange", "max speed {trajectory.max_flange_speed_m_s:.4f m/s}, acceleration "
-     "{trajectory.max_flange_acceleration_m_s2:.3f m/s²}, angular speed "
-     "{trajectory.max_angular_speed_rad_s:.3f rad/s}"),
-    ("Cusps", "{cusps:d}", "cusps", "σ = {cusps.#.sigma_m:.4f m}: {cusps.#.kind}, flange at "
-     "{cusps.#.flange_speed_ratio:.2f ×} the TCP speed"),
+    (
+        "Fit error",
+        "max {fit.max_error_mm:.4f mm}, RMS {fit.rms_error_mm:.4f mm} (tolerance "
+        "{fit.tolerance_mm:.3f mm}; degree {fit.degree:d}, {fit.n_control_points:d} control "
+        "points)",
+    ),
+    (
+        "Cycle time",
+        "{trajectory.duration_s:.3f s} (without joint limits "
+        "{robot_motion.cycle_time_without_joint_limits_s:.3f s})",
+    ),
+    (
+        "Speed command",
+        "{motion.limits.speed_m_s:.4f m/s} at the {motion.speed_reference}, "
+        "reached {motion.top_speed_m_s:.4f m/s}; acceleration "
+        "{motion.limits.max_acceleration_m_s2:.3f m/s²}, "
+        "jerk {motion.limits.max_jerk_m_s3:.2f m/s³}",
+    ),
+    (
+        "TCP speed held",
+        "max deviation {trajectory.tcp_speed_max_error_rel:.2g %} of the top "
+        "speed; chord check {trajectory.chord_speed_max_error_rel:.2g %}",
+    ),
+    (
+        "Flange",
+        "max speed {trajectory.max_flange_speed_m_s:.4f m/s}, acceleration "
+        "{trajectory.max_flange_acceleration_m_s2:.3f m/s²}, angular speed "
+        "{trajectory.max_angular_speed_rad_s:.3f rad/s}",
+    ),
+    (
+        "Cusps",
+        "{cusps:d}",
+        "cusps",
+        "σ = {cusps.#.sigma_m:.4f m}: {cusps.#.kind}, flange at "
+        "{cusps.#.flange_speed_ratio:.2f ×} the TCP speed",
+    ),
     ("Minimum distance", None),
-    ("Joint-limit margins", "(min {robot_motion.min_joint_limit_margin_deg:.1f °})",
-     f"{_RM}.joint_limit_margin_deg", f"{{{_RM}.joint_limit_margin_deg.#:.1f °}}", True),
-    ("Joint speed use", "of the limit", f"{_RM}.max_joint_speed_use",
-     f"{{{_RM}.max_joint_speed_use.#:.1f %}}", True),
-    ("Largest joint step", f"{{{_STEP}.step_deg:.3f °}} on joint {{{_STEP}.joint:d}} at "
-     f"σ = {{{_STEP}.sigma_m:.4f m}}"),
-    ("Singularity distance", "", f"{_RM}.singularities",
-     f"#: {{{_RM}.singularities.#.distance:.3f}} {{{_RM}.singularities.#.unit}} at "
-     f"σ = {{{_RM}.singularities.#.sigma_m:.4f m}}"),
-    ("Speed reductions", f"{{{_RED}:d}}", _RED, f"σ {{{_RED}.#.sigma_start_m:.4f m}} to "
-     f"{{{_RED}.#.sigma_end_m:.4f m}}: {{{_RED}.#.speed_m_s:.4f m/s}} "
-     f"(−{{{_RED}.#.reduction_percent:.1f %}})"),
+    (
+        "Joint-limit margins",
+        "(min {robot_motion.min_joint_limit_margin_deg:.1f °})",
+        f"{_RM}.joint_limit_margin_deg",
+        f"{{{_RM}.joint_limit_margin_deg.#:.1f °}}",
+        True,
+    ),
+    (
+        "Joint speed use",
+        "of the limit",
+        f"{_RM}.max_joint_speed_use",
+        f"{{{_RM}.max_joint_speed_use.#:.1f %}}",
+        True,
+    ),
+    (
+        "Largest joint step",
+        f"{{{_STEP}.step_deg:.3f °}} on joint {{{_STEP}.joint:d}} at σ = {{{_STEP}.sigma_m:.4f m}}",
+    ),
+    (
+        "Singularity distance",
+        "",
+        f"{_RM}.singularities",
+        f"#: {{{_RM}.singularities.#.distance:.3f}} {{{_RM}.singularities.#.unit}} at "
+        f"σ = {{{_RM}.singularities.#.sigma_m:.4f m}}",
+    ),
+    (
+        "Speed reductions",
+        f"{{{_RED}:d}}",
+        _RED,
+        f"σ {{{_RED}.#.sigma_start_m:.4f m}} to "
+        f"{{{_RED}.#.sigma_end_m:.4f m}}: {{{_RED}.#.speed_m_s:.4f m/s}} "
+        f"(−{{{_RED}.#.reduction_percent:.1f %}})",
+    ),
 )
-# fmt: on
 
 
 def _min_distance_cell(report: dict) -> str:

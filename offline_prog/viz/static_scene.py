@@ -124,15 +124,29 @@ class StaticScene:
                 "depth": size[2],
             }
         elif kind == "sphere":
-            geometry = {"type": "SphereGeometry", "radius": size[0], "widthSegments": 24,
-                        "heightSegments": 16}  # fmt: skip
+            geometry = {
+                "type": "SphereGeometry",
+                "radius": size[0],
+                "widthSegments": 24,
+                "heightSegments": 16,
+            }
         elif kind == "cylinder":
-            geometry = {"type": "CylinderGeometry", "radiusTop": size[0], "radiusBottom": size[0],
-                        "height": size[1], "radialSegments": 32}  # fmt: skip
+            geometry = {
+                "type": "CylinderGeometry",
+                "radiusTop": size[0],
+                "radiusBottom": size[0],
+                "height": size[1],
+                "radialSegments": 32,
+            }
             matrix = _Y_TO_Z
         elif kind == "capsule":
-            geometry = {"type": "CapsuleGeometry", "radius": size[0], "length": size[1],
-                        "capSegments": 12, "radialSegments": 24}  # fmt: skip
+            geometry = {
+                "type": "CapsuleGeometry",
+                "radius": size[0],
+                "length": size[1],
+                "capSegments": 12,
+                "radialSegments": 24,
+            }
             matrix = _Y_TO_Z
         else:
             raise ValueError(f"preview: no primitive {kind!r}")
@@ -182,8 +196,9 @@ class StaticScene:
         for path, scale in (scales or {}).items():
             values = [[float(v)] * 3 for v in np.asarray(scale)[keep]]
             track = {"name": ".scale", "type": "vector3", "keys": _keys(frames, values)}
-            animations.append({"path": path, "clip": {"fps": fps, "name": "default",
-                                                      "tracks": [track]}})  # fmt: skip
+            animations.append(
+                {"path": path, "clip": {"fps": fps, "name": "default", "tracks": [track]}}
+            )
         for path, X in zip(paths, poses, strict=True):
             positions = X[:, :3, 3].tolist()
             quaternions = Rotation.from_matrix(X[:, :3, :3]).as_quat().tolist()  # x, y, z, w

@@ -84,9 +84,14 @@ X_PPlate = RigidTransform([0.0, 0.0, 0.005])
 def plate_cell(robot, obstacles, part=None, **kwargs):
     part = part or [box("plate", PLATE, X_PPlate)]
     return build_drake_cell(
-        robot, X_IB=RigidTransform(), X_IT=X_IT, X_PE=X_PE, part_shapes=part,
-        obstacles=obstacles, **kwargs,
-    )  # fmt: skip
+        robot,
+        X_IB=RigidTransform(),
+        X_IT=X_IT,
+        X_PE=X_PE,
+        part_shapes=part,
+        obstacles=obstacles,
+        **kwargs,
+    )
 
 
 def test_obstacle_in_the_path_collides_at_the_right_sigma_with_the_right_pair(kr16):
@@ -234,9 +239,15 @@ def test_demo_cells_with_geometry_are_clear_and_list_the_tool_contact(name, tmp_
     # Without the tool-on-part contact allowed, that contact is what the check reports.
     geometry = cell_geometry(plan.cell, plan.cell_file)
     unfiltered = build_drake_cell(
-        plan.robot, X_IB=cell.X_IB, X_IT=cell.X_IT, X_PE=cell.X_PE, part_shapes=geometry.part,
-        tool_shapes=geometry.tool, obstacles=geometry.obstacles, allowed_contact=allowed[1:],
-    )  # fmt: skip
+        plan.robot,
+        X_IB=cell.X_IB,
+        X_IT=cell.X_IT,
+        X_PE=cell.X_PE,
+        part_shapes=geometry.part,
+        tool_shapes=geometry.tool,
+        obstacles=geometry.obstacles,
+        allowed_contact=allowed[1:],
+    )
     touching = check_trajectory(unfiltered, plan.joints.q, traj.t, traj.s, clearance=clearance)
     assert not touching.collision_free
     assert {touching.closest.a, touching.closest.b} == set(allowed[0])
@@ -249,9 +260,11 @@ def test_exact_distances_match_the_analytic_ones(rng):
         p_IC = rng.uniform(-1, 1, 3)
         r_a, r_b = rng.uniform(0.01, 0.2, 2)
         spheres = exact_distance(
-            exact_shape("sphere", (r_a,), None), X_IA, exact_shape("sphere", (r_b,), None),
+            exact_shape("sphere", (r_a,), None),
+            X_IA,
+            exact_shape("sphere", (r_b,), None),
             RigidTransform(p_IC),
-        )  # fmt: skip
+        )
         expected = np.linalg.norm(p_IC - X_IA.translation()) - r_a - r_b
         assert spheres == pytest.approx(expected, abs=EXACT_TOL_M)
         size = tuple(rng.uniform(0.05, 0.5, 3))
@@ -265,9 +278,11 @@ def test_exact_distances_match_the_analytic_ones(rng):
             d = exact_distance(solid, X_IA, small, RigidTransform(p_IC))
             assert d == pytest.approx(expected, abs=EXACT_TOL_M)
     inside = exact_distance(
-        exact_shape("mesh", (), trimesh.creation.box(extents=(0.2, 0.2, 0.2))), RigidTransform(),
-        exact_shape("sphere", (0.01,), None), RigidTransform(),
-    )  # fmt: skip
+        exact_shape("mesh", (), trimesh.creation.box(extents=(0.2, 0.2, 0.2))),
+        RigidTransform(),
+        exact_shape("sphere", (0.01,), None),
+        RigidTransform(),
+    )
     assert inside == 0.0  # a solid inside a mesh is in contact, not 90 mm away
 
 

@@ -19,9 +19,12 @@ P_I_PROBE = np.array([-0.161, 0.199, 0.634])
 
 def _check(robot, obstacles, q, **clearances):
     cell = build_drake_cell(
-        robot, X_IB=RigidTransform(), X_IT=RigidTransform([3.0, 0, 0]),
-        X_PE=RigidTransform([0, 0, -0.1]), obstacles=obstacles,
-    )  # fmt: skip
+        robot,
+        X_IB=RigidTransform(),
+        X_IT=RigidTransform([3.0, 0, 0]),
+        X_PE=RigidTransform([0, 0, -0.1]),
+        obstacles=obstacles,
+    )
     q = np.asarray(q, dtype=float)
     t = np.arange(len(q), dtype=float)
     return cell, check_trajectory(cell, q, t, t, **{"clearance": 0.005, **clearances})
@@ -85,9 +88,14 @@ def test_the_fixed_layout_is_checked_a_duct_through_the_base_fails(tmp_path):
     text = (CELLS / "seal_plate_kr16.yaml").read_text().replace(": data/", f": {CELLS}/data/")
     assert "obstacles:   # in I" in text
     file = tmp_path / "duct.yaml"
-    file.write_text(text.replace("obstacles:   # in I", "obstacles:   # in I\n"
-        "  - {name: cable_duct, shape: box, size_mm: [200, 200, 150], "
-        "pose: {translation: [-0.25, 0.0, 0.25]}}"))  # fmt: skip
+    file.write_text(
+        text.replace(
+            "obstacles:   # in I",
+            "obstacles:   # in I\n"
+            "  - {name: cable_duct, shape: box, size_mm: [200, 200, 150], "
+            "pose: {translation: [-0.25, 0.0, 0.25]}}",
+        )
+    )
     plan = plan_cell(file)
     assert not plan.feasible and plan.failure.startswith("collision: base_link vs cable_duct")
     pairs = {(p.a, p.b): p.distance_m for p in plan.collisions.pairs}

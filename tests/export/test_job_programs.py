@@ -90,16 +90,18 @@ KRL_DECL = re.compile(r"^DECL (E6POS|E6AXIS) (\w+)=\{(.*)\}$")
 
 
 def krl_fields(text: str) -> dict[str, float]:
-    return {k: float(v) for k, v in (item.split() for item in text.split(",")) if k != "S"
-            and k != "T"}  # fmt: skip
+    return {
+        k: float(v) for k, v in (item.split() for item in text.split(",")) if k != "S" and k != "T"
+    }
 
 
 def krl_tool_in_part(fields) -> np.ndarray:
     """p_PT [m]: the E6POS is P in T (X_TP, KUKA Z-Y'-X'' angles); the tool in P is its
     inverse's translation."""
     X = np.eye(4)
-    X[:3, :3] = Rotation.from_euler("ZYX", [fields["A"], fields["B"], fields["C"]],
-                                    degrees=True).as_matrix()  # fmt: skip
+    X[:3, :3] = Rotation.from_euler(
+        "ZYX", [fields["A"], fields["B"], fields["C"]], degrees=True
+    ).as_matrix()
     X[:3, 3] = np.array([fields["X"], fields["Y"], fields["Z"]]) * 1e-3
     return np.linalg.inv(X)[:3, 3]
 
@@ -217,9 +219,10 @@ def test_rapid_job_links_approach_retract_and_io(folders):
     targets = [MOVE.match(line)[2] for line in run if line.startswith("MoveAbsJ")]
     planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
     np.testing.assert_allclose(
-        [joints[t] for t in targets], abb_axes_deg(np.array(planned), j23_coupled=True),
+        [joints[t] for t in targets],
+        abb_axes_deg(np.array(planned), j23_coupled=True),
         atol=JOINT_TOL_DEG,
-    )  # fmt: skip
+    )
     triggs, here, position, switched, q_link = {}, None, 0.0, {}, None
     for line in run:
         if line.startswith("TriggIO"):
@@ -308,7 +311,8 @@ def test_export_of_a_job_refuses_one_seam_options_in_one_line(folders, capsys):
     assert main(["export", str(plan_folder), "--format", "krl", "--out", str(out)]) == 0
     assert (out / "offline_prog.src").is_file()
     capsys.readouterr()
-    code = main(["export", str(plan_folder), "--format", "krl", "--style", "flange",
-                 "--out", str(out)])  # fmt: skip
+    code = main(
+        ["export", str(plan_folder), "--format", "krl", "--style", "flange", "--out", str(out)]
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "style is for one-seam plans" in err[0]

@@ -65,9 +65,18 @@ def test_a_thin_plate_across_a_direct_move_is_found_between_samples(plate_across
     assert all(checker.clear(q) for q in samples[[0, 1, 2, 4, 5, 6]])
     assert not checker.move_clear(q_a, q_b)
     link = plan_link(
-        scene, inputs.robot, q_a, q_b, clearance=CLEARANCE, self_clearance=CLEARANCE,
-        seed=0, time_budget_s=20.0, rate_hz=250.0, name="home -> turned", checker=checker,
-    )  # fmt: skip
+        scene,
+        inputs.robot,
+        q_a,
+        q_b,
+        clearance=CLEARANCE,
+        self_clearance=CLEARANCE,
+        seed=0,
+        time_budget_s=20.0,
+        rate_hz=250.0,
+        name="home -> turned",
+        checker=checker,
+    )
     assert link.ok and link.method == "planned"
     # The timed link, certified between samples on the exact shapes, is clear.
     result = check_trajectory(scene, link.q, link.t, np.zeros(len(link.t)), clearance=CLEARANCE)
@@ -79,9 +88,17 @@ def test_direct_move_when_nothing_is_in_the_way(ends):
     scene = build_scene(inputs)
     q_a, q_b, _ = ends
     link = plan_link(
-        scene, inputs.robot, q_a, q_b, clearance=CLEARANCE, self_clearance=CLEARANCE,
-        seed=0, time_budget_s=5.0, rate_hz=250.0, name="direct",
-    )  # fmt: skip
+        scene,
+        inputs.robot,
+        q_a,
+        q_b,
+        clearance=CLEARANCE,
+        self_clearance=CLEARANCE,
+        seed=0,
+        time_budget_s=5.0,
+        rate_hz=250.0,
+        name="direct",
+    )
     assert link.ok and link.method == "direct"
     np.testing.assert_array_equal(link.waypoints, [q_a, q_b])
 
@@ -101,7 +118,7 @@ def test_same_seed_same_link(plate_across, ends):
             time_budget_s=20.0,
             rate_hz=250.0,
             name="again",
-        )  # fmt: skip
+        )
         for _ in range(2)
     ]
     np.testing.assert_array_equal(links[0].waypoints, links[1].waypoints)
@@ -113,9 +130,17 @@ def test_timed_link_keeps_the_joint_limits_and_ends_at_its_goal(plate_across, en
     robot = inputs.robot
     q_a, q_b, _ = ends
     link = plan_link(
-        scene, robot, q_a, q_b, clearance=CLEARANCE, self_clearance=CLEARANCE,
-        seed=0, time_budget_s=20.0, rate_hz=250.0, name="limits",
-    )  # fmt: skip
+        scene,
+        robot,
+        q_a,
+        q_b,
+        clearance=CLEARANCE,
+        self_clearance=CLEARANCE,
+        seed=0,
+        time_budget_s=20.0,
+        rate_hz=250.0,
+        name="limits",
+    )
     np.testing.assert_array_equal(link.q[0], q_a)
     np.testing.assert_allclose(link.q[-1], q_b, atol=1e-12)
     q_c = robot.controller_joints(link.q)
@@ -145,9 +170,17 @@ def test_goal_inside_an_obstacle_is_a_failure_naming_the_link(tmp_path, ends):
     )
     inputs, scene = cell_with(tmp_path, obstacle)
     link = plan_link(
-        scene, inputs.robot, q_a, q_b, clearance=CLEARANCE, self_clearance=CLEARANCE,
-        seed=0, time_budget_s=2.0, rate_hz=250.0, name="home -> blocked",
-    )  # fmt: skip
+        scene,
+        inputs.robot,
+        q_a,
+        q_b,
+        clearance=CLEARANCE,
+        self_clearance=CLEARANCE,
+        seed=0,
+        time_budget_s=2.0,
+        rate_hz=250.0,
+        name="home -> blocked",
+    )
     assert not link.ok
     assert "link home -> blocked" in link.failure.reason
     assert "goal configuration" in link.failure.reason

@@ -17,7 +17,14 @@ def test_free_rotation_of_a_drake_family_robot_is_tried_smallest_first():
     inputs = load_inputs(CELLS / "seal_plate_kr16.yaml", ROBOTS_DIR)
     robot = dataclasses.replace(inputs.robot, family="drake", params=None)
     fit = fit_path(inputs)
-    rotations = tool_rotations(robot, inputs.X_IB, fit.path, fit.normal, X_IT=inputs.X_IT,
-                               X_PE=inputs.X_PE, bound_rad=np.deg2rad(20.0))  # fmt: skip
+    rotations = tool_rotations(
+        robot,
+        inputs.X_IB,
+        fit.path,
+        fit.normal,
+        X_IT=inputs.X_IT,
+        X_PE=inputs.X_PE,
+        bound_rad=np.deg2rad(20.0),
+    )
     phis = [phi for phi, _ in rotations]
     assert phis[0] == 0.0 and np.all(np.diff(np.abs(phis)) >= 0) and len(phis) == 9

@@ -114,8 +114,10 @@ def test_missing_stretch_is_refused_naming_gap_and_spacing(tmp_path):
     assert "a stretch of the contour is missing" in message
     run = subprocess.run(
         [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(tmp_path / "o")],
-        cwd=REPO, capture_output=True, text=True,
-    )  # fmt: skip
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 2 and run.stdout == ""
     assert run.stderr.strip() == f"error: {message}" and not (tmp_path / "o").exists()
 

@@ -37,8 +37,9 @@ def test_process_pose_holds_and_derivatives_are_exact(rng, closed):
     for _ in range(3):
         base = random_flange_path(rng, closed=closed)
         turn = SmoothTurn(base.path, base.normal, axis="y", width_m=0.02, offset_rad=0.3)
-        flange = FlangePath(base.path, base.normal, X_IT=base.X_IT, X_PE=base.X_PE,
-                            tool_turn=turn, axis=Y)  # fmt: skip
+        flange = FlangePath(
+            base.path, base.normal, X_IT=base.X_IT, X_PE=base.X_PE, tool_turn=turn, axis=Y
+        )
         s = rng.uniform(0.01, flange.length - 0.01, 200)
         f = flange(s)
         R_PE, p_PE = flange.X_PE.rotation().matrix(), flange.X_PE.translation()
@@ -53,10 +54,14 @@ def test_process_pose_holds_and_derivatives_are_exact(rng, closed):
         # φ′ and φ″ against central differences of φ and φ′.
         h = 1e-5
         phi, dphi, ddphi = turn(s)
-        np.testing.assert_allclose(dphi, (turn(s + h)[0] - turn(s - h)[0]) / (2 * h),
-                                   atol=1e-5 * (1 + np.abs(dphi).max()))  # fmt: skip
-        np.testing.assert_allclose(ddphi, (turn(s + h)[1] - turn(s - h)[1]) / (2 * h),
-                                   atol=1e-4 * (1 + np.abs(ddphi).max()))  # fmt: skip
+        np.testing.assert_allclose(
+            dphi, (turn(s + h)[0] - turn(s - h)[0]) / (2 * h), atol=1e-5 * (1 + np.abs(dphi).max())
+        )
+        np.testing.assert_allclose(
+            ddphi,
+            (turn(s + h)[1] - turn(s - h)[1]) / (2 * h),
+            atol=1e-4 * (1 + np.abs(ddphi).max()),
+        )
 
 
 def test_corner_turn_is_spread_and_the_seam_joins():
@@ -85,9 +90,16 @@ def test_every_turn_tried_stays_within_the_free_rotation(bound_deg, width_mm):
     fit = fit_path(inputs)
     turn = SmoothTurn(fit.path, fit.normal, axis="y", width_m=width_mm * 1e-3)
     bound = np.deg2rad(bound_deg)
-    rotations = tool_rotations(inputs.robot, inputs.X_IB, fit.path, fit.normal,
-                               X_IT=inputs.X_IT, X_PE=inputs.X_PE, bound_rad=bound,
-                               smooth_turn=turn)  # fmt: skip
+    rotations = tool_rotations(
+        inputs.robot,
+        inputs.X_IB,
+        fit.path,
+        fit.normal,
+        X_IT=inputs.X_IT,
+        X_PE=inputs.X_PE,
+        bound_rad=bound,
+        smooth_turn=turn,
+    )
     # The outermost φ₀ each way, every 12 µm (between the splines' 0.5 mm nodes).
     fine = np.linspace(0.0, fit.path.length, 100_001)
     for _, flange in (min(rotations, key=lambda r: r[0]), max(rotations, key=lambda r: r[0])):
@@ -105,8 +117,9 @@ def test_every_turn_tried_stays_within_the_free_rotation(bound_deg, width_mm):
 
 
 def test_open_path_turn_holds_its_ends(rng):
-    points = np.column_stack([np.linspace(0, 0.3, 40), 0.05 * np.sin(np.linspace(0, 6, 40)),
-                              np.zeros(40)])  # fmt: skip
+    points = np.column_stack(
+        [np.linspace(0, 0.3, 40), 0.05 * np.sin(np.linspace(0, 6, 40)), np.zeros(40)]
+    )
     path = ArcLengthPath(fit_bspline(points, closed=False, tolerance_m=1e-6))
     turn = SmoothTurn(path, constant_normal([0, 0, 1]), axis="y", width_m=0.02)
     phi = turn(np.linspace(0, path.length, 500))[0]

@@ -73,8 +73,9 @@ def test_the_stand_moves_with_the_tool():
     others = [o.pose for o in moved.obstacles if o.name != "nozzle_stand"]
     assert [transform(p).GetAsMatrix4().tolist() for p in others] == [
         transform(o.pose).GetAsMatrix4().tolist()
-        for o in cell.obstacles if o.name != "nozzle_stand"
-    ]  # fmt: skip
+        for o in cell.obstacles
+        if o.name != "nozzle_stand"
+    ]
     assert moved.part.X_PE.rotation.value.deg.tolist() == [180.0, 0.0, 90.0]
 
 
@@ -110,8 +111,11 @@ def test_a_job_is_screened_seam_by_seam():
     file = CELLS / "seal_job_kr16.yaml"
     ctx = context(cell_payload(file, load_cell(file)))
     assert [s.inputs.cell.path.analytic.kind for s in ctx.seams] == [
-        "rounded_rectangle", "arc", "arc", "line",
-    ]  # fmt: skip
+        "rounded_rectangle",
+        "arc",
+        "arc",
+        "line",
+    ]
     X_PE = ((0.0, 0.0, 0.1), (180.0, 0.0, 0.0))
     given = screen(ctx, Candidate((), -1, ((1.0, 0.0, 0.5), (90.0, 0.0, 0.0)), X_PE))
     assert given.tier == FEASIBLE
@@ -135,8 +139,10 @@ def test_the_payload_keeps_symlinked_and_absolute_data_files(tmp_path):
     (shared / "weld_seam.dxf").write_bytes(dxf.read_bytes())
     (data / "weld_seam.dxf").symlink_to(shared / "weld_seam.dxf")
     text = (CELLS / "weld_seam_irb2400.yaml").read_text()
-    for name, source in (("linked", "../data/weld_seam.dxf"),
-                         ("absolute", str(shared / "weld_seam.dxf"))):  # fmt: skip
+    for name, source in (
+        ("linked", "../data/weld_seam.dxf"),
+        ("absolute", str(shared / "weld_seam.dxf")),
+    ):
         file = cells / f"{name}.yaml"
         file.write_text(text.replace("dxf: data/weld_seam.dxf", f"dxf: {source}"))
         copy = unpack(cell_payload(file, load_cell(file)))
@@ -157,9 +163,17 @@ def test_why_not_more_names_the_fixed_tool_turn():
     from offline_prog.placement.space import Candidate
 
     pose = ((1.0, 0.0, 0.5), (90.0, 0.0, 0.0))
-    run = Evaluation(Candidate((), -1, pose, pose), "plan", FEASIBLE, 0.0, "",
-                     cycle_time_s=14.0, process_bound_s=12.0, slowed_share=0.2,
-                     limiting_axis=6)  # fmt: skip
+    run = Evaluation(
+        Candidate((), -1, pose, pose),
+        "plan",
+        FEASIBLE,
+        0.0,
+        "",
+        cycle_time_s=14.0,
+        process_bound_s=12.0,
+        slowed_share=0.2,
+        limiting_axis=6,
+    )
     base = dataclasses.replace(run, cycle_time_s=14.5)
     result = Placement(run, base, [base, run], [], 1.0)
     fixed = ToolConfig(free_rotation_deg=90.0)

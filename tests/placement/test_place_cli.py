@@ -18,8 +18,16 @@ from offline_prog.plan import plan_job
 from conftest import CELLS
 
 DEMO = CELLS / "placement" / "seal_out_of_reach_kr16.yaml"
-CONTRACT = {"X_IT", "X_PE", "feasible", "cycle_time_s", "joint_limit_margin_deg",
-            "singularity_margin_deg", "clearance_mm", "reason"}  # fmt: skip
+CONTRACT = {
+    "X_IT",
+    "X_PE",
+    "feasible",
+    "cycle_time_s",
+    "joint_limit_margin_deg",
+    "singularity_margin_deg",
+    "clearance_mm",
+    "reason",
+}
 
 
 def small_search(tmp_path, screen_points: int = 100):
@@ -84,8 +92,9 @@ def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_p
 @pytest.mark.slow  # the scheduler's connect timeout: 5 s
 def test_an_unreachable_scheduler_is_one_line_exit_2_within_seconds(tmp_path, capsys):
     start = time.monotonic()
-    code = main(["place", str(DEMO), "--out", str(tmp_path / "o"),
-                 "--scheduler", "tcp://127.0.0.1:9"])  # fmt: skip
+    code = main(
+        ["place", str(DEMO), "--out", str(tmp_path / "o"), "--scheduler", "tcp://127.0.0.1:9"]
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1, err
     assert "tcp://127.0.0.1:9" in err[0] and "--scheduler" in err[0] and "cannot reach" in err[0]
@@ -98,10 +107,22 @@ def test_ctrl_c_stops_the_workers_exit_130_one_line_no_folder(tmp_path):
     file = small_search(tmp_path, screen_points=1000)
     out = tmp_path / "o"
     process = subprocess.Popen(
-        [sys.executable, "-m", "offline_prog", "place", str(file), "--out", str(out),
-         "--workers", "2"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "place",
+            str(file),
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     # Wait until the LocalCluster's worker processes run (they share the command's
     # process group), then interrupt it while it screens: no fixed 12 s sleep.
     deadline = time.monotonic() + 60

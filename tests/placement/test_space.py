@@ -33,12 +33,20 @@ def _variant(tmp_path, old: str, new: str):
         # numpy takes seeds below 2³², and CMA-ES gets seed + 1 + its restarts
         ("seed: 0", "seed: 4294967295", "place.seed", "outside 0..2,147,483,647"),
         ("seed: 0", "seed: -1", "place.seed", "outside 0..2,147,483,647"),
-        ("moves_with_tool: [nozzle_stand]", "moves_with_tool: [stand]",
-         "place.moves_with_tool[0]", "'stand' is not an obstacle"),
-        ("  X_PE:   ", "  X_PE:\n    rpy_deg: {yaw: [-10, 10]}\n  ", "place.X_PE.rpy_deg.yaw",
-         "the grasps differ on this axis"),
+        (
+            "moves_with_tool: [nozzle_stand]",
+            "moves_with_tool: [stand]",
+            "place.moves_with_tool[0]",
+            "'stand' is not an obstacle",
+        ),
+        (
+            "  X_PE:   ",
+            "  X_PE:\n    rpy_deg: {yaw: [-10, 10]}\n  ",
+            "place.X_PE.rpy_deg.yaw",
+            "the grasps differ on this axis",
+        ),
     ],
-)  # fmt: skip
+)
 def test_bad_place_input_is_one_line_exit_2_nothing_written(
     tmp_path, capsys, old, new, key, reason
 ):
@@ -84,9 +92,11 @@ def test_unit_coordinates_map_onto_the_named_ranges_only(rng):
     cell = load_cell(DEMO)
     place, space = check_place(DEMO, cell)
     assert [a.key for a in space.axes] == [
-        "place.X_IT.translation_mm.x", "place.X_IT.translation_mm.y",
-        "place.X_IT.translation_mm.z", "place.X_IT.rpy_deg.yaw",
-    ]  # fmt: skip
+        "place.X_IT.translation_mm.x",
+        "place.X_IT.translation_mm.y",
+        "place.X_IT.translation_mm.z",
+        "place.X_IT.rpy_deg.yaw",
+    ]
     low, high = space.candidate([0, 0, 0, 0], 1), space.candidate([1, 1, 1, 1], 1)
     assert low.X_IT == ((0.7, -0.4, 0.4), (90.0, 0.0, 0.0))
     assert high.X_IT == ((1.9, 0.4, 0.9), (90.0, 0.0, 60.0))

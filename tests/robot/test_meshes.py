@@ -134,9 +134,14 @@ def test_committed_matrix_classes_follow_their_distances(name):
             continue
         low, high = p.min_distance_m, p.max_distance_m
         expected = (
-            "always" if high <= 0 else "constant" if high - low < CONSTANT_SPREAD_M
-            else "never" if low > NEVER_MARGIN_M else "check"
-        )  # fmt: skip
+            "always"
+            if high <= 0
+            else "constant"
+            if high - low < CONSTANT_SPREAD_M
+            else "never"
+            if low > NEVER_MARGIN_M
+            else "check"
+        )
         assert p.kind == expected, p
 
 
@@ -156,8 +161,9 @@ def test_matrix_is_deterministic_for_a_seed_and_finds_the_known_pairs():
 def test_committed_matrix_is_what_the_command_computes(name):
     record = yaml.safe_load((ROBOTS_DIR / name / MATRIX_FILE).read_text())
     pairs = compute_matrix(load_robot(name), samples=record["samples"], seed=record["seed"])
-    assert [(p.a, p.b, p.kind) for p in pairs] == [(p["a"], p["b"], p["class"]) for p in
-                                                   record["pairs"]]  # fmt: skip
+    assert [(p.a, p.b, p.kind) for p in pairs] == [
+        (p["a"], p["b"], p["class"]) for p in record["pairs"]
+    ]
 
 
 def test_every_robot_ships_meshes_licence_and_sources():

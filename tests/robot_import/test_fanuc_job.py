@@ -44,9 +44,13 @@ SPEED_M_S = 0.15
 
 def _m20ia(work: Path) -> None:
     import_robot(
-        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro", name="fanuc_m20ia", out=work / "robots",
-        package_paths=[FANUC], vendor="fanuc", samples=500,
-    )  # fmt: skip
+        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
+        name="fanuc_m20ia",
+        out=work / "robots",
+        package_paths=[FANUC],
+        vendor="fanuc",
+        samples=500,
+    )
 
 
 def _on_m20ia(text: str) -> str:
@@ -173,9 +177,10 @@ def _check_job(data, folder, robot, cell):
     joints = [np.radians(e["joints"]) for s, e in run if s.startswith("J ")]
     planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
     np.testing.assert_allclose(
-        np.degrees(joints), np.degrees(robot.controller_joints(np.array(planned))),
+        np.degrees(joints),
+        np.degrees(robot.controller_joints(np.array(planned))),
         atol=JOINT_TOL_DEG,
-    )  # fmt: skip
+    )
     io = load_cell(cell).tool.process_io
     seams = _walk(data, folder, robot)
     assert len(seams) == len(data.seam_names)

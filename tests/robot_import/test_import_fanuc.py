@@ -47,7 +47,7 @@ def robots(tmp_path_factory):
             package_paths=[FANUC],
             vendor="fanuc",
             samples=500,
-        )  # fmt: skip
+        )
         for model in MODELS
     }
     return out, results
@@ -68,9 +68,16 @@ def test_opw_parameters_equal_the_published_ones(robots, model):
 def test_folder_has_the_bundled_layout(robots, model):
     out, results = robots
     folder = out / f"fanuc_{model}"
-    for name in ("robot.yaml", "README.md", "self_collision.yaml", f"fanuc_{model}.urdf",
-                 "meshes/SOURCES.md", "meshes/LICENSE", "meshes/visual/link_4.obj",
-                 "meshes/collision/link_4.obj"):  # fmt: skip
+    for name in (
+        "robot.yaml",
+        "README.md",
+        "self_collision.yaml",
+        f"fanuc_{model}.urdf",
+        "meshes/SOURCES.md",
+        "meshes/LICENSE",
+        "meshes/visual/link_4.obj",
+        "meshes/collision/link_4.obj",
+    ):
         assert (folder / name).is_file(), name
     robot = load_robot(f"fanuc_{model}", out)
     assert robot.family == "opw" and robot.language == "fanuc" and robot.j23_factor == -1
@@ -100,12 +107,29 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
     using robots_dir, plan, and a FANUC program that moves the robot as planned."""
     out = tmp_path / "robots"
     run = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "robots", "import",
-         str(FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro"), "--name", "fanuc_m20ia",
-         "--vendor", "fanuc", "--package-path", str(FANUC), "--out", str(out),
-         "--samples", "500"],
-        cwd=REPO, capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "robots",
+            "import",
+            str(FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro"),
+            "--name",
+            "fanuc_m20ia",
+            "--vendor",
+            "fanuc",
+            "--package-path",
+            str(FANUC),
+            "--out",
+            str(out),
+            "--samples",
+            "500",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr
     cell = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
     assert "model: kuka_kr16_2\n" in cell
@@ -113,10 +137,21 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
     (tmp_path / "seal_m20ia.yaml").write_text(cell)
     plan_dir = tmp_path / "plan"
     run = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "plan", str(tmp_path / "seal_m20ia.yaml"),
-         "--out", str(plan_dir)],
-        cwd=REPO, capture_output=True, text=True, timeout=900, env={**os.environ},
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "plan",
+            str(tmp_path / "seal_m20ia.yaml"),
+            "--out",
+            str(plan_dir),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env={**os.environ},
+    )
     assert run.returncode == 0, run.stdout + run.stderr
     assert "collision-free" in run.stdout
     program = plan_dir / "programs" / "OFFLINE_PROG.ls"
@@ -124,10 +159,24 @@ def test_readme_walkthrough_plans_the_seal_demo_and_exports_fanuc(robots, tmp_pa
     # A line limit splits the moves into called sub-programs that run the same points.
     whole = _program_points(program.parent, program.stem)
     run = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "export", str(plan_dir), "--format", "fanuc",
-         "--line-limit", "100", "--out", str(tmp_path / "split")],
-        cwd=REPO, capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "export",
+            str(plan_dir),
+            "--format",
+            "fanuc",
+            "--line-limit",
+            "100",
+            "--out",
+            str(tmp_path / "split"),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr
     split = sorted((tmp_path / "split").glob("*.ls"))
     assert len(split) > len(list(program.parent.glob("*.ls")))
@@ -203,11 +252,29 @@ def test_bad_descriptions_are_one_line_exit_2(tmp_path, edit, message):
     top = (FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro").read_text()
     (pkg / "urdf" / "m20ia.xacro").write_text(top)
     run = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "robots", "import", str(pkg / "urdf/m20ia.xacro"),
-         "--name", "bad", "--package-path", str(tmp_path / "pkgs"), "--package-path", str(FANUC),
-         "--out", str(tmp_path / "out"), "--samples", "10"],
-        cwd=REPO, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "robots",
+            "import",
+            str(pkg / "urdf/m20ia.xacro"),
+            "--name",
+            "bad",
+            "--package-path",
+            str(tmp_path / "pkgs"),
+            "--package-path",
+            str(FANUC),
+            "--out",
+            str(tmp_path / "out"),
+            "--samples",
+            "10",
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 2, run.stdout + run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and message in run.stderr, run.stderr
     assert not (tmp_path / "out" / "bad").exists()
@@ -215,8 +282,12 @@ def test_bad_descriptions_are_one_line_exit_2(tmp_path, edit, message):
 
 def test_unknown_package_in_library_call_names_the_file(tmp_path):
     with pytest.raises(InputError, match="fanuc_m20ia_support"):
-        import_robot(FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro", name="x", out=tmp_path,
-                     package_paths=[tmp_path])  # fmt: skip
+        import_robot(
+            FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
+            name="x",
+            out=tmp_path,
+            package_paths=[tmp_path],
+        )
 
 
 def test_preview_draws_the_imported_meshes(robots, tmp_path):
@@ -258,17 +329,32 @@ def test_m10ia_on_the_search_path_plans_the_seal_demo(robots, tmp_path):
     env = {**os.environ, "OFFLINE_PROG_ROBOTS": str(out)}
     listing = subprocess.run(
         [sys.executable, "-m", "offline_prog", "robots", "list"],
-        cwd=REPO, capture_output=True, text=True, timeout=300, env=env,
-    )  # fmt: skip
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
     rows = {line.split()[0]: line for line in listing.stdout.splitlines()}
     assert f"OFFLINE_PROG_ROBOTS: {out}" in rows["fanuc_m10ia"] and "bundled" in rows["ur10e"]
     cell = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
     (tmp_path / "seal_m10ia.yaml").write_text(cell.replace("kuka_kr16_2", "fanuc_m10ia"))
     run = subprocess.run(
-        [sys.executable, "-m", "offline_prog", "plan", str(tmp_path / "seal_m10ia.yaml"),
-         "--out", str(tmp_path / "plan")],
-        cwd=REPO, capture_output=True, text=True, timeout=900, env=env,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "plan",
+            str(tmp_path / "seal_m10ia.yaml"),
+            "--out",
+            str(tmp_path / "plan"),
+        ],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env=env,
+    )
     assert run.returncode == 0, run.stdout + run.stderr
     assert "collision-free" in run.stdout
     program = tmp_path / "plan" / "programs" / "OFFLINE_PROG.ls"
@@ -278,6 +364,11 @@ def test_m10ia_on_the_search_path_plans_the_seal_demo(robots, tmp_path):
 def test_default_package_path_is_the_folder_holding_the_package(tmp_path):
     """Without --package-path, the packages beside the description's own are found
     (fanuc_resources next to fanuc_m10ia_support)."""
-    result = import_robot(FANUC / "fanuc_m10ia_support/urdf/m10ia.xacro", name="m10ia",
-                          out=tmp_path, vendor="fanuc", samples=20)  # fmt: skip
+    result = import_robot(
+        FANUC / "fanuc_m10ia_support/urdf/m10ia.xacro",
+        name="m10ia",
+        out=tmp_path,
+        vendor="fanuc",
+        samples=20,
+    )
     assert result.params.c3 == pytest.approx(0.64) and result.fk.ok

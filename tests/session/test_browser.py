@@ -37,10 +37,22 @@ def session(tmp_path):
     port = free_port_pair()
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     process = subprocess.Popen(
-        [sys.executable, "-m", "offline_prog", "session", cell.name, "--port", str(port),
-         "--no-browser"],
-        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "session",
+            cell.name,
+            "--port",
+            str(port),
+            "--no-browser",
+        ],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     line = process.stdout.readline()
     url = re.search(rf" at (http://localhost:{port}/\?token=[\w-]+) ", line)
     assert url, (line, process.stderr.read())
@@ -154,9 +166,7 @@ def test_session_in_the_browser(session):
         write_outputs(reference, expected)
         names = sorted(p.relative_to(expected) for p in expected.rglob("*"))
         assert sorted(p.relative_to(exported) for p in exported.rglob("*")) == names
-        ours, theirs = (
-            (f / "trajectory.csv").read_text() for f in (exported, expected)
-        )  # fmt: skip
+        ours, theirs = ((f / "trajectory.csv").read_text() for f in (exported, expected))
         assert ours == theirs
         report = json.loads((exported / "report.json").read_text())
         assert report["cell"].endswith("seal_plate_kr16-1.yaml")  # the saved cell

@@ -13,8 +13,15 @@ from offline_prog.session.state import with_value
 
 from conftest import CELLS
 
-CHANGES = [("X_IT.x", 1020), ("X_IT.pitch", 2.5), ("X_PE.z", 95), ("speed", 80),
-           ("clearance", 7), ("free_rotation", 30), ("turn_smoothing", 12)]  # fmt: skip
+CHANGES = [
+    ("X_IT.x", 1020),
+    ("X_IT.pitch", 2.5),
+    ("X_PE.z", 95),
+    ("speed", 80),
+    ("clearance", 7),
+    ("free_rotation", 30),
+    ("turn_smoothing", 12),
+]
 
 
 @pytest.mark.parametrize("name", ["seal_plate_kr16", "seal_job_kr16", "tape_cylinder_ur10e"])

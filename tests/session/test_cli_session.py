@@ -17,8 +17,17 @@ def test_session_prints_the_url_and_the_tunnel_hint(capsys):
     with socket.socket() as probe:
         probe.bind(("localhost", 0))
         port = probe.getsockname()[1]
-    code = main(["session", str(CELLS / "tape_cylinder_ur10e.yaml"), "--port", str(port),
-                 "--no-browser", "--seconds", "0"])  # fmt: skip
+    code = main(
+        [
+            "session",
+            str(CELLS / "tape_cylinder_ur10e.yaml"),
+            "--port",
+            str(port),
+            "--no-browser",
+            "--seconds",
+            "0",
+        ]
+    )
     out = capsys.readouterr().out
     assert code == 0, out
     token = re.search(rf"at http://localhost:{port}/\?token=([\w-]+) ", out).group(1)
@@ -31,8 +40,17 @@ def test_a_taken_port_is_one_line_exit_2(capsys):
         taken.bind(("localhost", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        code = main(["session", str(CELLS / "tape_cylinder_ur10e.yaml"), "--port", str(port),
-                     "--no-browser", "--seconds", "0"])  # fmt: skip
+        code = main(
+            [
+                "session",
+                str(CELLS / "tape_cylinder_ur10e.yaml"),
+                "--port",
+                str(port),
+                "--no-browser",
+                "--seconds",
+                "0",
+            ]
+        )
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "--port" in err[0] and "cannot listen" in err[0]
 

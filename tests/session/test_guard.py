@@ -25,8 +25,14 @@ def test_on_localhost_only_the_loopback_names_with_the_port_pass():
     guard = Guard.serving("localhost", 7000, TOKEN)
     for host in ("localhost:7000", "127.0.0.1:7000", "[::1]:7000", "LocalHost:7000"):
         assert ask(guard, host=host) is None, host
-    for host in ("evil.example:7000", "localhost:7001", "localhost", "192.0.2.2:7000",
-                 f"{socket.gethostname()}:7000", "127.0.0.1.evil.example:7000"):  # fmt: skip
+    for host in (
+        "evil.example:7000",
+        "localhost:7001",
+        "localhost",
+        "192.0.2.2:7000",
+        f"{socket.gethostname()}:7000",
+        "127.0.0.1.evil.example:7000",
+    ):
         assert ask(guard, host=host).startswith("Host "), host
 
 

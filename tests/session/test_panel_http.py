@@ -85,9 +85,7 @@ def test_a_rebinding_name_cannot_read_the_status(live):
     """DNS rebinding: evil.example resolves to 127.0.0.1; its page is same-origin with
     itself, its requests name evil.example as the Host."""
     for host in ("evil.example", f"evil.example:{live.port}", f"localhost:{live.port + 7}"):
-        code, reply = live.send(
-            "GET", "/status", headers={"Origin": None}, host=host
-        )  # fmt: skip
+        code, reply = live.send("GET", "/status", headers={"Origin": None}, host=host)
         assert code == 403 and "values" not in reply, reply
         assert reply["message"].startswith("refused: Host")
     for host in (f"localhost:{live.port}", f"127.0.0.1:{live.port}", f"LOCALHOST:{live.port}"):

@@ -10,8 +10,9 @@ from offline_prog.timing.filtered_law import FilteredTimeLaw
 def trapezoid(length=1.0, v=0.2, a=1.0, n=2001):
     """(σ (n,), σ̇ (n,)): a rest-to-rest speed profile with constant σ̈ = ±a ramps."""
     sigma = np.linspace(0.0, length, n)
-    return sigma, np.minimum.reduce([np.sqrt(2 * a * sigma), np.sqrt(2 * a * (length - sigma)),
-                                     np.full(n, v)])  # fmt: skip
+    return sigma, np.minimum.reduce(
+        [np.sqrt(2 * a * sigma), np.sqrt(2 * a * (length - sigma)), np.full(n, v)]
+    )
 
 
 @pytest.mark.parametrize("window", [0.05, 0.2, 0.5])

@@ -113,9 +113,13 @@ def test_jerk_stage_holds_every_joint_limit_and_stays_near_topp_ra():
     rates = bump_rates()
     limits = (QD_MAX, QDD_MAX, QDDD_MAX)
     profile = topp_profile(
-        rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+        rates,
+        qd_max=QD_MAX,
+        qdd_max=QDD_MAX,
+        v_cap=0.5,
+        a_path=2.0,
         v_steady=steady_jerk_limit(rates, limits),
-    )  # fmt: skip
+    )
     for process in ("constant_speed", "cycle_time"):
         timing = jerk_limited_law(
             rates, profile, v_process=0.5, a_max=2.0, j_max=20.0, limits=limits, process=process
@@ -148,9 +152,13 @@ def test_a_tight_jerk_limit_holds_and_costs_time():
     durations = []
     for limits in (loose, tight):
         profile = topp_profile(
-            rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+            rates,
+            qd_max=QD_MAX,
+            qdd_max=QDD_MAX,
+            v_cap=0.5,
+            a_path=2.0,
             v_steady=steady_jerk_limit(rates, limits),
-        )  # fmt: skip
+        )
         timing = jerk_limited_law(
             rates, profile, v_process=0.5, a_max=2.0, j_max=20.0, limits=limits
         )
@@ -165,9 +173,13 @@ def test_averaged_profile_holds_every_limit_and_beats_the_staircase(gain, jerk_s
     rates = bump_rates(gain=gain)
     limits = (QD_MAX, QDD_MAX, QDDD_MAX * jerk_share)
     profile = topp_profile(
-        rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=0.5, a_path=2.0,
+        rates,
+        qd_max=QD_MAX,
+        qdd_max=QDD_MAX,
+        v_cap=0.5,
+        a_path=2.0,
         v_steady=steady_jerk_limit(rates, limits),
-    )  # fmt: skip
+    )
     path = dict(v_process=0.5, a_max=2.0, j_max=20.0, limits=limits)
     staircase = jerk_limited_law(rates, profile, process="cycle_time", **path)
     averaged = filtered_timing(rates, profile, **path)
@@ -190,8 +202,9 @@ def test_tape_demo_cycle_time_within_5_percent_of_topp_ra():
     from conftest import CELLS
 
     text = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
-    text = text.replace("  max_jerk: 10.0\n", "  max_jerk: 10.0\n  time_law: time_optimal\n"
-                        "  process: cycle_time\n")  # fmt: skip
+    text = text.replace(
+        "  max_jerk: 10.0\n", "  max_jerk: 10.0\n  time_law: time_optimal\n  process: cycle_time\n"
+    )
     cell = CELLS / "_test_time_optimal_tape.yaml"
     cell.write_text(text)
     try:
@@ -236,8 +249,12 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
     fixed = CELLS / f"_test_fixed_turn_{process}.yaml"
     fixed.write_text(text)
     cell = CELLS / f"_test_time_optimal_{process}.yaml"
-    cell.write_text(text.replace("speed_reference: tcp", f"speed_reference: tcp\n  time_law: "
-                                 f"time_optimal\n  process: {process}"))  # fmt: skip
+    cell.write_text(
+        text.replace(
+            "speed_reference: tcp",
+            f"speed_reference: tcp\n  time_law: time_optimal\n  process: {process}",
+        )
+    )
     try:
         plan = plan_cell(cell)
         sin2 = plan_cell(fixed)
@@ -274,8 +291,14 @@ def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, pro
     limits = (QD_MAX, QDD_MAX, QDDD_MAX)
     path = dict(v_process=speed, a_max=2.0, j_max=20.0)
     nominal = sin2_time_law(LENGTH, v_max=speed, a_max=2.0, j_max=20.0)
-    profile = topp_profile(rates, qd_max=QD_MAX, qdd_max=QDD_MAX, v_cap=speed, a_path=2.0,
-                           v_steady=steady_jerk_limit(rates, limits))  # fmt: skip
+    profile = topp_profile(
+        rates,
+        qd_max=QD_MAX,
+        qdd_max=QDD_MAX,
+        v_cap=speed,
+        a_path=2.0,
+        v_steady=steady_jerk_limit(rates, limits),
+    )
     staircase = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
     averaged = filtered_timing(rates, profile, limits=limits, **path)
     held = SpeedHold(rates, limits=limits, **path)

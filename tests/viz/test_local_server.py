@@ -20,8 +20,11 @@ CELL = str(CELLS / "tape_cylinder_ur10e.yaml")
 def offline_prog(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "offline_prog", *args],
-        capture_output=True, text=True, cwd=REPO, timeout=timeout,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        cwd=REPO,
+        timeout=timeout,
+    )
 
 
 @pytest.mark.parametrize(
@@ -107,8 +110,11 @@ def test_preview_listens_on_loopback_only(host):
     flags = ["--host", host] if host else []
     process = subprocess.Popen(
         [sys.executable, "-m", "offline_prog", "preview", CELL, "--port", str(port), *flags],
-        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )  # fmt: skip
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         line = process.stdout.readline()
         name = "[::1]" if host else "localhost"

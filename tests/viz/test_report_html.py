@@ -271,8 +271,11 @@ def test_speed_plot_shades_each_time_optimal_slowdown_with_its_joint(tmp_path):
     cell = tmp_path / "seal_time_optimal.yaml"
     # The nozzle's turn fixed (no tool.turn_smoothing_mm): the wrist's jerk binds.
     text = re.sub(r"\n  turn_smoothing_mm: .*", "", (CELLS / "seal_plate_kr16.yaml").read_text())
-    cell.write_text(text.replace("  speed_reference: tcp\n",
-                                 "  speed_reference: tcp\n  time_law: time_optimal\n"))  # fmt: skip
+    cell.write_text(
+        text.replace(
+            "  speed_reference: tcp\n", "  speed_reference: tcp\n  time_law: time_optimal\n"
+        )
+    )
     plan_dir = make_plan_folder(cell, tmp_path / "plan")
     slowdowns = json.loads((plan_dir / "report.json").read_text())["robot_motion"]["slowdowns"]
     assert any(s["joint"] is not None for s in slowdowns), slowdowns  # the corners
