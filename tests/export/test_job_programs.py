@@ -35,7 +35,10 @@ IO = (
 
 def one_seam_job(tmp_path, name: str, home: str) -> object:
     text = (CELLS / f"{name}.yaml").read_text()
-    text = text.replace("motion:", f"job: {{order: given{home}}}\nmotion:", 1)
+    if re.search(r"(?m)^job:", text):  # the cell's own job: block (its home) stays
+        text = re.sub(r"(?m)^job:.*\n", lambda m: m.group(0) + "  order: given\n", text, count=1)
+    else:
+        text = text.replace("motion:", f"job: {{order: given{home}}}\nmotion:", 1)
     text = text.replace("tool:\n", IO, 1)
     file = tmp_path / f"{name}_job.yaml"
     file.write_text(text)

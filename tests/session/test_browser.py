@@ -18,8 +18,8 @@ import pytest
 from pydrake.math import RigidTransform, RotationMatrix
 
 from offline_prog.config.cell import load_cell
-from offline_prog.plan import plan_cell
-from offline_prog.results.plan_folder import write_outputs
+from offline_prog.plan import plan_cell, plan_job
+from offline_prog.results.job_folder import write_job_outputs
 
 from browser import WEBGL_ARGS, require_chromium
 from conftest import CELLS, REPO
@@ -163,7 +163,7 @@ def test_session_in_the_browser(session):
         expect(page.locator("#files")).to_contain_text("exported:", timeout=TIMEOUT_MS)
         exported = folder / "out" / "seal_plate_kr16-1"
         expected = folder / "expected"
-        write_outputs(reference, expected)
+        write_job_outputs(plan_job(saved), expected)  # a path: cell is a one-seam job
         names = sorted(p.relative_to(expected) for p in expected.rglob("*"))
         assert sorted(p.relative_to(exported) for p in exported.rglob("*")) == names
         ours, theirs = ((f / "trajectory.csv").read_text() for f in (exported, expected))

@@ -141,7 +141,11 @@ def test_a_colliding_plan_writes_its_reports_but_no_program(tmp_path):
     assert len(lines) == 1 and "collision: plate vs intruder" in lines[0], lines
     report = json.loads((out / "report.json").read_text())
     assert report["collision_free"] is False and report["feasible"] is False
-    assert report["failure_kind"] == "collision" and report["failure"].startswith("collision:")
+    # A path: cell is a one-seam job: the failure names the move (here the approach).
+    assert (
+        report["failure_kind"] == "collision"
+        and "collision: plate vs intruder" in (report["failure"])
+    )
     assert (out / "collisions.json").is_file() and (out / "preview.html").is_file()
     assert not (out / "programs").exists()
 
