@@ -96,12 +96,19 @@ class ProgramData:
     X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
     # These rows are a whole job's (job.npz beside them holds its segments and I/O).
     whole_job: bool = False
+    # The plan's robot (robot.record.robot_record); None: a plan made before plans
+    # carried it, whose robot is looked up by name.
+    robot_record: dict | None = None
 
     def load_robot(self):
-        """The plan's RobotModel: from robots_dir when it still holds the robot, else
-        from the search path (OFFLINE_PROG_ROBOTS, then the bundled robots)."""
+        """The plan's RobotModel, built from the robot record the plan carries (no
+        robot folder is read). A plan made before plans carried it: from robots_dir
+        when it still holds the robot, else from the search path."""
         from offline_prog.robot.model import load_robot
+        from offline_prog.robot.record import robot_from_record
 
+        if self.robot_record is not None:
+            return robot_from_record(self.robot_record)
         folder = Path(self.robots_dir) if self.robots_dir else None
         has = folder is not None and (folder / self.robot / "robot.yaml").is_file()
         return load_robot(self.robot, folder if has else None)

@@ -32,6 +32,7 @@ from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.job.records import Plan
 from offline_prog.results.report import report
+from offline_prog.robot.record import robot_record
 from offline_prog.timing.trajectory import CSV_COLUMNS
 from offline_prog.viz.preview import write_preview_html
 from offline_prog.viz.report_html import write_report_html
@@ -113,6 +114,7 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
         "payload": payload_record(cell),
+        "robot_record": robot_record(robot),
     }
 
 
