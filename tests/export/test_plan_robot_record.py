@@ -11,6 +11,8 @@ import pytest
 
 from offline_prog.cli import main
 from offline_prog.config.robot_search import ENV_VAR
+from offline_prog.export.densify import densify
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.formats import default_formats
 from offline_prog.export.program import ProgramData
 from offline_prog.plan import plan_cell
@@ -36,13 +38,17 @@ def programs(plan_folder: Path, out: Path) -> dict[str, list[str]]:
 @pytest.fixture(scope="module")
 def planned_with_own_robot(tmp_path_factory):
     """(plan folder, robots folder): seal_plate_kr16 planned with a copy of the KR 16
-    found first on the search path (OFFLINE_PROG_ROBOTS), as a user's own robot is."""
+    found first on the search path (OFFLINE_PROG_ROBOTS), as a user's own robot is; at
+    2 samples per second, so that the writers insert grid points between the samples."""
     tmp = tmp_path_factory.mktemp("own_robot")
     robots = tmp / "robots"
     shutil.copytree(model.ROBOTS_DIR / "kuka_kr16_2", robots / "kuka_kr16_2")
+    text = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
+    cell = tmp / "seal_plate_kr16.yaml"
+    cell.write_text(text.replace("  max_jerk:", "  sample_rate_hz: 2\n  max_jerk:", 1))
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv(ENV_VAR, str(robots))
-        plan = plan_cell(REPO / "cells" / "seal_plate_kr16.yaml")
+        plan = plan_cell(cell)
         write_outputs(plan, tmp / "plan")
     assert ProgramData.load(tmp / "plan").robots_dir == str(robots)
     return tmp / "plan", robots
@@ -115,3 +121,24 @@ def test_a_plan_made_before_robot_records_exports_by_the_robot_name(
         _strip_record(file)
     assert ProgramData.load(old).robot_record is None
     assert programs(old, tmp_path / "old") == programs(plan_folder, tmp_path / "new")
+
+
+def test_export_runs_no_inverse_kinematics(planned_with_own_robot, tmp_path, monkeypatch):
+    """The joints of the points a writer inserts between samples were planned (plan.npz's
+    q_dense): with every IK entry point raising, export writes the same programs."""
+    from offline_prog.robot import kinematics_opw, kinematics_ur
+
+    plan_folder, _ = planned_with_own_robot
+    monkeypatch.delenv(ENV_VAR, raising=False)
+    before = programs(plan_folder, tmp_path / "before")
+    data = ProgramData.load(plan_folder)
+    assert data.q_dense.shape == (len(data.sigma_dense), 6)
+    assert densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).n_inserted > 0
+
+    def no_ik(*_):
+        raise AssertionError("export ran inverse kinematics")
+
+    for module in (kinematics_opw, kinematics_ur):
+        monkeypatch.setattr(module, "inverse", no_ik)
+    monkeypatch.setattr(model.RobotModel, "inverse", no_ik)
+    assert programs(plan_folder, tmp_path / "after") == before
