@@ -12,8 +12,9 @@ segment is convex), so the writers select with the tolerance less the residual a
 state d + residual.
 
 Inserted rows: s and X_PF from the grid, X_BE = X_BT · X_PF⁻¹ · X_EP⁻¹, t by monotone
-interpolation of t(s), q from the inverse kinematics nearest the Hermite-interpolated q
-(so configuration bits are exact), speeds interpolated.
+interpolation of t(s), q the plan's joints at the grid point (``q_dense``, planned once
+by ``robot.dense_joints``: the writers run no inverse kinematics), speeds interpolated.
+A plan made before plans stored q_dense gets them from the robot's IK here.
 """
 
 from __future__ import annotations
@@ -115,33 +116,19 @@ def densify(data: ProgramData, chord_tol_m: float, angle_tol_rad: float) -> Dens
     new = k[refine[i]]
     if len(new) == 0:
         return Densified(data, residual_d, residual_a, 0)
-    return Densified(_insert(data, s_d[new], X_d[new]), residual_d, residual_a, len(new))
+    return Densified(_insert(data, new), residual_d, residual_a, len(new))
 
 
-def _nearest(solutions: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per row: the gap [rad] and index of the IK solution (K, 8, 6) nearest q (K, 6),
-    each joint taken at its 2π turn nearest q."""
-    wrapped = q[:, None] + (solutions - q[:, None] + np.pi) % (2 * np.pi) - np.pi
-    gap = np.nan_to_num(np.abs(wrapped - q[:, None]).max(axis=2), nan=np.inf)
-    return gap.min(axis=1), gap.argmin(axis=1)
-
-
-def _insert(data: ProgramData, s_new: np.ndarray, X_PF_new: np.ndarray) -> ProgramData:
-    """The plan's rows plus rows at s_new (K,) with process frames X_PF_new (K, 4, 4)."""
-
+def _insert(data: ProgramData, new: np.ndarray) -> ProgramData:
+    """The plan's rows plus the grid points ``new`` (K,) (indices into sigma_dense)."""
+    s_new, X_PF_new = data.sigma_dense[new], data.X_PF_dense[new]
     rising = np.concatenate([[True], np.diff(data.sigma) > 0])
     t_new = PchipInterpolator(data.sigma[rising], data.t[rising])(s_new)
-    hermite = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)
-    q_new, qd_new = hermite(t_new), hermite(t_new, 1)
+    qd_new = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)(t_new, 1)
     X_BE_new = data.X_BT @ np.linalg.inv(X_PF_new) @ np.linalg.inv(data.X_EP)
-    robot = data.load_robot()
-    if robot.params is not None:  # exact joints on the branch of the sample before
-        left = np.searchsorted(data.sigma, s_new, side="right") - 1
-        branch = _nearest(robot.inverse(data.X_BE[left]), data.q[left])[1]
-        solutions = robot.inverse(X_BE_new)[np.arange(len(s_new)), branch]  # (K, 6)
-        wrapped = q_new + (solutions - q_new + np.pi) % (2 * np.pi) - np.pi
-        ok = np.isfinite(wrapped).all(axis=1)
-        q_new[ok] = wrapped[ok]
+    q_new = (
+        data.q_dense[new] if len(data.q_dense) == len(data.sigma_dense) else _old_plan(data)[new]
+    )
     order = np.argsort(np.concatenate([data.sigma, s_new]), kind="stable")
 
     def merged(old, new):
@@ -157,3 +144,12 @@ def _insert(data: ProgramData, s_new: np.ndarray, X_PF_new: np.ndarray) -> Progr
         X_PF=merged(data.X_PF, X_PF_new),
         tcp_speed=merged(data.tcp_speed, np.interp(s_new, data.sigma, data.tcp_speed)),
     )
+
+
+def _old_plan(data: ProgramData) -> np.ndarray:
+    """(M, 6) q_dense of a plan made before plans stored it, from the robot's IK."""
+    from offline_prog.robot.dense_joints import dense_joints
+
+    X_BE_dense = data.X_BT @ np.linalg.inv(data.X_PF_dense) @ np.linalg.inv(data.X_EP)
+    args = (data.sigma, data.t, data.q, data.qd, data.X_BE, data.sigma_dense, X_BE_dense)
+    return dense_joints(data.load_robot(), *args)

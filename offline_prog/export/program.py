@@ -33,7 +33,7 @@ _ARRAYS = (
     "qd_max",
 )
 # The continuous path on a fine grid of s (plans written before it existed lack it).
-_DENSE_ARRAYS = ("sigma_dense", "X_PF_dense")
+_DENSE_ARRAYS = ("sigma_dense", "X_PF_dense", "q_dense")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,6 +59,8 @@ class ProgramData:
         sigma_dense: (M,) a fine grid of s [m] over the whole path (export.densify).
         X_PF_dense: (M, 4, 4) the process frames of the continuous plan at sigma_dense,
             so that point selection measures deviations between the samples too.
+        q_dense: (M, 6) the planned joints [rad] at sigma_dense (robot.dense_joints),
+            which the writers read for points they insert (empty: an older plan).
     """
 
     cell_name: str
@@ -94,14 +96,22 @@ class ProgramData:
     time_law: str = "sin2"
     sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
     X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
+    q_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 6)))
     # These rows are a whole job's (job.npz beside them holds its segments and I/O).
     whole_job: bool = False
+    # The plan's robot (robot.record.robot_record); None: a plan made before plans
+    # carried it, whose robot is looked up by name.
+    robot_record: dict | None = None
 
     def load_robot(self):
-        """The plan's RobotModel: from robots_dir when it still holds the robot, else
-        from the search path (OFFLINE_PROG_ROBOTS, then the bundled robots)."""
+        """The plan's RobotModel, built from the robot record the plan carries (no
+        robot folder is read). A plan made before plans carried it: from robots_dir
+        when it still holds the robot, else from the search path."""
         from offline_prog.robot.model import load_robot
+        from offline_prog.robot.record import robot_from_record
 
+        if self.robot_record is not None:
+            return robot_from_record(self.robot_record)
         folder = Path(self.robots_dir) if self.robots_dir else None
         has = folder is not None and (folder / self.robot / "robot.yaml").is_file()
         return load_robot(self.robot, folder if has else None)

@@ -32,6 +32,8 @@ from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.job.records import Plan
 from offline_prog.results.report import report
+from offline_prog.robot.dense_joints import dense_joints
+from offline_prog.robot.record import robot_record
 from offline_prog.timing.trajectory import CSV_COLUMNS
 from offline_prog.viz.preview import write_preview_html
 from offline_prog.viz.report_html import write_report_html
@@ -113,6 +115,7 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
         "payload": payload_record(cell),
+        "robot_record": robot_record(robot),
     }
 
 
@@ -131,6 +134,11 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
     dense = plan.flange(s_dense)
     X_BE_dense = X_BI @ _poses(dense.p_IE, dense.R_IE)
     X_PF_dense = np.linalg.inv(np.linalg.inv(X_BT) @ X_BE_dense @ X_EP)
+    # The writers' inserted points: X_BE as export.densify computes it from X_PF_dense.
+    X_BE_grid = X_BT @ np.linalg.inv(X_PF_dense) @ np.linalg.inv(X_EP)
+    q_dense = dense_joints(
+        plan.robot, traj.s, traj.t, joints.q, joints.qd, X_BE, s_dense, X_BE_grid
+    )
     return ProgramData(
         **program_names(cell, plan.cell_file, plan.robot, summary),
         speed_reference=traj.reference,
@@ -149,6 +157,7 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         tcp_speed=traj.tcp_speed,
         sigma_dense=s_dense,
         X_PF_dense=X_PF_dense,
+        q_dense=q_dense,
     )
 
 

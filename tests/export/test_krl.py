@@ -14,6 +14,7 @@ from offline_prog.export.krl import write_krl
 from offline_prog.export.kuka import kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
 from offline_prog.robot.model import load_robot
+from offline_prog.robot.record import robot_record
 
 POSITION_TOL_M = 0.01e-3  # round trip of every written pose
 ANGLE_TOL_DEG = 0.01
@@ -384,7 +385,8 @@ def test_bad_arguments_are_refused(data, tmp_path, options):
 
 def test_a_non_opw_robot_is_refused(data, tmp_path):
     with pytest.raises(ValueError, match="not an OPW arm"):
-        write_krl(dataclasses.replace(data, robot="ur10e"), tmp_path)
+        ur = robot_record(load_robot("ur10e"))
+        write_krl(dataclasses.replace(data, robot="ur10e", robot_record=ur), tmp_path)
 
 
 @pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
