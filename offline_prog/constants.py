@@ -1,5 +1,7 @@
 """Tolerances and defaults, named once (see toppra's constants.py)."""
 
+import enum
+
 import numpy as np
 
 # B-spline fit (paper §2).
@@ -47,9 +49,24 @@ MAX_PLACE_BUDGET = 100_000
 MAX_PLACE_SEED = 2**31 - 1
 # A cell's mesh larger than this across is a unit slip (a mm file read as m: 1000×).
 MAX_MESH_EXTENT_M = 20.0
-# motion.time_law: TOPP-RA + jerk stage (the default, config/cell.py), or the paper's
-# sin² law.
-TIME_LAWS = ("time_optimal", "sin2")
-# motion.process, the time-optimal law's intent: hold the process speed wherever the
-# robot can (sealing, gluing), or anything up to it for the shortest cycle.
-PROCESS_INTENTS = ("constant_speed", "cycle_time")
+
+
+class TimeLaw(enum.StrEnum):
+    """motion.time_law: TOPP-RA + jerk stage (the default, config/cell.py), or the paper's
+    sin² law. The values are the cell file's strings (the contract); report.json and the
+    program headers write them unchanged (a StrEnum is its value)."""
+
+    TIME_OPTIMAL = "time_optimal"
+    SIN2 = "sin2"
+
+
+class ProcessIntent(enum.StrEnum):
+    """motion.process, the time-optimal law's intent: hold the process speed wherever the
+    robot can (sealing, gluing), or anything up to it for the shortest cycle."""
+
+    CONSTANT_SPEED = "constant_speed"
+    CYCLE_TIME = "cycle_time"
+
+
+TIME_LAWS = tuple(law.value for law in TimeLaw)
+PROCESS_INTENTS = tuple(intent.value for intent in ProcessIntent)

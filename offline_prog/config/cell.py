@@ -192,9 +192,11 @@ class MotionConfig:
     max_acceleration: float = required()  # m/s²
     max_jerk: float = required()  # m/s³
     speed_reference: str = "tcp"  # tcp | flange
-    # sin2 (the paper's law, the default) | time_optimal (TOPP-RA + jerk stage)
-    time_law: str = "time_optimal"  # time_optimal (TOPP-RA + jerk stage) | sin2 (the paper)
-    process: str = "constant_speed"  # constant_speed | cycle_time (time_optimal only)
+    # time_optimal (TOPP-RA + jerk stage, the default) | sin2 (the paper's law); Drake's
+    # loader reads a string, check_cell turns it into constants.TimeLaw.
+    time_law: str = "time_optimal"
+    # constant_speed | cycle_time (time_optimal only); check_cell: constants.ProcessIntent
+    process: str = "constant_speed"
     sample_rate_hz: float = 250.0
     cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation
     clearance: float = 0.005  # m: robot and part vs obstacles, the tool and each other

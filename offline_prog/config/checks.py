@@ -23,6 +23,8 @@ from offline_prog.constants import (
     PROCESS_INTENTS,
     TIME_LAWS,
     UNIT_SCALE,
+    ProcessIntent,
+    TimeLaw,
 )
 from offline_prog.errors import InputError
 
@@ -86,6 +88,8 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(
             file, "motion.process", f"{motion.process!r} (use {' or '.join(PROCESS_INTENTS)})"
         )
+    # The config boundary: from here on the law and the intent are enums.
+    motion.time_law, motion.process = TimeLaw(motion.time_law), ProcessIntent(motion.process)
     if not 0.0 <= cell.tool.free_rotation_deg <= 180.0:
         raise _error(file, "tool.free_rotation_deg", "must be within [0, 180]")
     if cell.tool.symmetry_axis not in ("x", "y", "z"):

@@ -17,6 +17,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.arrays import true_runs
+from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.path_ik import (
     BranchResult,
@@ -25,12 +26,11 @@ from offline_prog.joints.path_ik import (
     choose_branch,
     singularity_distances,
 )
-from offline_prog.joints.path_timing import path_timing
+from offline_prog.joints.path_timing import PathLimits, PathTiming, time_path
 from offline_prog.robot.jacobian import joint_path_rates, urdf_chain
 from offline_prog.robot.kinematics_opw import wrap_to_pi
 from offline_prog.robot.model import RobotModel
-from offline_prog.timing.jerk_stage import JerkLimitedTiming
-from offline_prog.timing.joint_timing import JointRates, Retiming
+from offline_prog.timing.joint_timing import JointRates
 from offline_prog.timing.time_law import Sin2TimeLaw
 from offline_prog.timing.trajectory import (
     TimeLawParameter,
@@ -83,7 +83,7 @@ class JointTrajectory:
     margin_rad: np.ndarray
     largest_step: tuple[int, float, float]
     singularities: dict
-    retiming: Retiming | JerkLimitedTiming
+    retiming: PathTiming
 
 
 class BranchPath:
@@ -199,8 +199,8 @@ def plan_joint_trajectory(
     *,
     rate_hz: float,
     branch: int | None = None,
-    time_law: str = "sin2",
-    process: str = "constant_speed",
+    time_law: TimeLaw = TimeLaw.SIN2,
+    process: ProcessIntent = ProcessIntent.CONSTANT_SPEED,
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -212,9 +212,9 @@ def plan_joint_trajectory(
         nominal: the process time law (before joint limits).
         rate_hz: output sample rate.
         branch: use this analytic branch (if feasible) instead of the best one.
-        time_law: "time_optimal" (TOPP-RA, then the jerk stage) or "sin2" (the
-            paper's law, plateaus lowered where the joints need it).
-        process: the time-optimal intent, "constant_speed" or "cycle_time".
+        time_law: TimeLaw.TIME_OPTIMAL (TOPP-RA, then the jerk stage) or TimeLaw.SIN2
+            (the paper's law, plateaus lowered where the joints need it).
+        process: the time-optimal intent (ProcessIntent).
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
@@ -236,10 +236,11 @@ def plan_joint_trajectory(
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
-    retiming = path_timing(robot, controller, nominal, time_law, process)
+    retiming = time_path(controller, PathLimits.of(robot, nominal), time_law, process)
     if not retiming.feasible:
         joint, sigma, use = retiming.worst
-        kinds = "speed/acceleration/jerk" if time_law == "time_optimal" else "speed/acceleration"
+        jerk = retiming.law_kind is TimeLaw.TIME_OPTIMAL
+        kinds = "speed/acceleration/jerk" if jerk else "speed/acceleration"
         raise JointPlanError(
             sigma,
             _time_at(retiming.law, sigma),

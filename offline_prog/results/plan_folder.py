@@ -25,6 +25,7 @@ from offline_prog.atomic import (
 )
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
+from offline_prog.constants import TimeLaw
 from offline_prog.errors import InputError
 from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
@@ -90,7 +91,7 @@ def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
 def time_law_name(motion) -> str:
     """The time law as the program header names it: "sin2", or "time_optimal
     (constant_speed)" / "time_optimal (cycle_time)"."""
-    if motion.time_law == "time_optimal":
+    if motion.time_law == TimeLaw.TIME_OPTIMAL:
         return f"time_optimal ({motion.process})"
     return motion.time_law
 

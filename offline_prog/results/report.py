@@ -12,6 +12,7 @@ import datetime
 import numpy as np
 
 from offline_prog import __version__
+from offline_prog.constants import TimeLaw
 from offline_prog.export.payload import payload, payload_note, payload_record
 from offline_prog.job.records import Plan
 from offline_prog.joints.path_timing import without_joint_limits
@@ -121,7 +122,7 @@ def timing_report(plan: Plan) -> dict:
         "max_joint_jerk_use": jerk_use.round(4).tolist(),  # finite differences of qd
     }
     retiming = joints.retiming
-    if motion.time_law != "time_optimal":
+    if motion.time_law != TimeLaw.TIME_OPTIMAL:
         return out
     return out | {
         "process": motion.process,

@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from offline_prog.arrays import true_runs
-from offline_prog.constants import LIMIT_CHECK_RATE_HZ
+from offline_prog.constants import LIMIT_CHECK_RATE_HZ, ProcessIntent
 from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.jerk_stage import JerkLimitedTiming, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates
@@ -168,7 +168,7 @@ def filtered_timing(
                 worst,
                 slowdowns(law, t, use, v_process),
                 profile,
-                "cycle_time",
+                ProcessIntent.CYCLE_TIME,
             )
         speed_over, change_over = (x**EXCESS_DAMPING for x in _excess(use, jerk_path))
         # The profile's steps each sample averages; TOPP-RA's curves hold at a step's

@@ -28,7 +28,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.arrays import true_runs
-from offline_prog.constants import LIMIT_CHECK_RATE_HZ
+from offline_prog.constants import LIMIT_CHECK_RATE_HZ, ProcessIntent
 from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.joint_timing import JointRates
 from offline_prog.timing.limit_use import (
@@ -69,7 +69,7 @@ class JerkLimitedTiming:
         slowdowns: every stretch below the process speed, with its limiting joint.
         topp: the TOPP-RA profile underneath, with the steady jerk limit as a speed
             limit curve (its duration: without the jerk stage).
-        process: the intent ("constant_speed" | "cycle_time").
+        process: the intent (constants.ProcessIntent).
     """
 
     law: Sin2TimeLaw | FilteredTimeLaw
@@ -79,7 +79,7 @@ class JerkLimitedTiming:
     worst: tuple[int, float, float]
     slowdowns: tuple[Slowdown, ...]
     topp: ToppProfile | None = None
-    process: str = "constant_speed"
+    process: ProcessIntent = ProcessIntent.CONSTANT_SPEED
     topp_plain_s: float = float("nan")  # TOPP-RA without the steady jerk limit [s]
     # (share of the feasible length holding the process speed ±0.5 %, feasible share
     # of the path): timing.speed_hold.SpeedHold.
@@ -123,7 +123,7 @@ def ceiling(profile: ToppProfile, steady: np.ndarray, v_process: float, process:
     Args:
         steady: (G,) the highest steady speed the joints allow there (static_limit).
     """
-    if process == "cycle_time":
+    if process == ProcessIntent.CYCLE_TIME:
         speed = np.minimum(envelope(profile), steady)
         ratio = np.clip(speed / (v_process * (1.0 - HOLD_TOLERANCE)), 1e-9, 1.0)
         level = np.ceil(np.log(ratio) / np.log1p(-LEVEL_STEP))
@@ -157,7 +157,7 @@ def jerk_limited_law(
     a_max: float,
     j_max: float,
     limits: tuple[np.ndarray, np.ndarray, np.ndarray],
-    process: str = "constant_speed",
+    process: ProcessIntent = ProcessIntent.CONSTANT_SPEED,
     check_rate_hz: float = LIMIT_CHECK_RATE_HZ,
 ) -> JerkLimitedTiming:
     """The jerk stage (module doc).
@@ -167,7 +167,7 @@ def jerk_limited_law(
         profile: TOPP-RA's answer for the same path and limits.
         v_process: the process speed [m/s]; a_max, j_max: path limits [m/s², m/s³].
         limits: (qd_max, qdd_max, qddd_max), each (6,).
-        process: "constant_speed" or "cycle_time".
+        process: the intent (constants.ProcessIntent).
     """
     length = float(rates.sigma[-1])
     dddq = with_jerk(rates)

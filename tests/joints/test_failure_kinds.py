@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from offline_prog.cli import exit_code
+from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError
 from offline_prog.joints.path_ik import branch_results
-from offline_prog.joints.path_timing import path_timing
+from offline_prog.joints.path_timing import PathLimits, time_path
 from offline_prog.robot.model import load_robot
 from offline_prog.timing.joint_timing import JointRates
 from offline_prog.timing.time_law import sin2_time_law
@@ -38,7 +39,12 @@ def test_a_failed_topp_ra_solve_is_a_plan_failure_with_where_and_why():
     impossible = dataclasses.replace(robot, qdd_max=-robot.qdd_max)
     nominal = sin2_time_law(LENGTH_M, v_max=0.1, a_max=1.0, j_max=10.0)
     with pytest.raises(PlanFailedError) as raised:
-        path_timing(impossible, straight_rates(), nominal, "time_optimal", "constant_speed")
+        time_path(
+            straight_rates(),
+            PathLimits.of(impossible, nominal),
+            TimeLaw.TIME_OPTIMAL,
+            ProcessIntent.CONSTANT_SPEED,
+        )
     failure = raised.value.failure
     assert failure.kind is Failure.JOINT_RATE_LIMIT
     assert 0.0 <= failure.sigma_m <= LENGTH_M and 0.0 < failure.t_s <= nominal.duration
