@@ -119,18 +119,18 @@ def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
 
         return [write_ros_json(data, out_dir)]
     if fmt == "urscript":
-        from offline_prog.export.urscript import write_urscript
+        from offline_prog.export.ur.urscript import write_urscript
 
         return [write_urscript(data, out_dir, forced=forced, **options).file]
     if fmt == "fanuc":
-        from offline_prog.export.fanuc_ls import write_fanuc
+        from offline_prog.export.fanuc.fanuc_ls import write_fanuc
 
         return list(write_fanuc(data, out_dir, forced=forced, **options).files)
     if fmt == "krl":
-        from offline_prog.export.krl import write_krl
+        from offline_prog.export.kuka.krl import write_krl
 
         return list(write_krl(data, out_dir, forced=forced, **options).files)
-    from offline_prog.export.rapid import write_rapid
+    from offline_prog.export.abb.rapid import write_rapid
 
     return list(write_rapid(data, out_dir, forced=forced, **options).files)
 
@@ -167,17 +167,17 @@ def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list
 
         return [write_job_ros_json(data, out_dir)]
     if fmt == "krl":
-        from offline_prog.export.krl_job import write_krl_job
+        from offline_prog.export.kuka.krl_job import write_krl_job
 
         return write_krl_job(data, out_dir, forced=not data.feasible, **options)
     if fmt == "fanuc":
-        from offline_prog.export.fanuc_job import write_fanuc_job
+        from offline_prog.export.fanuc.fanuc_job import write_fanuc_job
 
         return write_fanuc_job(data, out_dir, forced=not data.feasible, **options)
     if fmt == "rapid":
-        from offline_prog.export.rapid_job import write_rapid_job
+        from offline_prog.export.abb.rapid_job import write_rapid_job
 
         return write_rapid_job(data, out_dir, forced=not data.feasible, **options)
-    from offline_prog.export.urscript_job import write_urscript_job
+    from offline_prog.export.ur.urscript_job import write_urscript_job
 
     return [write_urscript_job(data, out_dir, forced=not data.feasible, **options)]

@@ -23,7 +23,7 @@ import numpy as np
 
 from offline_prog.export.densify import densify
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.krl_points import process_points
+from offline_prog.export.kuka.krl_points import process_points
 from offline_prog.export.program import ProgramData
 from offline_prog.io_events import IoEvent, Signal
 

@@ -13,10 +13,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import transform
+from offline_prog.export.abb.rapid import write_rapid
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
-from offline_prog.export.krl import write_krl
-from offline_prog.export.rapid import write_rapid
+from offline_prog.export.kuka.krl import write_krl
 from offline_prog.plan import plan_cell
 from offline_prog.results.plan_folder import program_data
 from offline_prog.results.report import report

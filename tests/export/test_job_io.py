@@ -20,10 +20,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from offline_prog.config.cell import load_cell
+from offline_prog.export.abb.rapid_job import write_rapid_job
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.krl_job import write_krl_job
-from offline_prog.export.rapid_job import write_rapid_job
-from offline_prog.export.urscript_job import write_urscript_job
+from offline_prog.export.kuka.krl_job import write_krl_job
+from offline_prog.export.ur.urscript_job import write_urscript_job
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs

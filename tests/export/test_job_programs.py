@@ -214,7 +214,7 @@ def rapid_run(module_text: str):
 
 @pytest.mark.slow  # plans a job of its own (CI runs it: pytest -m slow)
 def test_rapid_job_links_approach_retract_and_io(folders):
-    from offline_prog.export.abb import abb_axes_deg
+    from offline_prog.export.abb.abb import abb_axes_deg
 
     data, folder, _ = folders["rapid"]
     text = (folder / "OfflineProg.mod").read_text()

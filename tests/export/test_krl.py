@@ -10,8 +10,8 @@ import pytest
 from krl_lint import assert_krllint_clean
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.krl import write_krl
-from offline_prog.export.kuka import kuka_abc_deg, status_turn
+from offline_prog.export.kuka.krl import write_krl
+from offline_prog.export.kuka.kuka import kuka_abc_deg, status_turn
 from offline_prog.export.program import ProgramData
 from offline_prog.robot.model import load_robot
 from offline_prog.robot.record import robot_record

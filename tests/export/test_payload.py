@@ -12,10 +12,10 @@ from config.test_cell_errors import BASE, write_cell  # tests/config
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
 from offline_prog.errors import InputError
-from offline_prog.export.krl import write_krl
+from offline_prog.export.abb.rapid import write_rapid
+from offline_prog.export.kuka.krl import write_krl
 from offline_prog.export.program import ProgramData
-from offline_prog.export.rapid import write_rapid
-from offline_prog.export.urscript import write_urscript
+from offline_prog.export.ur.urscript import write_urscript
 from offline_prog.robot.model import ROBOTS_DIR
 
 RECORD = {  # gripper 4 kg 80 mm down the flange axis; part 2 kg at (10, 0, 5) mm in P

@@ -10,11 +10,11 @@ import re
 
 import pytest
 
-from offline_prog.export.krl import write_krl
-from offline_prog.export.kuka import VEL_CP_MAX_M_S
+from offline_prog.export.abb.rapid import MAX_SPEED_MMS, write_rapid
+from offline_prog.export.kuka.krl import write_krl
+from offline_prog.export.kuka.kuka import VEL_CP_MAX_M_S
 from offline_prog.export.program import ProgramData
-from offline_prog.export.rapid import MAX_SPEED_MMS, write_rapid
-from offline_prog.export.urscript import MOVEL_MAX_SPEED_M_S, write_urscript
+from offline_prog.export.ur.urscript import MOVEL_MAX_SPEED_M_S, write_urscript
 
 
 def mm_per_s_slip(data: ProgramData) -> ProgramData:

@@ -13,8 +13,8 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.spatial.transform import Rotation, Slerp
 
+from offline_prog.export.abb.rapid import confdata, write_rapid
 from offline_prog.export.program import ProgramData
-from offline_prog.export.rapid import confdata, write_rapid
 from offline_prog.robot.model import ROBOTS_DIR, load_robot
 
 POSITION_TOL_MM, ANGLE_TOL_DEG, JOINT_TOL_DEG = 0.01, 0.01, 0.001

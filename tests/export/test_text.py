@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from krl_lint import assert_krllint_clean
 
-from offline_prog.export.krl import write_krl
+from offline_prog.export.abb.rapid import write_rapid
+from offline_prog.export.kuka.krl import write_krl
 from offline_prog.export.program import ProgramData
-from offline_prog.export.rapid import write_rapid
 from offline_prog.export.text import (
     RAPID_STRING_MAX,
     identifier,
@@ -18,7 +18,7 @@ from offline_prog.export.text import (
     rapid_string,
     urscript_string,
 )
-from offline_prog.export.urscript import write_urscript
+from offline_prog.export.ur.urscript import write_urscript
 
 # Each carries a statement after a line break of some kind, and the characters that
 # mean something to one of the languages: quotes, ; (KRL comment), % (RAPID late

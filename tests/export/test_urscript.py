@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from offline_prog.export.formats import ExportRefusedError, export
 from offline_prog.export.program import ProgramData
-from offline_prog.export.urscript import X_BC, resample_joints
+from offline_prog.export.ur.urscript import X_BC, resample_joints
 from offline_prog.plan import plan_cell
 
 from conftest import CELLS, REPO

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
 
 from offline_prog.config.cell import load_cell
-from offline_prog.export.fanuc_job import write_fanuc_job
+from offline_prog.export.fanuc.fanuc_job import write_fanuc_job
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job

@@ -1,6 +1,6 @@
 """KUKA conventions: A, B, C angles, Status and Turn, and the flange frame.
 
-Used by the KRL writer (``export.krl``); see its module docstring for sources.
+Used by the KRL writer (``export.kuka.krl``); see its module docstring for sources.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """ABB RAPID: a whole job as one module ``<module>.mod`` (+ ``.pgf``), in the frames of
-:mod:`offline_prog.export.rapid` (stationary ``tooldata`` = the fixed tool T,
+:mod:`offline_prog.export.abb.rapid` (stationary ``tooldata`` = the fixed tool T,
 robot-held ``wobjdata`` = the part P, robtarget = the process frame X_PF).
 
 ``main``: ``MoveAbsJ`` home; per seam the link (``MoveAbsJ`` through its jointtargets,
@@ -27,13 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.abb import abb_axes_deg, confdata
-from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
-from offline_prog.export.header import header_lines
-from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.job_steps import JointMove, LinearMove, Process, job_steps
-from offline_prog.export.payload import payload
-from offline_prog.export.rapid import (
+from offline_prog.export.abb.abb import abb_axes_deg, confdata
+from offline_prog.export.abb.rapid import (
     DEG_DIGITS,
     EXTAX,
     GRIPPER_LOAD,
@@ -48,6 +43,11 @@ from offline_prog.export.rapid import (
     _robtarget,
     segment_speeds_mms,
 )
+from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
+from offline_prog.export.header import header_lines
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.job_steps import JointMove, LinearMove, Process, job_steps
+from offline_prog.export.payload import payload
 from offline_prog.export.text import identifier, identifier_from, rapid_comment
 from offline_prog.io_events import Signal
 

@@ -1,5 +1,5 @@
 """FANUC TP programs of a whole job (LS text), in the frames and form of
-:mod:`offline_prog.export.fanuc_ls` (flange-style: UTOOL[1] = the part P in the
+:mod:`offline_prog.export.fanuc.fanuc_ls` (flange-style: UTOOL[1] = the part P in the
 faceplate, positions = P in UFRAME[1] = base_link).
 
 ``<name>.ls``: ``J`` home; per seam the link (``J`` through its joint-represented
@@ -10,7 +10,7 @@ program grows with the job; home at the end (the last link). Every ``L`` point i
 planned sample.
 
 Process I/O, translated from the plan's I/O events (``io_events``), placed by
-:mod:`offline_prog.export.fanuc_io`:
+:mod:`offline_prog.export.fanuc.fanuc_io`:
 
 - the digital output: FANUC's distance-before motion option on the motion whose end the
   event precedes, ``L P[i] ... DB d mm,DO[n]=ON`` (the output is set when the TCP comes
@@ -38,9 +38,9 @@ import numpy as np
 from offline_prog.atomic import write_atomic
 from offline_prog.errors import InputError
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
-from offline_prog.export.fanuc import cartesian_pos, config_strings, fanuc_axes_deg, joint_pos
-from offline_prog.export.fanuc_io import Samples, place_events
-from offline_prog.export.fanuc_ls import (
+from offline_prog.export.fanuc.fanuc import cartesian_pos, config_strings, fanuc_axes_deg, joint_pos
+from offline_prog.export.fanuc.fanuc_io import Samples, place_events
+from offline_prog.export.fanuc.fanuc_ls import (
     DEFAULT_LINE_LIMIT,
     JOINT_SPEED_PCT,
     NAME_MAX,

@@ -20,7 +20,7 @@ from scipy.spatial.transform import Rotation
 from offline_prog.atomic import write_atomic
 from offline_prog.export.densify import densify
 from offline_prog.export.header import header_lines
-from offline_prog.export.krl_points import process_points
+from offline_prog.export.kuka.krl_points import process_points
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
 from offline_prog.export.text import identifier, urscript_comment

@@ -33,9 +33,9 @@ from offline_prog.atomic import write_atomic
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.header import header_lines
-from offline_prog.export.krl_header import krl_comments, krl_conventions
-from offline_prog.export.krl_points import process_points
-from offline_prog.export.kuka import (
+from offline_prog.export.kuka.krl_header import krl_comments, krl_conventions
+from offline_prog.export.kuka.krl_points import process_points
+from offline_prog.export.kuka.kuka import (
     X_KE,
     joints_near,
     krl_frame,

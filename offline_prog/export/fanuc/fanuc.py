@@ -1,6 +1,6 @@
 """FANUC conventions: controller axes, configuration strings, W-P-R, LS position text.
 
-Sources and assumptions (the LS program writer, :mod:`offline_prog.export.fanuc_ls`,
+Sources and assumptions (the LS program writer, :mod:`offline_prog.export.fanuc.fanuc_ls`,
 states them in each program's header):
 
 - Axes: FANUC counts J3 from the horizontal; the ROS-Industrial FANUC support packages'
@@ -13,7 +13,7 @@ states them in each program's header):
 - Configuration ``'F|N U|D T|B, t1, t4, t6'``: N (no flip) when J5 ≤ 0 in FANUC's axes,
   F when J5 > 0; U when the elbow (axis 3) is above the line from axis 2 to the wrist
   centre, D below; T when the wrist centre is in front of axis 1, B behind it (the same
-  geometric tests as ABB's cfx bits, ``export.abb.confdata``); turn numbers of J1, J4,
+  geometric tests as ABB's cfx bits, ``export.abb.abb.confdata``); turn numbers of J1, J4,
   J6: 0 for (-180°, 180°], 1 for (180°, 540°], -1 for (-540°, -180°].
 - World: FANUC's world frame sits on axis 1 at the height of axis 2 (the ROS-Industrial
   FANUC support packages' ``base`` frame: base_link raised by c1); positions here are in

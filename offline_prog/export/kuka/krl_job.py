@@ -1,5 +1,5 @@
 """KUKA KRL for KSS 8: a whole job as ``name.src`` / ``.dat`` plus one ``name_<k>``
-module per seam, in the external-TCP style of :mod:`offline_prog.export.krl` (``$BASE``
+module per seam, in the external-TCP style of :mod:`offline_prog.export.kuka.krl` (``$BASE``
 = the fixed tool T, ``$TOOL`` = the part P, ``$IPO_MODE=#TCP``, LIN points X_TP).
 
 Main program: home (``PTP`` to an ``E6AXIS``), then per seam: the link (``PTP`` through
@@ -31,9 +31,9 @@ from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL
 from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.job_steps import JointMove, LinearMove, Process, job_steps
-from offline_prog.export.krl import _load, _process_lines, _write
-from offline_prog.export.krl_header import krl_comments
-from offline_prog.export.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
+from offline_prog.export.kuka.krl import _load, _process_lines, _write
+from offline_prog.export.kuka.krl_header import krl_comments
+from offline_prog.export.kuka.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
 from offline_prog.io_events import Signal
 
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
@@ -210,7 +210,7 @@ def _seam_module(
 def _ori_speed(job) -> float:
     from scipy.spatial.transform import Rotation
 
-    from offline_prog.export.krl import ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S
+    from offline_prog.export.kuka.krl import ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S
 
     R = job.X_BE[:, :3, :3]
     dt = np.diff(job.t)

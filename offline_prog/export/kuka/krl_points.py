@@ -1,4 +1,4 @@
-"""Which plan samples become KRL LIN points, for each KRL style (see ``export.krl``).
+"""Which plan samples become KRL LIN points, for each KRL style (see ``export.kuka.krl``).
 
 Frames: B robot base, P part, F process frame, T fixed tool. Tolerances: chord [m]
 and angle [rad] against the plan's process frames.

@@ -4,7 +4,7 @@ Links: ``movej`` through the link's joint waypoints (the planned, collision-chec
 straight joint moves; the controller's own timing at the joints' common limits). Each
 seam with its approach and retract: the planned joint trajectory resampled to the
 controller period and streamed with ``servoj``, as the one-seam writer does
-(:mod:`offline_prog.export.urscript`).
+(:mod:`offline_prog.export.ur.urscript`).
 
 Process I/O from the plan's I/O events: an output is set (``set_standard_digital_out``,
 ``set_standard_analog_out``) just before the first ``servoj`` whose sample has reached
@@ -27,7 +27,7 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.payload import payload
 from offline_prog.export.text import identifier, urscript_comment
-from offline_prog.export.urscript import (
+from offline_prog.export.ur.urscript import (
     E_SERIES_PERIOD_S,
     NAME_MAX,
     SERVOJ_GAIN,

@@ -1,13 +1,13 @@
 """FANUC TP programs as LS text (``/PROG … /ATTR … /MN … /POS … /END``) for one seam.
 
-Form: **flange-style, dense point list** (KRL's ``flange`` style, ``export.krl_points``).
+Form: **flange-style, dense point list** (KRL's ``flange`` style, ``export.kuka.krl_points``).
 FANUC sells a Remote TCP option for a robot that carries the part past a fixed tool, but
 this writer has no FANUC document at hand to cite for its instructions, so it does not
 use it (the issue's rule: cite the source or write the flange form and say so). The
 tool frame is the part: UTOOL[1] = X_EP (P in the faceplate = URDF tool0, z out of the
 flange), and every position is the part frame X_BP = X_BE · X_EP in a user frame equal
 to the URDF base_link (UFRAME[1] = 0, 0, -c1, 0, 0, 0 in FANUC's world, see
-export.fanuc). The controller interpolates P linearly between the points while the
+export.fanuc.fanuc). The controller interpolates P linearly between the points while the
 tool stays fixed, so the points are split until the tool's curve on the part also stays
 within the chord and angle tolerances (``process_points(style="flange")`` after
 ``densify``). Speeds are each segment's planned mean speed of P's origin [mm/sec];
@@ -26,9 +26,10 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
+from offline_prog.export.abb.rapid import DEFAULT_APPROACH_M, approach_and_retract
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
-from offline_prog.export.fanuc import (
+from offline_prog.export.fanuc.fanuc import (
     cartesian_pos,
     config_strings,
     fanuc_axes_deg,
@@ -36,10 +37,9 @@ from offline_prog.export.fanuc import (
     wpr_deg,
 )
 from offline_prog.export.header import header_lines
-from offline_prog.export.krl_points import process_points
+from offline_prog.export.kuka.krl_points import process_points
 from offline_prog.export.payload import payload
 from offline_prog.export.program import ProgramData
-from offline_prog.export.rapid import DEFAULT_APPROACH_M, approach_and_retract
 from offline_prog.export.text import fanuc_comments, identifier
 
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most

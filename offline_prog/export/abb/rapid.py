@@ -27,7 +27,7 @@ import numpy as np
 from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.abb import abb_axes_deg, confdata
+from offline_prog.export.abb.abb import abb_axes_deg, confdata
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.header import header_lines

@@ -1,4 +1,4 @@
-"""ABB conventions: controller axis values and confdata (see ``export.rapid``)."""
+"""ABB conventions: controller axis values and confdata (see ``export.abb.rapid``)."""
 
 from __future__ import annotations
 
