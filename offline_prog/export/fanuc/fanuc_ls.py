@@ -11,9 +11,13 @@ export.fanuc.fanuc). The controller interpolates P linearly between the points w
 tool stays fixed, so the points are split until the tool's curve on the part also stays
 within the chord and angle tolerances (``process_points(style="flange")`` after
 ``densify``). Speeds are each segment's planned mean speed of P's origin [mm/sec];
-CNT100 between process points, FINE at the ends. As the RAPID writer: ``J`` (joint
-represented) to the approach pose, ``approach_m`` off the surface along -y of F, ``L``
-onto the first point and ``L`` back off after the last. Each program holds at most
+CNT100 between process points, FINE at the ends. By default the program moves only as
+planned: ``J`` (joint represented) to the plan's first joints, then the ``L`` points.
+With ``approach_m`` > 0, as the RAPID writer's option: ``J`` to the approach pose,
+``approach_m`` off the surface along -y of F, ``L`` onto the first point and ``L`` back
+off after the last (moves the plan did not check). This writer serves one-seam plan
+folders written before every cell became a job (``fanuc_job`` writes every new plan).
+Each program holds at most
 ``line_limit`` /MN lines; longer ones call sub-programs ``NAME_2 …``.
 """
 
@@ -26,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.abb.rapid import DEFAULT_APPROACH_M, approach_and_retract
+from offline_prog.export.abb.rapid import approach_and_retract
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.fanuc.fanuc import (
@@ -99,7 +103,7 @@ def write_fanuc(
     chord_tol_m: float = DEFAULT_CHORD_TOL_M,
     angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
     line_limit: int = DEFAULT_LINE_LIMIT,
-    approach_m: float = DEFAULT_APPROACH_M,
+    approach_m: float = 0.0,
     forced: bool = False,
 ) -> FanucResult:
     """Write ``<name>.ls`` (and ``<name>_<k>.ls`` sub-programs) for a one-seam plan.
@@ -108,9 +112,9 @@ def write_fanuc(
         data: the plan, of an OPW robot.
         chord_tol_m, angle_tol_rad: the tool's largest deviation on the part [m, rad].
         line_limit: most /MN lines in one program.
-        approach_m: approach / retract distance off the surface [m] (0 or out of reach:
-            none), as the RAPID writer's: J to the approach, L to the first point, and L
-            back off after the last.
+        approach_m: approach / retract distance off the surface [m] (0, the default, or
+            out of reach: none), as the RAPID writer's: J to the approach, L to the first
+            point, and L back off after the last.
 
     Raises:
         ValueError: naming the bad argument.
