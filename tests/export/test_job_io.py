@@ -30,6 +30,7 @@ from offline_prog.results.job_folder import write_job_outputs
 from offline_prog.robot.model import load_robot
 
 from conftest import CELLS
+from rapid_reader import rapid_procs
 
 IO_TOL_M = 1e-3  # the issue: within ±1 mm
 START_P = np.array([-0.120, 0.080, 0.0])  # the stripe in P [m] (cells/seal_job_kr16.yaml)
@@ -188,15 +189,7 @@ def rapid_events(data, text):
         m[1]: np.deg2rad(np.array(m[2].split(","), float))
         for m in re.finditer(r"jointtarget (\w+) := \[\[([^\]]*)\]", text)
     }
-    procs, current = {}, None
-    for raw in text.splitlines():
-        line = raw.strip()
-        if line.startswith("PROC "):
-            current = procs.setdefault(line.split()[1].split("(")[0], [])
-        elif line.startswith("ENDPROC"):
-            current = None
-        elif current is not None:
-            current.append(line)
+    procs = rapid_procs(text)
     run = [s for line in procs["main"] for s in procs.get(line.split(";")[0], [line])]
     defined, here, events = {}, None, []
     for line in run:

@@ -22,6 +22,7 @@ from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 
 from conftest import CELLS
+from rapid_reader import rapid_procs
 
 IO_TOL_M = 1e-3  # the issue: within ±1 mm
 LENGTH_TOL_M = 0.01e-3  # approach / retract lengths
@@ -196,15 +197,7 @@ def rapid_run(module_text: str):
         m[1]: np.array(m[2].split(","), float) * 1e-3 for m in ROBTARGET.finditer(module_text)
     }
     joints = {m[1]: np.array(m[2].split(","), float) for m in JOINTTARGET.finditer(module_text)}
-    procs, current = {}, None
-    for raw in module_text.splitlines():
-        line = raw.strip()
-        if line.startswith("PROC "):
-            current = procs.setdefault(line.split()[1].split("(")[0], [])
-        elif line.startswith("ENDPROC"):
-            current = None
-        elif current is not None:
-            current.append(line)
+    procs = rapid_procs(module_text)
     run = []
     for line in procs["main"]:
         call = line.split(";")[0]

@@ -31,6 +31,7 @@ from offline_prog.config.cell import load_cell, transform
 from offline_prog.robot.model import load_robot
 
 from conftest import CELLS
+from rapid_reader import rapid_procs
 
 POSITION_TOL_M = 1e-6
 ANGLE_TOL_RAD = 1e-6
@@ -129,15 +130,10 @@ def rapid_matches(folder, rows: Rows):
     text = (folder / "OfflineProg.mod").read_text()
     robtargets = {m[1]: (m[2], m[3]) for m in ROBTARGET.finditer(text)}
     jointtargets = {m[1]: m[2] for m in JOINTTARGET.finditer(text)}
-    procs, current = {}, None
-    for raw in text.splitlines():
-        line = raw.strip()
-        if line.startswith("PROC "):
-            current = procs.setdefault(line.split()[1].split("(")[0], [])
-        elif line.startswith("ENDPROC"):
-            current = None
-        elif current is not None and not line.startswith("!"):
-            current.append(line)
+    procs = {
+        name: [line for line in lines if not line.startswith("!")]
+        for name, lines in rapid_procs(text).items()
+    }
 
     def run(proc):
         for line in procs[proc]:
