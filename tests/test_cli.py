@@ -5,6 +5,7 @@ import errno
 import os
 import re
 import shutil
+import time
 
 import pytest
 
@@ -125,9 +126,16 @@ def test_ctrl_c_while_writing_is_exit_130_one_line_and_no_half_folder(
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
+    def slow_preview(*args, **kwargs):  # still drawing, in its child, at the Ctrl-C
+        time.sleep(0.5)
+        draw_preview(*args, **kwargs)
+
+    draw_preview = job_folder.write_job_preview_html
+    monkeypatch.setattr(job_folder, "write_job_preview_html", slow_preview)
     monkeypatch.setattr(job_folder, "write_job_report_html", interrupted)
     code, err = run(capsys, "plan", CELLS / "tape_cylinder_ur10e.yaml", "--out", out)
     assert code == 130 and err == ["interrupted"]
+    time.sleep(1.0)  # a preview child left running would have written by now
     assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staged sibling left
 

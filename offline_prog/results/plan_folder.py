@@ -218,12 +218,10 @@ def _write_all(plan: Plan, out_dir: Path, *, folder_name: str) -> tuple[dict[str
     }
     # preview.html needs nothing the other outputs write: the second core draws it.
     files["preview"] = out_dir / "preview.html"
-    preview = InParallel(lambda: write_preview_html(plan, files["preview"]))
-    try:
+    # An error or Ctrl-C in the block stops the child before the folder goes.
+    with InParallel(lambda: write_preview_html(plan, files["preview"])) as preview:
         summary = _write_rest(plan, out_dir, files, folder_name=folder_name)
         preview.wait()
-    finally:
-        preview.cancel()  # an error or Ctrl-C here: stop it before the folder goes
     return files, summary
 
 
@@ -253,7 +251,8 @@ class InParallel:
 
     ``wait()`` blocks until it is done and raises the child's error here, as it was (an
     OSError keeps its path; RuntimeError if it cannot travel). ``cancel()`` stops it:
-    a folder is never removed while the child still writes into it.
+    a folder is never removed while the child still writes into it. Used as a context
+    manager, leaving the block by any error or Ctrl-C cancels it.
     """
 
     def __init__(self, function):
@@ -299,3 +298,9 @@ class InParallel:
             self.process.terminate()
             self.process.join()
             self.process = None
+
+    def __enter__(self) -> InParallel:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.cancel()
