@@ -16,6 +16,7 @@ from pydrake.math import RigidTransform
 
 from offline_prog.config import safe_yaml
 from offline_prog.config.cad_keys import CadSeamConfig
+from offline_prog.config.process_keys import ProcessConfig
 from offline_prog.config.typed_check import check_mapping
 from offline_prog.errors import InputError
 
@@ -66,7 +67,7 @@ class AnalogFlow:
     lag [s], by which the command leads the tool."""
 
     analog_output: int = required()
-    per_mps: float = required()
+    per_mps: float | None = None  # required unless process.bead sets it (check_cell)
     offset: float = 0.0
     min: float = 0.0
     max: float = 10.0
@@ -270,6 +271,8 @@ class Cell:
     allowed_contact: list[list[str]] = dataclasses.field(default_factory=list)
     # Where the tool and grasp may go (offline-prog place); plan ignores it.
     place: PlaceConfig | None = None
+    # What the part gets along the path: bead, heat input or tape temperature.
+    process: ProcessConfig | None = None
 
 
 def load_cell(file: str | os.PathLike) -> Cell:

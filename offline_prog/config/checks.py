@@ -13,6 +13,7 @@ import numpy as np
 from offline_prog.config.cad_keys import check_cad, check_part_model
 from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.config.job_checks import check_job
+from offline_prog.config.process_keys import check_process
 from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
@@ -57,6 +58,9 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     for key, path in seam_keys(cell):
         _check_path(file, key, path, cell)
     check_job(file, cell)
+    check_process(
+        file, cell.process, None if cell.tool.process_io is None else cell.tool.process_io.flow
+    )
     for key, value in (
         ("motion.speed", motion.speed),
         ("motion.max_acceleration", motion.max_acceleration),

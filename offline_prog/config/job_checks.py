@@ -83,7 +83,14 @@ def check_job(file: Path, cell: Cell) -> None:
             raise _error(file, "tool.process_io.off.digital_output", "must equal on's")
         if io.flow is not None and not io.flow.min < io.flow.max:
             raise _error(file, "tool.process_io.flow", "needs min < max")
-        if io.flow is not None and not io.flow.per_mps > 0:
+        bead = cell.process is not None and cell.process.model == "bead"
+        if io.flow is not None and io.flow.per_mps is None and not bead:
+            raise _error(
+                file,
+                "tool.process_io.flow.per_mps",
+                "missing: the flow's V per m/s (or a process.bead model that sets it)",
+            )
+        if io.flow is not None and io.flow.per_mps is not None and not io.flow.per_mps > 0:
             raise _error(
                 file,
                 "tool.process_io.flow.per_mps",

@@ -17,8 +17,10 @@ import dataclasses
 import numpy as np
 
 from offline_prog.config.cell import ProcessIoConfig
+from offline_prog.config.process_keys import ProcessConfig
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import JobSamples
+from offline_prog.process.model import process_model, speed_output
 
 POSITION_TOL_M = 1e-6  # a switch this close to the approach's start or retract's end
 
@@ -48,32 +50,37 @@ class IoPlacementError(ValueError):
         super().__init__(f"{key}: {reason}")
 
 
-def process_io_settings(io: ProcessIoConfig | None) -> ProcessIo | None:
-    """The cell's ``tool.process_io`` in SI units (None: no process I/O)."""
-    if io is None:
+def process_io_settings(io: ProcessIoConfig | None, process=None) -> ProcessIo | None:
+    """The cell's ``tool.process_io`` in SI units, with the speed-following output the
+    process model sets (``process:``, process.model.speed_output: the bead's flow gain
+    and lead, the tape heater's power output); None: no process I/O."""
+    fields = speed_output(process_model(process), process)
+    if io is None and not fields:
         return None
-    flow = io.flow
+    flow = None if io is None else io.flow
+    if flow is not None:
+        fields = {
+            "analog_output": flow.analog_output,
+            "per_mps": flow.per_mps,
+            "offset": flow.offset,
+            "min": flow.min,
+            "max": flow.max,
+            "lag_s": flow.lag_s,
+        } | fields
     return ProcessIo(
-        digital_output=None if io.on is None else io.on.digital_output,
-        on_lead_m=0.0 if io.on is None else io.on.lead_mm * 1e-3,
-        off_lead_m=0.0 if io.off is None else io.off.lead_mm * 1e-3,
-        **(
-            {}
-            if flow is None
-            else {
-                "analog_output": flow.analog_output,
-                "per_mps": flow.per_mps,
-                "offset": flow.offset,
-                "min": flow.min,
-                "max": flow.max,
-                "lag_s": flow.lag_s,
-            }
-        ),
+        digital_output=None if io is None or io.on is None else io.on.digital_output,
+        on_lead_m=0.0 if io is None or io.on is None else io.on.lead_mm * 1e-3,
+        off_lead_m=0.0 if io is None or io.off is None else io.off.lead_mm * 1e-3,
+        **fields,
     )
 
 
 def io_columns(
-    samples: JobSamples, io: ProcessIoConfig | None, lengths_m: dict[str, float], tcp_speed
+    samples: JobSamples,
+    io: ProcessIoConfig | None,
+    lengths_m: dict[str, float],
+    tcp_speed,
+    process: ProcessConfig | None = None,
 ) -> IoColumns:
     """The process output's state and the flow command on every row, and the events.
 
@@ -82,6 +89,7 @@ def io_columns(
         io: ``tool.process_io`` (None: no I/O).
         lengths_m: each seam's path length L [m] by name.
         tcp_speed: (N,) speed of the tool along the part [m/s].
+        process: the cell's ``process:`` (its model may set the speed-following output).
 
     Raises:
         IoPlacementError: on a seam, the output goes off before it goes on, either
@@ -89,7 +97,7 @@ def io_columns(
             is never on while the seam runs (one line naming the seam and both
             positions); or the flow's lag leads its start before the approach.
     """
-    settings = process_io_settings(io)
+    settings = process_io_settings(io, process)
     if settings is None:
         return IoColumns(None, None, [])
     t = samples.t

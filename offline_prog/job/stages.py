@@ -263,7 +263,9 @@ def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
     lengths = {option.name: option.plan.path.length for option in linked.chosen}
     process_io = inputs.cell.tool.process_io
     try:
-        return io_columns(linked.samples, process_io, lengths, linked.tcp_speed)
+        return io_columns(
+            linked.samples, process_io, lengths, linked.tcp_speed, inputs.cell.process
+        )
     except IoPlacementError as error:
         raise InputError(inputs.file, error.key, error.reason) from None
 

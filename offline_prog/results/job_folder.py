@@ -83,12 +83,11 @@ def job_table(job: JobPlan) -> tuple[list[str], list[np.ndarray]]:
     header = [*CSV_COLUMNS, "segment"]
     header += [f"q{i + 1}" for i in range(6)] + [f"qd{i + 1}" for i in range(6)]
     columns = [*flange_table(job).T, s.labels(), *s.q.T, *s.qd.T]
-    process_io = job.cell.tool.process_io
     if io_.digital is not None:
-        header.append(f"do{process_io.on.digital_output}")
+        header.append(f"do{io_.settings.digital_output}")
         columns.append(io_.digital)
     if io_.analog is not None:
-        header.append(f"ao{process_io.flow.analog_output}")
+        header.append(f"ao{io_.settings.analog_output}")
         columns.append(io_.analog)
     return header, columns
 
