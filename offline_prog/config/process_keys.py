@@ -28,7 +28,6 @@ without its section, a non-positive parameter, an inverted band and a model with
 the output it needs (bead: ``tool.process_io.flow``), each in one line.
 """
 
-
 import dataclasses
 import math
 from pathlib import Path
