@@ -12,7 +12,8 @@ a row is *dispensing* when the output is on and (bead, tape) its lagged flow or 
 positive; elsewhere the quality column is NaN. The share within the band is weighted by
 path length (trapezoid weights from ``path_m``), over the dispensing length. A row
 where the tool stands (v below the model's ``MIN_SPEED_M_S``) while dispensing is out of
-the band (the bead piles up, the tape and the weld overheat) and NaN in the column.
+the band (the bead piles up, the weld overheats) and NaN in the column, unless the
+output follows the speed to rest (the heater: no power, nothing dispensed).
 
 Each stretch outside the band gets one cause, decided at its worst row i (the largest
 excess over the band) in this order:
@@ -171,14 +172,14 @@ def process_quality(
             seam_of[segment.start : segment.stop] = len(names)
             names.append(segment.seam)
     gate = np.ones(len(t), bool) if digital is None else np.asarray(digital) > 0
-    values, dispensing = _values(model, t, v, command, gate & (seam_of >= 0))
+    values, dispensing = _values(model, t, v, command, gate & (seam_of >= 0), settings)
     weights = _row_weights(np.nan_to_num(np.asarray(path_m, float)), seam_of)
     low, high = model.band
     inside = dispensing & (values >= low) & (values <= high)
     uncompensated = None
     if isinstance(model, BeadModel):
         u_off = _uncompensated_command(t, v, settings, events)
-        off_values, off_dispensing = _values(model, t, v, u_off, gate & (seam_of >= 0))
+        off_values, off_dispensing = _values(model, t, v, u_off, gate & (seam_of >= 0), settings)
         off_inside = off_dispensing & (off_values >= low) & (off_values <= high)
         uncompensated = (off_inside, off_dispensing)
     causes = _cause_rows(model, v, seam_of, len(names), settings)
@@ -196,21 +197,28 @@ def process_quality(
     return ProcessQuality(model, shown, summary(seam_of >= 0), seams)
 
 
-def _values(model, t, v, command, on) -> tuple[np.ndarray, np.ndarray]:
-    """(N,) quality [SI] (inf at a standstill) and (N,) dispensing rows among ``on``."""
+def _values(model, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) quality [SI] (inf at a standstill) and (N,) dispensing rows among ``on``.
+
+    Below the least defined speed a row counts only if the output gives more than its
+    law gives at that speed (the bead's lagged flow, the arc): the part then gets it
+    without the tool moving. An output that follows the speed to rest (the heater)
+    gives a vanishing amount there: not dispensing."""
     if isinstance(model, HeatInputModel):
-        amount = np.ones(len(t))
+        amount, at_rest = np.ones(len(t)), 0.0
         values = model.predict(t, v)
     else:
         if command is None:
             raise ValueError(f"process model {NAMES[type(model)]} needs its output's command")
         values = model.predict(t, v, command)
+        at_rest = float(settings.flow(MIN_SPEED_M_S))
         if isinstance(model, BeadModel):
             amount = first_order_response(t, command, model.lag_s)
         else:
             amount = np.asarray(command, float)
-    dispensing = on & (amount > 0)
-    values = np.where(dispensing & (v < MIN_SPEED_M_S), np.inf, values)
+    slow = v < MIN_SPEED_M_S
+    dispensing = on & (amount > 0) & ~(slow & (amount <= at_rest + SATURATION_TOL))
+    values = np.where(dispensing & slow, np.inf, values)
     return values, dispensing
 
 
