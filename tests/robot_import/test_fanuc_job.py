@@ -27,6 +27,8 @@ from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 from offline_prog.robot_import.run import import_robot
 
+from conftest import with_own_io
+
 IO_TOL_M = 1e-3
 JOINT_TOL_DEG = 1e-3
 FLOW_TOL_V = 0.05  # a motion's AO value against the plan's column on its rows
@@ -62,7 +64,8 @@ def fanuc_job(tmp_path_factory):
     work = tmp_path_factory.mktemp("fanuc_job")
     _m20ia(work)
     text = _on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
-    text = text.replace("motion:", "job: {order: given}\nmotion:", 1).replace("tool:\n", IO, 1)
+    text = text.replace("motion:", "job: {order: given}\nmotion:", 1)
+    text = with_own_io(text, IO)
     cell = work / "seal_job_m20ia.yaml"
     cell.write_text(text)
     job = plan_job(cell)
