@@ -21,8 +21,10 @@ excess over the band) in this order:
 1. ``standstill``: v_i below the model's least defined speed;
 2. ``output saturated``: the output the target needs at v_i, offset + gain · v_i, lies
    outside the output's [min, max] (for the tape: the heater's full power);
-3. ``start ramp``: i lies before the seam's speed first reaches RAMP_SHARE of its top
-   (the speed rising from rest at the seam's start); ``end ramp``: after it last does;
+3. ``start ramp``: the seam starts from rest and i lies on its first rise: before the
+   speed first reaches RAMP_SHARE of the seam's top speed or first falls; ``end ramp``:
+   the seam ends at rest and i lies on its last fall (after the speed last was at the
+   top or last rose);
 4. ``lag`` (a bead with a lag): the speed changes where the lead cannot cancel the
    dispenser's first-order lag (a slowdown, a corner);
 5. ``slowdown``: v_i below RAMP_SHARE of the seam's top speed (heat input, tape);
@@ -241,16 +243,28 @@ def _row_weights(path: np.ndarray, seam_of: np.ndarray) -> np.ndarray:
 
 def _cause_rows(model, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
     """Per row, the masks the causes are decided from (see the module)."""
-    top = np.zeros(n_seams)
-    np.maximum.at(top, seam_of[seam_of >= 0], v[seam_of >= 0])
-    top_row = np.where(seam_of >= 0, top[np.maximum(seam_of, 0)], np.inf)
-    at_top = (v >= RAMP_SHARE * top_row) & (seam_of >= 0)
     index = np.arange(len(v))
-    first_top = np.full(n_seams, len(v))
-    last_top = np.full(n_seams, -1)
-    np.minimum.at(first_top, seam_of[at_top], index[at_top])
-    np.maximum.at(last_top, seam_of[at_top], index[at_top])
+    on = seam_of >= 0
     seam = np.maximum(seam_of, 0)
+    top = np.zeros(n_seams)
+    np.maximum.at(top, seam_of[on], v[on])
+    at_top = on & (v >= RAMP_SHARE * top[seam])
+    first, last = np.full(n_seams, len(v)), np.full(n_seams, -1)
+    np.minimum.at(first, seam_of[on], index[on])
+    np.maximum.at(last, seam_of[on], index[on])
+    # A ramp runs from rest (at the seam's end: to rest), before the speed first reaches
+    # (after it last leaves) its top, as long as it rises (falls) monotonically.
+    same = on[1:] & (seam_of[1:] == seam_of[:-1])
+    falls, rises = same & (v[1:] < v[:-1]), same & (v[1:] > v[:-1])
+    ramp_up_end = np.full(n_seams, len(v))
+    ramp_down_start = np.full(n_seams, -1)
+    np.minimum.at(ramp_up_end, seam_of[at_top], index[at_top])
+    np.minimum.at(ramp_up_end, seam_of[:-1][falls], index[:-1][falls])
+    np.maximum.at(ramp_down_start, seam_of[at_top], index[at_top])
+    np.maximum.at(ramp_down_start, seam_of[1:][rises], index[1:][rises])
+    at_rest = (1.0 - RAMP_SHARE) * top
+    from_rest = v[np.minimum(first, len(v) - 1)] <= at_rest
+    to_rest = v[np.maximum(last, 0)] <= at_rest
     saturated = np.zeros(len(v), bool)
     if not isinstance(model, HeatInputModel):
         law = settings.offset + settings.per_mps * v
@@ -261,8 +275,8 @@ def _cause_rows(model, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
     return {
         "standstill": v < MIN_SPEED_M_S,
         "output saturated": saturated,
-        "start ramp": index < first_top[seam],
-        "end ramp": index > last_top[seam],
+        "start ramp": on & from_rest[seam] & (index < ramp_up_end[seam]),
+        "end ramp": on & to_rest[seam] & (index > ramp_down_start[seam]),
         "lag": np.full(len(v), isinstance(model, BeadModel) and model.lag_s > 0),
         "slowdown": ~at_top,
         "process speed": np.ones(len(v), bool),
