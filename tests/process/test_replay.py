@@ -21,7 +21,7 @@ from offline_prog.process.model import process_model
 from conftest import CELLS, with_own_io
 
 REPLAY_TOL = 0.01  # the issue: within 1 %
-BEAD_ON_UR = (
+BEAD_ON_UR = (  # the bead of the sealing demo, on another demo's robot
     "process:\n  model: bead\n"
     "  bead: {area_mm2: 12.0, tolerance_pct: 5, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
 )
@@ -139,17 +139,8 @@ def test_bead_flow_law_written_in_krl_gives_the_reported_bead(planned_job):
     live = [float(x) for x in re.findall(rf"DO {factor}=([-\d.]+)", programs)]
     assert live and live[-1] == 0.0 and max(live) > 0
     fk = max(live)  # [fraction of 10 V per m/s]
-    s = job.samples
-    t = s.t
-    lead = -delay
-    v_ahead = np.interp(t + lead, t, job.tcp_speed)
-    # The live window: FK is set at the plan's analog events (the TRIGGERs' positions).
-    window = np.zeros(len(t), bool)
-    flow = [e for e in job.io.events if e.signal.value == "analog"]
-    for on, off in zip(flow[::2], flow[1::2], strict=True):
-        window |= (t >= on.t_s) & (t < off.t_s)
-    value = 10.0 * np.clip(np.where(window, fk, 0.0) * v_ahead + offset, low, high)
-    compare(job, folder, t, replayed(job, t, value))
+    value = 10.0 * law_replay(job, per_mps=fk, lead_s=-delay, offset=offset, low=low, high=high)
+    compare(job, folder, job.samples.t, replayed(job, job.samples.t, value))
 
 
 def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
@@ -163,3 +154,33 @@ def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
     for seam in report["seams"].values():
         assert seam["share_within_band"] >= seam["share_within_band_uncompensated"]
     assert report["share_within_band"] > 0.95
+
+
+def law_replay(job, *, per_mps: float, lead_s: float, offset: float, low: float, high: float):
+    """(N,) the speed-following output [V] a controller sets from its law at the plan's
+    speed, leading by ``lead_s``, live in the plan's flow windows (the TRIGGERs'
+    positions), idle (offset) otherwise, within [low, high]."""
+    t = job.samples.t
+    window = np.zeros(len(t), bool)
+    flow = [e for e in job.io.events if e.signal.value == "analog"]
+    for on, off in zip(flow[::2], flow[1::2], strict=True):
+        window |= (t >= on.t_s) & (t < off.t_s)
+    v_ahead = np.interp(t + lead_s, t, job.tcp_speed)
+    return np.clip(np.where(window, per_mps, 0.0) * v_ahead + offset, low, high)
+
+
+def test_bead_flow_law_written_in_rapid_gives_the_reported_bead(capsys, tmp_path):
+    """The weld demo's IRB 2400 laying a bead: ``TriggSpeed tFlowOn, d, ScaleLag, ao1,
+    ScaleValue`` (V per mm/s) read from the module, replayed at the plan's speed."""
+    text = (CELLS / "weld_seam_irb2400.yaml").read_text()
+    text = with_own_io(text, "tool:\n  process_io:\n    flow: {analog_output: 1}\n")
+    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD_ON_UR + "motion:"))
+    module = (folder / "programs" / "OfflineProg.mod").read_text()
+    speeds = re.findall(r"TriggSpeed \w+, [\d.]+, ([\d.]+), ao1, ([\d.]+);", module)
+    assert speeds and float(speeds[-1][1]) == 0.0
+    scale_lag, per_mm_s = (float(x) for x in speeds[0])
+    io = job.io.settings  # offset and limits are the signal's configuration (header)
+    value = law_replay(
+        job, per_mps=per_mm_s * 1e3, lead_s=scale_lag, offset=io.offset, low=io.min, high=io.max
+    )
+    compare(job, folder, job.samples.t, replayed(job, job.samples.t, value))
