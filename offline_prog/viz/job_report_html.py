@@ -120,7 +120,7 @@ def _quality_plot(quality: dict | None, col: dict, columns: dict) -> list[dict]:
     bottom = max(min(finite.min(initial=low), low), low - QUALITY_SPAN * width)
     margin = 0.1 * (top - bottom)
     share = quality["share_within_band"]
-    within = "" if share is None else f"; {100 * share:.1f} % of the process length within"
+    within = "" if share is None else f"; {100 * share:.1f} % of the process length in the band"
     panel = {
         "title": f"process quality: {quality['model']} [{unit}]{within}",
         "ylabel": f"{name} [{unit}]",
