@@ -122,25 +122,49 @@ def test_bead_flow_set_by_urscript_gives_the_reported_bead(capsys, tmp_path):
     compare(job, folder, t, replayed(job, t, value))
 
 
-def test_bead_flow_law_written_in_krl_gives_the_reported_bead(planned_job):
-    """The seal demo's KRL: ``ANOUT ON $ANOUT[1]=FK*$VEL_ACT+offset DELAY=−τ MINIMUM
-    MAXIMUM`` and the live factor FK its TRIGGER sets, replayed at the plan's speed."""
-    job, folder = planned_job("seal_plate_kr16")
-    src = (folder / "programs" / "offline_prog.src").read_text()
+def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
+    """Issue 24's stripe (tangent approach and retract: every position on one line)
+    laying the sealing demo's bead, the gun on 100 mm into it: the KRL's ``ANOUT ON
+    $ANOUT[1]=FK*$VEL_ACT+offset DELAY=−τ MINIMUM MAXIMUM`` and its TRIGGERs' FK values
+    and positions (from the program's own poses), replayed at the plan's speed."""
+    from export.test_job_io import krl_events, stripe_cell
+
+    from offline_prog.export.job_program import JobProgramData
+    from offline_prog.export.kuka.krl_job import write_krl_job
+    from offline_prog.plan import plan_job
+    from offline_prog.results.job_folder import write_job_outputs
+
+    cell = stripe_cell(tmp_path, on_lead_mm=-100.0, off_lead_mm=2.0, lag_s=0.0)
+    text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
+    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    folder = tmp_path / "plan"
+    write_job_outputs(job, folder)
+    data = JobProgramData.load(folder)
+    write_krl_job(data, tmp_path / "krl")
+    src = (tmp_path / "krl" / "offline_prog.src").read_text()
     m = re.search(
         r"ANOUT ON \$ANOUT\[1\]=(\w+)\*\$VEL_ACT\+([-\d.]+) DELAY=([-\d.]+) "
         r"MINIMUM=([-\d.]+) MAXIMUM=([-\d.]+)",
         src,
     )
     assert m, "no speed-following ANOUT in the KRL"
-    factor = m[1]
     offset, delay, low, high = (float(x) for x in m.groups()[1:])
-    programs = "".join(p.read_text() for p in sorted((folder / "programs").glob("*.src")))
-    live = [float(x) for x in re.findall(rf"DO {factor}=([-\d.]+)", programs)]
-    assert live and live[-1] == 0.0 and max(live) > 0
-    fk = max(live)  # [fraction of 10 V per m/s]
-    value = 10.0 * law_replay(job, per_mps=fk, lead_s=-delay, offset=offset, low=low, high=high)
-    compare(job, folder, job.samples.t, replayed(job, job.samples.t, value))
+    _, events = krl_events(data, tmp_path / "krl")
+    flow = [(float(value), position) for what, value, position, _ in events if what == m[1]]
+    (fk, p_on), (idle, p_off) = flow
+    assert fk > 0 and idle == 0.0
+    # The tool's time at each TRIGGER's position (the seam's rows: path_m rises).
+    s = job.samples
+    rows = np.flatnonzero(np.isfinite(s.path_m))
+    t_on, t_off = np.interp([p_on, p_off], s.path_m[rows], s.t[rows])
+    t = s.t
+    live = np.where((t >= t_on) & (t < t_off), fk, 0.0)
+    v_ahead = np.interp(t - delay, t, job.tcp_speed)  # DELAY < 0: the output leads
+    value = 10.0 * np.clip(live * v_ahead + offset, low, high)
+    report = compare(job, folder, t, replayed(job, t, value))
+    assert report < 1.0  # the bead starts 100 mm in at speed: the lag's thin start
 
 
 def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
