@@ -217,3 +217,47 @@ def test_a_seam_from_rest_names_its_ramps():
     for s in report["stretches_outside"]:
         assert s["t_end_s"] <= 0.3 + 3 * 0.08 or s["t_start_s"] >= 2.7 - 3 * 0.08, s
     assert report["share_within_band"] >= report["share_within_band_uncompensated"]
+
+
+def test_two_seams_and_the_gun_switched_off_early():
+    """Two seams (a link between them, where nothing counts); on the second the weld's
+    torch goes off at 80 % of its length: nothing is dispensed there (empty column),
+    and the job's share is the dispensed-length-weighted mean of the seams'."""
+    t = np.arange(0.0, 9.0 + DT / 2, DT)
+    v = np.where((t > 4.0) & (t < 5.0), 0.05, 0.008)  # the link moves fast
+    v = np.where((t > 1.0) & (t < 2.0), 0.006, v)  # a slowdown on the first seam
+    path = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    link = np.flatnonzero((t >= 4.0) & (t < 5.0))
+    path[link] = np.nan
+    second = np.flatnonzero(t >= 5.0)
+    path[second] -= path[second[0]]
+    segments = [
+        Segment("process", "a", 0, link[0], t[0], t[link[0]]),
+        Segment("link", "", link[0], second[0], t[link[0]], t[second[0]]),
+        Segment("process", "b", second[0], len(t), t[second[0]], t[-1]),
+    ]
+    digital = np.ones(len(t), np.int8)
+    digital[t >= 5.0 + 0.8 * 4.0] = 0
+    result = process_quality(
+        process_model(WELD),
+        t=t,
+        v_tcp=v,
+        path_m=path,
+        segments=segments,
+        command=None,
+        digital=digital,
+        settings=None,
+        events=[],
+    )
+    assert np.all(np.isnan(result.column[link]))
+    assert np.all(np.isnan(result.column[digital == 0]))
+    report = result.as_dict()
+    a, b = report["seams"]["a"], report["seams"]["b"]
+    assert b["dispensed_length_m"] == pytest.approx(0.8 * b["process_length_m"], abs=0.008 * DT)
+    assert b["share_within_band"] == 1.0 and a["n_stretches_outside"] == 1
+    assert a["share_within_band"] == pytest.approx(1 - 0.006 / (3 * 0.008 + 0.006), abs=1e-3)
+    lengths = np.array([a["dispensed_length_m"], b["dispensed_length_m"]])
+    shares = np.array([a["share_within_band"], b["share_within_band"]])
+    assert report["share_within_band"] == pytest.approx((lengths * shares).sum() / lengths.sum())
+    (stretch,) = report["stretches_outside"]
+    assert stretch["seam"] == "a" and stretch["cause"] == "slowdown"
