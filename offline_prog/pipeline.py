@@ -1,7 +1,8 @@
 """The stages as data, declared once: ``plan``, the session and placement run them.
 
-:data:`JOB_STAGES` plan a whole job (scene, home, seams, order, links, I/O, the whole
-job's check; every cell is a job), :data:`SEAM_STAGES` each of its seams.
+:data:`JOB_STAGES` plan a whole job (scene, home, seams, order, links, I/O, process
+quality, the whole job's check; every cell is a job), :data:`SEAM_STAGES` each of its
+seams.
 
 Each :class:`Stage` names its function, the results it reads (by stage name, or
 ``inputs``: the seam's :class:`~offline_prog.stages.Inputs`) and the editable cell
@@ -38,6 +39,7 @@ from offline_prog.job.stages import (
     choose_order,
     job_clearance,
     job_io,
+    job_quality,
     link_job,
     seam_options,
 )
@@ -111,6 +113,7 @@ JOB_STAGES = (
         ("inputs", "scene", "seams", "order", "home", "progress"),
     ),
     Stage("io", "process I/O", job_io, ("inputs", "links")),
+    Stage("quality", "process quality", job_quality, ("inputs", "links", "io")),
     Stage("check", "collision check of the whole job", check_job, ("inputs", "scene", "links")),
 )
 JOB_CLEARANCE = Stage("clearance", "clearance profile", job_clearance, ("scene", "links"))

@@ -210,4 +210,5 @@ def plan_loaded_job(
         results["check"],
         stage.timings_s,
         results.get("clearance"),
+        results["quality"],
     )

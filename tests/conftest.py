@@ -1,5 +1,6 @@
 """Shared fixtures: seeded random paths, frames and cell files."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,16 @@ from offline_prog.path.process_frames import constant_normal
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = REPO / "cells"
+
+
+def with_own_io(text: str, io: str) -> str:
+    """A demo cell's text with its process model and its process I/O replaced by ``io``
+    (``"tool:\\n  process_io: ..."``): tests of the I/O writers bring their own outputs."""
+    text = re.sub(r"(?ms)^process:.*?(?=^\S)", "", text)
+    text = re.sub(r"(?m)^  # The dispenser's flow output.*\n", "", text)
+    text = re.sub(r"(?m)^  process_io:\n(    .*\n)*", "", text)
+    return text.replace("tool:\n", io, 1)
+
 
 # Pose comparison tolerances.
 POSITION_TOL_M = 1e-9

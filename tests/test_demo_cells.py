@@ -5,6 +5,7 @@ point under the tool is on the path, the tool axes are the process frame, the TC
 is the commanded speed; and on every row the joints drive the flange along the poses."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -79,9 +80,12 @@ def test_one_seam_job_segments_and_defaults(planned_job_csv):
 def test_header_and_sampling(planned):
     cell_file, header, table, report = planned
     assert header[: len(CSV_COLUMNS)] == CSV_COLUMNS
-    assert header[len(CSV_COLUMNS) :] == [f"q{i}" for i in range(1, 7)] + [
-        f"qd{i}" for i in range(1, 7)
-    ]
+    joints = [f"q{i}" for i in range(1, 7)] + [f"qd{i}" for i in range(1, 7)]
+    rest = header[len(CSV_COLUMNS) :]
+    assert rest[:12] == joints
+    # Then the process outputs (do<n>, ao<n>) and the process model's quality column.
+    quality = [report["quality"]["column"]] if "quality" in report else []
+    assert [h for h in rest[12:] if not re.fullmatch(r"[da]o\d+", h)] == quality
     t = table[:, 0]
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
     np.testing.assert_allclose(np.diff(t)[:-1], 1 / 250.0, atol=1e-8)  # CSV: 10 digits

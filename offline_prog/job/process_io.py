@@ -133,7 +133,7 @@ def io_columns(
         if flowing:
             if times[0] - lag < t_seam[0] - 1e-9:  # a program sets it on the approach
                 raise IoPlacementError(
-                    "tool.process_io.flow.lag_s",
+                    _lag_key(process),
                     f"{lag:g} s before seam {seam}'s output goes on is before its approach "
                     f"starts ({times[0] - t_seam[0]:.3f} s earlier): a longer approach or "
                     "on.lead_mm leaves the flow room to lead",
@@ -164,6 +164,12 @@ def io_columns(
         analog = np.where(live, value, settings.idle)
     events.sort(key=lambda e: (e.t_s, e.signal is not Signal.DIGITAL))
     return IoColumns(digital, analog, events, settings)
+
+
+def _lag_key(process: ProcessConfig | None) -> str:
+    """The key that sets the flow's lead: the bead model's lag, else the flow's own."""
+    bead = process is not None and process.model == "bead"
+    return "process.bead.lag_s" if bead else "tool.process_io.flow.lag_s"
 
 
 def _check_gate(seam: str, gate: tuple[float, float], path: np.ndarray, length: float) -> None:

@@ -27,6 +27,7 @@ from offline_prog.path.cusps import Cusp, SmoothedFlangePath
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit
 from offline_prog.path.sources import PathPoints
+from offline_prog.process.quality import ProcessQuality
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.trajectory import WorkspaceTrajectory
 
@@ -117,6 +118,8 @@ class JobPlan:
     timings_s: dict[str, float]
     # (t_k, {pair group: smallest distance [m]}) over the whole job (clearance.csv).
     clearance_profile: tuple | None = None
+    # The process quality along the job (process.quality; None: no process model).
+    quality: ProcessQuality | None = None
 
     avoidance = None  # per seam, in each seam's report
 

@@ -28,6 +28,8 @@ from offline_prog.job.seams import (
     seam_inputs,
     seam_key,
 )
+from offline_prog.process.model import process_model
+from offline_prog.process.quality import ProcessQuality, process_quality
 from offline_prog.progress import Step
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs, attempt_motion
@@ -268,6 +270,26 @@ def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
         )
     except IoPlacementError as error:
         raise InputError(inputs.file, error.key, error.reason) from None
+
+
+def job_quality(inputs: Inputs, linked: LinkedJob, io: IoColumns) -> ProcessQuality | None:
+    """Stage ``quality``: the process quality along the job (process.quality) from the
+    planned TCP speed and the outputs as the programs set them; None without a model."""
+    model = process_model(inputs.cell.process)
+    if model is None:
+        return None
+    samples = linked.samples
+    return process_quality(
+        model,
+        t=samples.t,
+        v_tcp=linked.tcp_speed,
+        path_m=samples.path_m,
+        segments=samples.segments,
+        command=io.analog,
+        digital=io.digital,
+        settings=io.settings,
+        events=io.events,
+    )
 
 
 def check_job(inputs: Inputs, scene: DrakeCell, linked: LinkedJob) -> CollisionResult:

@@ -77,8 +77,10 @@ def flange_table(job: JobPlan) -> np.ndarray:
 def job_table(job: JobPlan) -> tuple[list[str], list[np.ndarray]]:
     """trajectory.csv's header and columns: the one-seam columns (``CSV_COLUMNS``),
     then ``segment`` (link, approach:<seam>, process:<seam>, retract:<seam>: the
-    contract), q1..q6 [rad], qd1..qd6 [rad/s], and do<n> (0/1) and ao<n> (the flow
-    value) when the tool has process I/O."""
+    contract), q1..q6 [rad], qd1..qd6 [rad/s], do<n> (0/1) and ao<n> (the flow
+    value) when the tool has process I/O, and the process quality (its model's column,
+    e.g. ``bead_area_mm2``, in that unit; empty off the dispensing rows) with a
+    process model."""
     s, io_ = job.samples, job.io
     header = [*CSV_COLUMNS, "segment"]
     header += [f"q{i + 1}" for i in range(6)] + [f"qd{i + 1}" for i in range(6)]
@@ -89,6 +91,9 @@ def job_table(job: JobPlan) -> tuple[list[str], list[np.ndarray]]:
     if io_.analog is not None:
         header.append(f"ao{io_.settings.analog_output}")
         columns.append(io_.analog)
+    if job.quality is not None:
+        header.append(job.quality.model.column)
+        columns.append(job.quality.column)
     return header, columns
 
 
@@ -206,6 +211,7 @@ def job_report(job: JobPlan) -> dict:
             for e in io_.switches
         ],
         "seams": [{"seam": o.name, **report(o.plan)} for o in job.chosen],
+        **({} if job.quality is None else {"quality": job.quality.as_dict()}),
         **collision_summary(job),
         "timings_s": job.timings_s,
     }

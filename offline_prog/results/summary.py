@@ -74,6 +74,25 @@ def print_payload_warning(console: Console, report: dict) -> None:
         )
 
 
+def print_quality(console: Console, quality: dict | None) -> None:
+    """One line: the process model's share of the process length within its band (and
+    with compensation off, for the bead), its range and the stretches outside."""
+    if not quality:
+        return
+    low, high, unit = *quality["band"], quality["unit"]
+    share = quality["share_within_band"]
+    text = "nothing dispensed" if share is None else f"{100 * share:.1f} %"
+    if quality.get("share_within_band_uncompensated") is not None:
+        text += f" (compensation off: {100 * quality['share_within_band_uncompensated']:.1f} %)"
+    spread = quality["min"] is not None and f" (from {quality['min']:.4g} to {quality['max']:.4g})"
+    console.print(
+        f"  quality   {quality['model']}: {text} of the process length within "
+        f"{low:g} .. {high:g} {unit}{spread or ''}; {quality['n_stretches_outside']} stretches "
+        "outside (report.json quality)",
+        highlight=False,
+    )
+
+
 def print_job_summary(console: Console, report: dict, files: dict, seconds: float) -> None:
     """A few lines for a job: order, cycle time split, each seam, links, clearance."""
     job = report["job"]
@@ -112,6 +131,7 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         )
     for link in report["links"]:
         console.print(f"  link      {link['name']}: {link['method']}, {link['duration_s']:.2f} s")
+    print_quality(console, report.get("quality"))
     distance = report["min_distance_m"]
     console.print(
         "  clearance "

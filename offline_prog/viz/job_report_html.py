@@ -23,6 +23,7 @@ from offline_prog.viz.report_summary import escape as _e
 
 JOINT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 MAX_PLOT_POINTS = 6000  # rows kept for the page's plots (every k-th row beyond)
+QUALITY_SPAN = 3.0  # the quality plot's value axis: at most this many band widths beyond
 
 
 def _columns(plan_dir: Path) -> dict[str, np.ndarray]:
@@ -81,9 +82,11 @@ def _plots(report: dict, col: dict) -> dict:
         ],
     }
     panels = [speed, io_panel] if io else [speed]
+    quality = _quality_plot(report.get("quality"), col, columns)
     return {
         "columns": columns,
-        "plots": [
+        "plots": quality
+        + [
             {
                 "id": "plot-speed",
                 "columns": 1,
@@ -99,6 +102,87 @@ def _plots(report: dict, col: dict) -> dict:
             },
         ],
     }
+
+
+def _quality_plot(quality: dict | None, col: dict, columns: dict) -> list[dict]:
+    """The process quality over the job's time with its band shaded (report.json
+    ``quality``, trajectory.csv's column of the model); none without a model. The value
+    axis spans the band and the values, up to QUALITY_SPAN band widths beyond it (a
+    standstill's spike would flatten the rest)."""
+    if not quality or quality["column"] not in col:
+        return []
+    name, unit, (low, high) = quality["column"], quality["unit"], quality["band"]
+    values = col[name]
+    columns[name] = _series(values)
+    finite = values[np.isfinite(values)]
+    width = high - low
+    top = min(max(finite.max(initial=high), high), high + QUALITY_SPAN * width)
+    bottom = max(min(finite.min(initial=low), low), low - QUALITY_SPAN * width)
+    margin = 0.1 * (top - bottom)
+    share = quality["share_within_band"]
+    within = "" if share is None else f"; {100 * share:.1f} % of the process length in the band"
+    panel = {
+        "title": f"process quality: {quality['model']} [{unit}]{within}",
+        "ylabel": f"{name} [{unit}]",
+        "series": [{"col": name, "label": f"{name} [{unit}]", "color": "#6a1b9a"}],
+        "ybands": [{"y0": low, "y1": high, "label": f"band {low:g} .. {high:g} {unit}"}],
+        "yrange": [bottom - margin, top + margin],
+    }
+    return [
+        {
+            "id": "plot-quality",
+            "columns": 1,
+            "panels": [panel],
+            "caption": "Process quality along the job over time (only where the process "
+            "runs), predicted by the process model from the planned speed and the outputs "
+            "as the programs set them; shaded: the band. Stretches outside it and their "
+            "causes are listed under Process quality.",
+        }
+    ]
+
+
+def _quality_section(quality: dict | None) -> str:
+    """The process quality's figures and its stretches outside the band (report.json
+    ``quality``); empty without a model."""
+    if not quality:
+        return ""
+
+    def share(key: str) -> str:
+        value = quality.get(key)
+        return "" if value is None else f"{100 * value:.1f} %"
+
+    unit = quality["unit"]
+    low, high = quality["band"]
+    figures = [
+        ("model", f"{quality['model']} ({quality['column']})"),
+        ("band", f"{low:g} .. {high:g} {unit} (target {quality['target']:g})"),
+        ("min .. max", f"{quality['min']:.4g} .. {quality['max']:.4g} {unit}")
+        if quality["min"] is not None
+        else ("min .. max", "nothing dispensed"),
+        ("within the band", share("share_within_band") + " of the process length"),
+    ]
+    if "share_within_band_uncompensated" in quality:
+        figures.append(("with compensation off", share("share_within_band_uncompensated")))
+    stretches = _table(
+        ["seam", "σ from [mm]", "σ to [mm]", "t from [s]", "t to [s]", f"worst [{unit}]", "cause"],
+        [
+            [
+                x["seam"],
+                f"{x['sigma_start_m'] * 1e3:.1f}",
+                f"{x['sigma_end_m'] * 1e3:.1f}",
+                f"{x['t_start_s']:.3f}",
+                f"{x['t_end_s']:.3f}",
+                "standstill" if x["worst"] is None else f"{x['worst']:.4g}",
+                x["cause"],
+            ]
+            for x in quality["stretches_outside"]
+        ],
+    )
+    rows = "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td></tr>" for k, v in figures)
+    return (
+        f'<h2>Process quality</h2><table id="quality">{rows}</table>'
+        f"<p>{quality['n_stretches_outside']} stretches outside the band:</p>{stretches}"
+    )
 
 
 def _table(header: list[str], rows: list[list]) -> str:
@@ -188,6 +272,7 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
             for e in report["process_io"]
         ],
     )
+    quality = _quality_section(report.get("quality"))
     data = _plots(report, col)
     text = json.dumps(data, separators=(",", ":"), allow_nan=False)
     text = text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
@@ -204,7 +289,7 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
         f'<p class="sub">{_e(report.get("generator", ""))}, planned '
         f"{_e(report.get('generated', ''))}; plan folder {_e(folder_name)}</p><h2>Summary</h2>"
         f'<table id="summary">{table}'
-        f"</table><h2>Seams</h2>{seams}<h2>Links</h2>{links}<h2>Process I/O</h2>{events}"
+        f"</table><h2>Seams</h2>{seams}<h2>Links</h2>{links}<h2>Process I/O</h2>{events}{quality}"
         f'<h2>Plots</h2><p class="hint">Drag to zoom into a time range, double-click to '
         f"reset.</p>{figures}"
         f'<script type="application/json" id="plot-data">{text}</script>'

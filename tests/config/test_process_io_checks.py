@@ -17,7 +17,7 @@ from offline_prog.io_events import Signal
 from offline_prog.job.assemble import JobSamples, Segment
 from offline_prog.job.process_io import IoPlacementError, io_columns
 
-from conftest import CELLS
+from conftest import CELLS, with_own_io
 
 IO = (
     "tool:\n  process_io:\n    on:  {digital_output: 1, lead_mm: 5}\n"
@@ -43,7 +43,7 @@ def test_process_io_on_a_path_cell_with_an_empty_job_switches_its_outputs(capsys
     it: tests/test_pipeline.py): its process I/O is planned, not ignored: the output is
     on along the seam and off at home."""
     job = "job:\n"
-    text = (CELLS / "seal_plate_kr16.yaml").read_text().replace("tool:\n", IO, 1)
+    text = with_own_io((CELLS / "seal_plate_kr16.yaml").read_text(), IO)
     code, err = run(capsys, tmp_path, with_cell_dir(text.replace("motion:", job + "motion:", 1)))
     assert code == 0, err
     rows = np.genfromtxt(tmp_path / "out" / "trajectory.csv", delimiter=",", names=True)

@@ -21,7 +21,7 @@ from offline_prog.export.job_program import JobProgramData
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 
-from conftest import CELLS
+from conftest import CELLS, with_own_io
 from rapid_reader import rapid_procs
 
 IO_TOL_M = 1e-3  # the issue: within ±1 mm
@@ -40,7 +40,7 @@ def one_seam_job(tmp_path, name: str, home: str) -> object:
         text = re.sub(r"(?m)^job:.*\n", lambda m: m.group(0) + "  order: given\n", text, count=1)
     else:
         text = text.replace("motion:", f"job: {{order: given{home}}}\nmotion:", 1)
-    text = text.replace("tool:\n", IO, 1)
+    text = with_own_io(text, IO)
     file = tmp_path / f"{name}_job.yaml"
     file.write_text(text)
     return file

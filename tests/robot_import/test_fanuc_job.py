@@ -27,6 +27,8 @@ from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 from offline_prog.robot_import.run import import_robot
 
+from conftest import with_own_io
+
 IO_TOL_M = 1e-3
 JOINT_TOL_DEG = 1e-3
 FLOW_TOL_V = 0.05  # a motion's AO value against the plan's column on its rows
@@ -62,7 +64,8 @@ def fanuc_job(tmp_path_factory):
     work = tmp_path_factory.mktemp("fanuc_job")
     _m20ia(work)
     text = _on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
-    text = text.replace("motion:", "job: {order: given}\nmotion:", 1).replace("tool:\n", IO, 1)
+    text = text.replace("motion:", "job: {order: given}\nmotion:", 1)
+    text = with_own_io(text, IO)
     cell = work / "seal_job_m20ia.yaml"
     cell.write_text(text)
     job = plan_job(cell)
@@ -297,3 +300,71 @@ def test_plan_refuses_switches_no_sample_separates_in_one_line(tmp_path, capsys)
     assert code == 2 and len(err) == 1, err
     assert "crowded.yaml: tool.process_io: seam stripe:" in err[0]
     assert "100.000 mm and at 100.010 mm" in err[0]
+
+
+@pytest.fixture(scope="module")
+def bead_stripe(tmp_path_factory):
+    """(JobProgramData, plan folder, robot, job) of the stripe on the M-20iA laying the
+    sealing demo's bead (issue 28): the flow's gain and lead are the bead model's."""
+    work = tmp_path_factory.mktemp("fanuc_bead")
+    _m20ia(work)
+    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    head, rest = text.split("seams:", 1)
+    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
+    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
+    head = head.replace("per_mps: 40.0, offset: 0.5, ", "")
+    bead = (
+        "process:\n  model: bead\n"
+        "  bead: {area_mm2: 12.0, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
+    )
+    cell = work / "bead.yaml"
+    cell.write_text(
+        bead + head + "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
+    )
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, work / "plan")
+    return JobProgramData.load(work / "plan"), work / "plan", job.robot, job
+
+
+def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_stripe, tmp_path):
+    """Issue 28: the AO values the LS program holds along the path (each L motion's,
+    placed by the program's own poses), replayed through the bead model (the
+    dispenser's lag) at the plan's speed, give the report's cross-section within 1 %."""
+    import json
+
+    from offline_prog.process.model import process_model
+
+    data, folder, robot, job = bead_stripe
+    write_fanuc_job(data, tmp_path)
+    (seam,) = _walk(data, tmp_path, robot)
+    s = job.samples
+    ends = np.array([b for _, b, _ in seam["moves"]])
+    values = np.array([v for _, _, v in seam["moves"]])
+    idle = job.io.settings.idle
+    on_path = np.isfinite(s.path_m)
+    k = np.minimum(np.searchsorted(ends, np.nan_to_num(s.path_m), side="left"), len(ends) - 1)
+    held = np.where(on_path, values[k], idle)
+    model = process_model(job.cell.process)
+    bead = model.predict(s.t, job.tcp_speed, held) * model.unit_scale
+    process = next(g for g in s.segments if g.kind == "process")
+    rows = np.arange(process.start, process.stop)
+    plan = job.quality.column[rows]
+    top = job.tcp_speed[rows].max()
+    check = np.isfinite(plan) & (job.tcp_speed[rows] > 0.05 * top)
+    assert check.sum() > 0.9 * len(rows)
+    # Within the band (and 5 % around it) the replay agrees within 1 %; on the ramps
+    # from and to rest, far outside the band, a motion's one AO value is coarser than
+    # the plan's continuous schedule (up to 6 % there): the same rows are outside.
+    low, high = model.band[0] * model.unit_scale, model.band[1] * model.unit_scale
+    near = check & (plan >= 0.95 * low) & (plan <= 1.05 * high)
+    assert near.sum() > 0.7 * len(rows)  # a 240 mm stripe: its ramps are a fifth of it
+    np.testing.assert_allclose(bead[rows][near], plan[near], rtol=0.01)
+    inside_plan = (plan >= low) & (plan <= high)
+    inside_replay = (bead[rows] >= low) & (bead[rows] <= high)
+    w = np.gradient(s.path_m[rows])
+    share = (w * inside_replay).sum() / (w * np.isfinite(plan)).sum()
+    report = json.loads((folder / "report.json").read_text())["quality"]
+    assert report["model"] == "bead"
+    assert share == pytest.approx(report["share_within_band"], abs=0.01)
+    assert np.mean(inside_plan[check] == inside_replay[check]) > 0.99

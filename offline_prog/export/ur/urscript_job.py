@@ -12,8 +12,8 @@ the event's time, so the tool is at most v_TCP · period past its position (0.2 
 100 mm/s and 2 ms). The flow, ``set_standard_analog_out(n, value / 10 V)`` (URScript
 takes the output as a fraction of its 0–10 V range), follows the plan's ``ao`` column
 while it is live, interpolated between live samples only (an edge is a step, not a
-ramp), written at each event and whenever it has changed by ``ANALOG_STEP_V``, and
-holds the idle value otherwise.
+ramp), written at each event and whenever it has changed by ``ANALOG_STEP_V`` or by
+``ANALOG_STEP_SHARE`` of its value, and holds the idle value otherwise.
 """
 
 from __future__ import annotations
@@ -39,6 +39,9 @@ from offline_prog.io_events import Signal
 
 ANALOG_RANGE_V = 10.0  # standard analog outputs: 0..10 V as 0..1
 ANALOG_STEP_V = 0.02  # write the flow when it changed by this much
+# ... or by this share of its value (a process model's quality follows the output's
+# value relative to the speed: a bead or a tape at a slow ramp needs fine steps)
+ANALOG_STEP_SHARE = 0.002
 
 
 def write_urscript_job(
@@ -127,7 +130,7 @@ def _stream(data: JobProgramData, rows: slice, seam: int, period_s: float) -> li
                 lines.append(f"  set_standard_digital_out({event.output}, {state})")
         if flow is not None and (
             last_flow is None
-            or abs(flow[i] - last_flow) >= ANALOG_STEP_V
+            or abs(flow[i] - last_flow) >= min(ANALOG_STEP_V, ANALOG_STEP_SHARE * abs(last_flow))
             or any(e.signal is Signal.ANALOG for e in sets.get(i, []))
         ):
             last_flow = flow[i]
