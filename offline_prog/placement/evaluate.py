@@ -104,6 +104,8 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
         missed = collisions.clearance_m - collisions.min_distance_m
         tier, violation = COLLIDES, max(missed, depth, MIN_VIOLATION)
     distance = collisions.min_distance_m
+    quality = plan.quality
+    share = None if quality is None else quality.job.share_within_band
     return Evaluation(
         candidate,
         "plan",
@@ -114,6 +116,7 @@ def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
         cycle_time_s=duration,
         air_time_s=max(0.0, air),
         clearance_mm=float(distance * 1e3) if math.isfinite(distance) else math.nan,
+        quality_share=math.nan if quality is None else float(share or 0.0),
         seconds=time.perf_counter() - start,
         **_seam_terms(seams),
     )

@@ -8,10 +8,13 @@
    beyond reach [m] (``path_ik.reach_excess``), share on a flipping branch, joint-limit
    excess / π [rad], and the share of the path not done), tier 3 makes geometry the
    method refuses (violation 1).
-2. cycle time [s], resolved to CYCLE_RESOLUTION_S, then
-3. the smallest joint-limit margin [deg] (larger is better),
-4. the distance to the wrist and elbow singularities [deg] (larger is better),
-5. the clearance [mm] (larger is better).
+2. with a process model (``process:``): the share of the dispensed process length whose
+   predicted quality lies within the band (larger is better), resolved to
+   QUALITY_RESOLUTION (without a model every candidate scores 1), then
+3. cycle time [s], resolved to CYCLE_RESOLUTION_S, then
+4. the smallest joint-limit margin [deg] (larger is better),
+5. the distance to the wrist and elbow singularities [deg] (larger is better),
+6. the clearance [mm] (larger is better).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import math
 from offline_prog.placement.space import Candidate
 
 CYCLE_RESOLUTION_S = 0.01  # cycle times closer than this tie; the margins decide
+QUALITY_RESOLUTION = 0.001  # shares within the band closer than this tie; the cycle decides
 FEASIBLE, COLLIDES, CANNOT_FOLLOW, REFUSED = range(4)  # tiers
 
 
@@ -48,6 +52,8 @@ class Evaluation:
         slowed_share: share of the path the joints slowed below the process speed;
             limiting_axis: the axis (1..6) closest to its limit there (0: none).
         air_time_s: a job's time off the seams: approach, retract, links [s].
+        quality_share: with a process model, the share of the dispensed process length
+            within the quality band (process.quality; NaN: no model or no plan).
         seconds: the evaluation's wall time [s].
     """
 
@@ -66,6 +72,7 @@ class Evaluation:
     slowed_share: float = 0.0
     air_time_s: float = 0.0
     limiting_axis: int = 0
+    quality_share: float = math.nan
     seconds: float = 0.0
 
     @property
@@ -75,9 +82,11 @@ class Evaluation:
     def key(self) -> tuple:
         """The lexicographic objective: smaller is better."""
         cycle = self.cycle_time_s if math.isfinite(self.cycle_time_s) else math.inf
+        share = self.quality_share if math.isfinite(self.quality_share) else 1.0
         return (
             self.tier,
             self.violation,
+            -round(share / QUALITY_RESOLUTION),
             round(cycle / CYCLE_RESOLUTION_S) if cycle < math.inf else math.inf,
             -self.joint_limit_margin_deg,
             -self.singularity_margin_deg,

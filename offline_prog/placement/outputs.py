@@ -55,6 +55,7 @@ def terms(e: Evaluation) -> dict:
         "limiting_axis": e.limiting_axis or None,
         "process_bound_s": _finite(e.process_bound_s),
         "air_time_s": e.air_time_s,
+        "quality_share_within_band": _finite(e.quality_share),
         "tier": e.tier,
         "violation": e.violation,
         "reason": e.reason,

@@ -3,6 +3,7 @@ of the cell; an infeasible candidate says how far it is from feasible, growing t
 farther it is; the tool's stand moves with the tool; the cell travels whole."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -11,7 +12,7 @@ from offline_prog.config.cell import load_cell, transform
 from offline_prog.joints.path_ik import reach_excess
 from offline_prog.placement.context import context, placed_cell
 from offline_prog.placement.evaluate import evaluate
-from offline_prog.placement.objective import CANNOT_FOLLOW, FEASIBLE
+from offline_prog.placement.objective import CANNOT_FOLLOW, COLLIDES, FEASIBLE, Evaluation
 from offline_prog.placement.payload import cell_payload, unpack
 from offline_prog.placement.screen import screen
 from offline_prog.placement.space import Candidate, check_place
@@ -42,7 +43,26 @@ def test_the_cell_as_given_evaluates_to_its_plan(seal, planned_job):
     assert e.joint_limit_margin_deg == pytest.approx(np.rad2deg(plan.joints.margin_rad.min()))
     assert e.clearance_mm == pytest.approx(job.collisions.min_distance_m * 1e3)
     assert e.process_bound_s == pytest.approx(plan.nominal_duration_s)
+    assert e.quality_share == pytest.approx(job.quality.job.share_within_band, abs=1e-12)
     assert screen(seal, Candidate((), -1, X_IT, X_PE)).tier == FEASIBLE
+
+
+def test_with_a_process_model_the_share_within_the_band_comes_before_cycle_time():
+    """A feasible candidate with more of its bead within the band ranks first, however
+    much faster the other is; without a model (NaN) the cycle time decides; feasibility
+    still comes before the quality."""
+    base = Evaluation(
+        Candidate((), -1, ((0, 0, 0), (0, 0, 0)), ((0, 0, 0), (0, 0, 0))), "plan", FEASIBLE, 0.0, ""
+    )
+    better = dataclasses.replace(base, quality_share=0.98, cycle_time_s=40.0)
+    faster = dataclasses.replace(base, quality_share=0.90, cycle_time_s=20.0)
+    assert min([faster, better], key=Evaluation.key) is better
+    no_model = [dataclasses.replace(x, quality_share=math.nan) for x in (better, faster)]
+    assert min(no_model, key=Evaluation.key).cycle_time_s == 20.0
+    tie = dataclasses.replace(faster, quality_share=0.98 + 1e-5)  # within the resolution
+    assert min([better, tie], key=Evaluation.key) is tie
+    colliding = dataclasses.replace(better, tier=COLLIDES, violation=1e-3, quality_share=1.0)
+    assert min([colliding, faster], key=Evaluation.key) is faster
 
 
 def test_out_of_reach_grows_with_the_distance(seal):
