@@ -72,6 +72,9 @@ class JointTrajectory:
         largest_step: (joint index, σ, step [rad]) between neighbouring samples.
         singularities: per kind, (min distance, σ at it) and the near stretches.
         retiming: the speed reductions the joints needed.
+        unbounded_s: the duration of the same path timed under the user's own caps
+            [s], when a process model lowered them (``process.timing_bound``; None:
+            it did not).
     """
 
     trajectory: WorkspaceTrajectory
@@ -84,6 +87,7 @@ class JointTrajectory:
     largest_step: tuple[int, float, float]
     singularities: dict
     retiming: PathTiming
+    unbounded_s: float | None = None
 
 
 class BranchPath:
@@ -201,6 +205,7 @@ def plan_joint_trajectory(
     branch: int | None = None,
     time_law: TimeLaw = TimeLaw.SIN2,
     process: ProcessIntent = ProcessIntent.CONSTANT_SPEED,
+    unbounded: Sin2TimeLaw | None = None,
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -215,6 +220,9 @@ def plan_joint_trajectory(
         time_law: TimeLaw.TIME_OPTIMAL (TOPP-RA, then the jerk stage) or TimeLaw.SIN2
             (the paper's law, plateaus lowered where the joints need it).
         process: the time-optimal intent (ProcessIntent).
+        unbounded: the process law under the user's caps where a process model lowered
+            ``nominal``'s (``process.timing_bound``): the same path is timed under it
+            too, for the trade-off in cycle time (``JointTrajectory.unbounded_s``).
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
@@ -247,6 +255,10 @@ def plan_joint_trajectory(
             f"joint {kinds} limit on axis {joint + 1} ({use:.2f}× the limit) even at reduced speed",
             Failure.JOINT_RATE_LIMIT,
         )
+    unbounded_s = None
+    if unbounded is not None:
+        other = time_path(controller, PathLimits.of(robot, unbounded), time_law, process)
+        unbounded_s = float(other.law.duration) if other.feasible else None
     trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
     sigma, sd, sdd, _ = retiming.law(trajectory.t)
     q_near = np.column_stack([np.interp(sigma, grid, chosen.q[:, j]) for j in range(6)])
@@ -300,4 +312,5 @@ def plan_joint_trajectory(
         (int(j), float(sigma[i + 1]), float(steps[i, j])),
         singular,
         retiming,
+        unbounded_s,
     )
