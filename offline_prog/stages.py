@@ -239,15 +239,6 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
     nominal = sin2_time_law(
         parameter.length, v_max=motion.speed, a_max=caps.a_max, j_max=caps.j_max
     )
-    # Under the user's caps too, when the process lowered them: the trade-off's figure.
-    unbounded = None
-    if caps.bounded:
-        unbounded = sin2_time_law(
-            parameter.length,
-            v_max=motion.speed,
-            a_max=motion.max_acceleration,
-            j_max=motion.max_jerk,
-        )
     samples = nominal.duration * max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ)
     if samples > MAX_SAMPLES:  # memory: every sample holds poses, joints, distances
         raise InputError(
@@ -267,7 +258,7 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         branch=branch,
         time_law=motion.time_law,
         process=motion.process,
-        unbounded=unbounded,
+        process_caps=caps,
     )
     return Attempt(rotation, flange, nominal, joints, None)
 
