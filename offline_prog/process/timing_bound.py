@@ -80,7 +80,7 @@ def bead_jerk_cap(model: BeadModel, v_process: float) -> float:
     """J_bead = 2·t·v_p/τ² [m/s³]: the path jerk at which the lead-compensated
     dispenser keeps the bead within its tolerance t at the speed v_p [m/s] (module
     docstring); inf without a lag."""
-    if model.lag_s <= 0.0:
+    if model.lag_s**2 <= 0.0:  # no lag (or one so small its square underflows)
         return math.inf
     return 2.0 * model.tolerance * v_process / model.lag_s**2
 
