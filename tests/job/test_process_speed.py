@@ -2,6 +2,7 @@
 input (issue 28): one line naming the speed's key, why, with the figures; exit 2 and
 nothing written. The demo sealing job with a bead model whose flow keys the bead sets."""
 
+import numpy as np
 import pytest
 
 from offline_prog.cli import main
@@ -108,3 +109,30 @@ def test_speed_outside_the_band_is_one_line_exit_2(tmp_path, capsys, text, key, 
     assert len(lines) == 1 and "Traceback" not in stderr
     assert f": {key}: " in lines[0] and reason in lines[0], lines[0]
     assert not out.exists()
+
+
+def test_weld_ramps_below_the_band_are_named(tmp_path):
+    """A weld at 6 mm/s (band 4.94–6.91 mm/s): the time law cannot hold a minimum speed
+    on the ramps from and to rest; report.json's quality.timing_bound names both
+    stretches, where they are and why, and no bound was applied (no output dynamics)."""
+    from offline_prog.plan import plan_job
+    from offline_prog.results.timing_bound import timing_bound_report
+
+    cell = tmp_path / "weld.yaml"
+    cell.write_text(PATH.replace("SPEED", "0.006") + WELD)
+    job = plan_job(cell)
+    report = timing_bound_report(job)
+    assert not report["applied"] and report["difference_s"] == 0.0
+    low, high = report["speed_band_m_s"]
+    assert abs(low - 3456 / 0.7e6) < 1e-12 and abs(high - 3456 / 0.5e6) < 1e-12
+    stretches = report["below_speed_band"]
+    assert [s["cause"] for s in stretches] == ["start ramp", "stop ramp"]
+    start, stop = stretches
+    process = next(g for g in job.samples.segments if g.kind == "process")
+    assert start["sigma_start_m"] == 0.0 and abs(start["t_start_s"] - process.t_start) < 1e-9
+    assert abs(stop["sigma_end_m"] - 0.2) < 1e-6 and start["speed_min_m_s"] < low
+    for s in stretches:  # the speed is below the band inside each stretch, above outside
+        rows = (job.samples.t >= s["t_start_s"]) & (job.samples.t <= s["t_end_s"])
+        assert np.all(job.tcp_speed[rows] < low)
+    middle = (job.samples.t > start["t_end_s"]) & (job.samples.t < stop["t_start_s"])
+    assert np.all(job.tcp_speed[middle] >= low)
