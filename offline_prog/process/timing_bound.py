@@ -42,7 +42,9 @@ there: approach, retract and links keep the user's caps) where it is below
 speed falls below v_p (the start and stop ramps, a joint slowdown) the same jerk gives
 a larger relative error (∝ 1/v): at the ramps from rest no jerk holds the bead
 (δA/A* → τ²/t'² a time t' after the start, whatever J), which the quality report
-names as the start ramp.
+names as the start ramp. With ``motion.speed_reference: flange`` the time law's
+parameter is the flange's path, so the cap bounds the flange's jerk, not the TCP's:
+the bound is then approximate where the two speeds differ (the path turns).
 """
 
 from __future__ import annotations
