@@ -8,6 +8,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.process.model import process_model
@@ -97,3 +99,74 @@ def test_the_bound_acts_on_the_process_stretch_alone(plans):
         t = np.linspace(0.0, law.duration, 20001)
         jerk = law(t)[3]
         assert np.abs(jerk).max() <= caps.j_max * (1 + 1e-6), option.name
+
+
+LINE = """\
+name: line
+robot:
+  model: kuka_kr16_2
+  X_IB: {translation: [0, 0, 0], rotation: !Rpy {deg: [0, 0, 0]}}
+tool:
+  X_IT: {translation: [1.0, 0, 0.5], rotation: !Rpy {deg: [90, 0, 0]}}
+  process_io:
+    flow: {analog_output: 1, min: 0.0, max: 10.0}
+part:
+  X_PE: {translation: [0, 0, 0.1], rotation: !Rpy {deg: [180, 0, 0]}}
+path:
+  analytic: {kind: arc, center: [0, 0, 0], radius: 60, start_deg: 0, end_deg: 180}
+  units: mm
+  normal: [0, 0, 1]
+motion:
+  speed: SPEED
+  max_acceleration: A_MAX
+  max_jerk: J_MAX
+process:
+  model: bead
+  bead: {area_mm2: 12.0, tolerance_pct: TOLERANCE, flow_mm3_s_per_unit: 250.0, lag_s: LAG}
+"""
+
+
+@settings(max_examples=6, deadline=None, derandomize=True)
+@example(speed=0.1, a_max=2.0, j_max=20.0, tolerance=5, lag=0.1)  # bounded: 1 m/s³
+@example(speed=0.05, a_max=0.5, j_max=2.0, tolerance=10, lag=0.03)  # cap 11 m/s³ > 2
+@given(
+    speed=st.sampled_from([0.05, 0.1, 0.2]),
+    a_max=st.sampled_from([0.5, 2.0]),
+    j_max=st.sampled_from([2.0, 20.0]),
+    tolerance=st.sampled_from([2, 5, 10]),
+    lag=st.sampled_from([0.0, 0.03, 0.1, 0.3]),
+)
+def test_the_bound_only_lowers_the_caps_of_the_process_stretch(
+    tmp_path_factory, speed, a_max, j_max, tolerance, lag
+):
+    """Seeded cells: planned with and without the bound, the process stretch runs
+    within min(user's, 2·tol·v/τ²) and is never faster for it; approach and retract
+    take as long either way."""
+    folder = tmp_path_factory.mktemp("line")
+    cell = folder / "line.yaml"
+    text = LINE
+    for key, value in dict(
+        SPEED=speed, A_MAX=a_max, J_MAX=j_max, TOLERANCE=tolerance, LAG=lag
+    ).items():
+        text = text.replace(key, str(value))
+    cell.write_text(text)
+    inputs = load_inputs(cell, ROBOTS_DIR)
+    jobs = [
+        plan_loaded_job(
+            dataclasses.replace(inputs, process_bound=bound),
+            StageTimer(lambda stage: None),
+            clearance_profile=False,
+        )
+        for bound in (True, False)
+    ]
+    cap = min(j_max, 2 * tolerance / 100 * speed / lag**2 if lag else np.inf)
+    bounded, free = (job.chosen[0].plan.joints for job in jobs)
+    assert np.isclose(bounded.process_caps.j_max, cap, rtol=1e-12, atol=0.0)
+    assert bounded.process_caps.a_max == a_max
+    assert free.process_caps.j_max == j_max and not free.process_caps.bounded
+    law = bounded.retiming.law
+    assert np.abs(law(np.linspace(0.0, law.duration, 5001))[3]).max() <= cap * (1 + 1e-6)
+    assert law.duration >= free.retiming.law.duration - TIME_TOL_S
+    for a, b in zip(jobs[0].samples.segments, jobs[1].samples.segments, strict=True):
+        if a.kind != "process":
+            assert abs((a.t_stop - a.t_start) - (b.t_stop - b.t_start)) < TIME_TOL_S, a.label
