@@ -80,29 +80,32 @@ def timing_bound_report(job: JobPlan) -> dict | None:
 
 def _below_band(job: JobPlan, low: float) -> list[dict]:
     """The process stretches slower than ``low`` [m/s], each with its cause: the start
-    or stop ramp (from or to rest), else a slowdown the joints force (a minimum speed
-    cannot beat a joint limit)."""
+    or stop ramp (from or to rest), else a slowdown the joints force, with the joint
+    and limit where the time law names them (a minimum speed cannot beat a joint
+    limit)."""
     if low <= 0.0:
         return []
     out = []
     samples, speed = job.samples, job.tcp_speed
+    by_seam = {option.name: option.plan.joints.retiming.slowdowns for option in job.chosen}
     for segment in samples.segments:
         if segment.kind != "process":
             continue
         rows = np.arange(segment.start, segment.stop)
         for a, b in true_runs(speed[rows] < low):
+            stretch = rows[a:b]
+            sigma = (float(samples.path_m[stretch[0]]), float(samples.path_m[stretch[-1]]))
             if a == 0:
                 cause = "start ramp"
             elif b == len(rows):
                 cause = "stop ramp"
             else:
-                cause = "slowdown: a joint limit the time law cannot beat"
-            stretch = rows[a:b]
+                cause = _slowdown_cause(by_seam[segment.seam], sigma)
             out.append(
                 {
                     "seam": segment.seam,
-                    "sigma_start_m": float(samples.path_m[stretch[0]]),
-                    "sigma_end_m": float(samples.path_m[stretch[-1]]),
+                    "sigma_start_m": sigma[0],
+                    "sigma_end_m": sigma[1],
                     "t_start_s": float(samples.t[stretch[0]]),
                     "t_end_s": float(samples.t[stretch[-1]]),
                     "speed_min_m_s": float(speed[stretch].min()),
@@ -110,3 +113,15 @@ def _below_band(job: JobPlan, low: float) -> list[dict]:
                 }
             )
     return out
+
+
+def _slowdown_cause(slowdowns, sigma: tuple[float, float]) -> str:
+    """The joint limit behind a slowdown over ``sigma`` [m] (the time law's
+    ``slowdowns``, time_optimal), or a plain "slowdown" (sin2 does not say)."""
+    for slow in slowdowns:
+        if slow.joint is not None and slow.sigma_m[0] <= sigma[1] and sigma[0] <= slow.sigma_m[1]:
+            return (
+                f"slowdown: joint {slow.joint} {slow.constraint} limit (a minimum speed "
+                "cannot beat it)"
+            )
+    return "slowdown: a joint limit (a minimum speed cannot beat it)"
