@@ -136,3 +136,29 @@ def test_weld_ramps_below_the_band_are_named(tmp_path):
         assert np.all(job.tcp_speed[rows] < low)
     middle = (job.samples.t > start["t_end_s"]) & (job.samples.t < stop["t_start_s"])
     assert np.all(job.tcp_speed[middle] >= low)
+
+
+def test_joint_slowdowns_below_the_band_are_named_with_their_joint(tmp_path):
+    """The plate demo with its nozzle's turn fixed (the wrist's jerk slows the corners
+    to about 52 mm/s) and a heat input whose band needs 90–120 mm/s: the corners are
+    below the band, and the report names each with the joint and limit behind it."""
+    import re
+
+    from offline_prog.plan import plan_job
+    from offline_prog.results.timing_bound import timing_bound_report
+
+    text = re.sub(r"\n  turn_smoothing_mm: .*", "", (CELLS / "seal_plate_kr16.yaml").read_text())
+    cell = tmp_path / "weld_fast.yaml"
+    cell.write_text(text + WELD.replace("[0.5, 0.7]", "[0.0288, 0.0384]"))
+    job = plan_job(cell)
+    report = timing_bound_report(job)
+    slowdowns = [s for s in job.chosen[0].plan.joints.retiming.slowdowns if s.joint is not None]
+    corners = [s for s in report["below_speed_band"] if s["cause"].startswith("slowdown")]
+    assert len(corners) == len(slowdowns) == 4
+    for corner, slow in zip(corners, slowdowns, strict=True):
+        assert corner["cause"].startswith(f"slowdown: joint {slow.joint} {slow.constraint}")
+        assert slow.sigma_m[0] <= corner["sigma_start_m"] <= corner["sigma_end_m"]
+        assert corner["sigma_end_m"] <= slow.sigma_m[1]
+        assert abs(corner["speed_min_m_s"] - slow.speed_min_m_s) < 1e-6
+    low = report["speed_band_m_s"][0]
+    assert all(s["speed_min_m_s"] < low for s in report["below_speed_band"])
