@@ -33,6 +33,7 @@ TIME_TOL_S = 1e-9
 def plans(tmp_path_factory):
     folder = tmp_path_factory.mktemp("bead")
     cell = folder / "seal_bead.yaml"
+    assert FLOW in JOB and "\nprocess:" not in JOB  # the demo as this test knows it
     cell.write_text(JOB.replace(FLOW, "flow: {analog_output: 1, min: 0.0, max: 10.0}") + BEAD)
     inputs = load_inputs(cell, ROBOTS_DIR)
     return {
