@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from bead_job import bead_job
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -20,11 +21,6 @@ from offline_prog.stages import load_inputs
 from conftest import CELLS
 
 JOB = (CELLS / "seal_job_kr16.yaml").read_text()
-FLOW = "flow: {analog_output: 1, per_mps: 40.0, offset: 0.5, min: 0.0, max: 10.0}"
-BEAD = (
-    "process:\n  model: bead\n  bead: {area_mm2: 12.0, tolerance_pct: 5, "
-    "flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
-)
 CRUISE_SHARE = 0.5  # the bead is judged where the tool runs at least half the seam's speed
 TIME_TOL_S = 1e-9
 
@@ -33,8 +29,7 @@ TIME_TOL_S = 1e-9
 def plans(tmp_path_factory):
     folder = tmp_path_factory.mktemp("bead")
     cell = folder / "seal_bead.yaml"
-    assert FLOW in JOB and "\nprocess:" not in JOB  # the demo as this test knows it
-    cell.write_text(JOB.replace(FLOW, "flow: {analog_output: 1, min: 0.0, max: 10.0}") + BEAD)
+    cell.write_text(bead_job())
     inputs = load_inputs(cell, ROBOTS_DIR)
     return {
         bound: plan_loaded_job(

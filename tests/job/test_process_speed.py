@@ -4,18 +4,14 @@ nothing written. The demo sealing job with a bead model whose flow keys the bead
 
 import numpy as np
 import pytest
+from bead_job import bead_job
 
 from offline_prog.cli import main
 
 from conftest import CELLS
 
 JOB = (CELLS / "seal_job_kr16.yaml").read_text()
-FLOW = "flow: {analog_output: 1, per_mps: 40.0, offset: 0.5, min: 0.0, max: 10.0}"
-BEAD = (
-    "process:\n  model: bead\n  bead: {area_mm2: 12.0, tolerance_pct: 5, "
-    "flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
-)
-BEAD_JOB = JOB.replace(FLOW, "flow: {analog_output: 1, min: 0.0, max: 10.0}") + BEAD
+BEAD_JOB = bead_job()
 PATH = """\
 name: one_seam
 robot:
