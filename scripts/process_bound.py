@@ -14,6 +14,7 @@ then the cycle times of both plans and report.json's ``quality.timing_bound`` fi
 from __future__ import annotations
 
 import dataclasses
+import re
 import sys
 import tempfile
 from pathlib import Path
@@ -27,7 +28,6 @@ from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
 
 REPO = Path(__file__).resolve().parents[1]
-FLOW = "flow: {analog_output: 1, per_mps: 40.0, offset: 0.5, min: 0.0, max: 10.0}"
 BEAD = (
     "process:\n  model: bead\n  bead: {area_mm2: 12.0, tolerance_pct: 5, "
     "flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
@@ -36,9 +36,14 @@ CRUISE_SHARE = 0.5
 
 
 def demo_cell(folder: Path) -> Path:
+    """The sealing job with BEAD (replacing a model it may have), its flow output
+    reduced to its number and limits (the bead sets the rest)."""
     text = (REPO / "cells" / "seal_job_kr16.yaml").read_text()
+    text = re.sub(r"(?ms)^process:.*?(?=^\S|\Z)", "", text)
+    flow = "    flow: {analog_output: 1, min: 0.0, max: 10.0}"
+    text = re.sub(r"(?m)^    flow: \{.*\}$", flow, text)
     cell = folder / "seal_job_kr16_bead.yaml"
-    cell.write_text(text.replace(FLOW, "flow: {analog_output: 1, min: 0.0, max: 10.0}") + BEAD)
+    cell.write_text(text + BEAD)
     return cell
 
 
