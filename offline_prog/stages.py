@@ -218,7 +218,10 @@ def first_joints(inputs: Inputs, flanges: FlangePaths) -> Attempt:
 
 def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = None) -> Attempt:
     """Time law (§4), path IK on a branch and joint retiming for one flange path; the
-    attempt's collision check is not run yet (``collisions`` None).
+    attempt's collision check is not run yet (``collisions`` None). The law runs under
+    the path caps of ``motion:``, lowered where the process model needs it
+    (``process.timing_bound.process_caps``: a bead's dispenser lag caps the jerk)
+    unless ``inputs.process_bound`` is False.
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
