@@ -31,6 +31,8 @@ from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, n
 from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn
+from offline_prog.process.model import process_model
+from offline_prog.process.timing_bound import process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
@@ -57,6 +59,9 @@ class Inputs:
     X_IB: RigidTransform  # robot base B in I
     X_IT: RigidTransform  # fixed tool T in I
     X_PE: RigidTransform  # flange E in the part P
+    # The process model's caps on the process stretch's time law (process.timing_bound);
+    # False plans under the user's caps alone (the trade-off's comparison).
+    process_bound: bool = True
 
 
 @dataclasses.dataclass
@@ -213,7 +218,10 @@ def first_joints(inputs: Inputs, flanges: FlangePaths) -> Attempt:
 
 def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = None) -> Attempt:
     """Time law (§4), path IK on a branch and joint retiming for one flange path; the
-    attempt's collision check is not run yet (``collisions`` None).
+    attempt's collision check is not run yet (``collisions`` None). The law runs under
+    the path caps of ``motion:``, lowered where the process model needs it
+    (``process.timing_bound.process_caps``: a bead's dispenser lag caps the jerk)
+    unless ``inputs.process_bound`` is False.
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
@@ -225,8 +233,14 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         except ValueError as error:
             raise InputError(inputs.file, "motion.cusp_smoothing_mm", str(error)) from None
     parameter = TimeLawParameter(flange, motion.speed_reference)
+    caps = process_caps(
+        process_model(inputs.cell.process) if inputs.process_bound else None,
+        v_process=motion.speed,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
+    )
     nominal = sin2_time_law(
-        parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+        parameter.length, v_max=motion.speed, a_max=caps.a_max, j_max=caps.j_max
     )
     samples = nominal.duration * max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ)
     if samples > MAX_SAMPLES:  # memory: every sample holds poses, joints, distances
@@ -247,6 +261,7 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         branch=branch,
         time_law=motion.time_law,
         process=motion.process,
+        process_caps=caps,
     )
     return Attempt(rotation, flange, nominal, joints, None)
 

@@ -144,7 +144,9 @@ def test_tcp_speed_is_the_commanded_speed(planned):
     v_tcp = np.linalg.norm(v + np.cross(w, p_IT - p_IE), axis=1)
     np.testing.assert_allclose(v_tcp, table[:, col["tcp_speed"]], atol=1e-8)
     speed = report["motion"]["top_speed_m_s"]
-    assert v_tcp.max() <= speed * (1 + 1e-8)
+    # Recomputed from the CSV's rounded columns: within their 1e-8 m/s of tcp_speed
+    # (above), which a law holding the speed exactly (sin²'s plateau) may reach.
+    assert v_tcp.max() <= speed * (1 + 1e-8) + 1e-8
     assert table[:, col["tcp_speed"]].max() <= speed * (1 + 1e-9)
     # σ from positions alone (chord per time step) matches the TCP speed within 0.05 %.
     sigma_dot = np.diff(table[:, col["sigma"]]) / np.diff(table[:, col["t"]])

@@ -20,6 +20,7 @@ from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.order import JobOrder, order_job
 from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
+from offline_prog.job.process_speed import check_speed_bands
 from offline_prog.job.records import SeamOption
 from offline_prog.job.seams import (
     errors_named_for,
@@ -44,9 +45,11 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
     ``plan_seam(k, reverse, seam_inputs, scene)`` plans seam k in one direction.
 
     Raises:
-        InputError: naming ``seams[k].<key>``.
+        InputError: naming ``seams[k].<key>`` (a process speed outside the process
+            model's speed band: ``job.process_speed``).
         PlanFailedError: a seam cannot be done in any direction (its reason, named).
     """
+    check_speed_bands(inputs)
     options, seams = [], job_seams(inputs.cell)
     for k, seam in enumerate(seams):
         directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]

@@ -27,6 +27,7 @@ from offline_prog.joints.path_ik import (
     singularity_distances,
 )
 from offline_prog.joints.path_timing import PathLimits, PathTiming, time_path
+from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.robot.jacobian import joint_path_rates, urdf_chain
 from offline_prog.robot.kinematics_opw import wrap_to_pi
 from offline_prog.robot.model import RobotModel
@@ -72,6 +73,10 @@ class JointTrajectory:
         largest_step: (joint index, σ, step [rad]) between neighbouring samples.
         singularities: per kind, (min distance, σ at it) and the near stretches.
         retiming: the speed reductions the joints needed.
+        process_caps: the path caps the process model set (``process.timing_bound``;
+            None: the user's alone).
+        unbounded_s: the duration of the same path timed under the user's own caps
+            [s], when the process model lowered them (None: it did not).
     """
 
     trajectory: WorkspaceTrajectory
@@ -84,6 +89,8 @@ class JointTrajectory:
     largest_step: tuple[int, float, float]
     singularities: dict
     retiming: PathTiming
+    process_caps: ProcessCaps | None = None
+    unbounded_s: float | None = None
 
 
 class BranchPath:
@@ -201,6 +208,7 @@ def plan_joint_trajectory(
     branch: int | None = None,
     time_law: TimeLaw = TimeLaw.SIN2,
     process: ProcessIntent = ProcessIntent.CONSTANT_SPEED,
+    process_caps: ProcessCaps | None = None,
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -215,6 +223,9 @@ def plan_joint_trajectory(
         time_law: TimeLaw.TIME_OPTIMAL (TOPP-RA, then the jerk stage) or TimeLaw.SIN2
             (the paper's law, plateaus lowered where the joints need it).
         process: the time-optimal intent (ProcessIntent).
+        process_caps: the caps ``nominal`` runs under (``process.timing_bound``); where
+            they are below the user's, the same path is timed under the user's caps
+            too, for the trade-off in cycle time (``JointTrajectory.unbounded_s``).
     """
     length = parameter.length
     grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
@@ -247,6 +258,15 @@ def plan_joint_trajectory(
             f"joint {kinds} limit on axis {joint + 1} ({use:.2f}× the limit) even at reduced speed",
             Failure.JOINT_RATE_LIMIT,
         )
+    unbounded_s = None
+    if process_caps is not None and process_caps.bounded:
+        unbounded = dataclasses.replace(
+            PathLimits.of(robot, nominal),
+            a_max=process_caps.user_a_max,
+            j_max=process_caps.user_j_max,
+        )
+        other = time_path(controller, unbounded, time_law, process)
+        unbounded_s = float(other.law.duration) if other.feasible else None
     trajectory = sample_workspace_trajectory(flange, parameter, retiming.law, rate_hz=rate_hz)
     sigma, sd, sdd, _ = retiming.law(trajectory.t)
     q_near = np.column_stack([np.interp(sigma, grid, chosen.q[:, j]) for j in range(6)])
@@ -300,4 +320,6 @@ def plan_joint_trajectory(
         (int(j), float(sigma[i + 1]), float(steps[i, j])),
         singular,
         retiming,
+        process_caps,
+        unbounded_s,
     )

@@ -34,6 +34,7 @@ from offline_prog.results.plan_folder import (
     time_law_name,
 )
 from offline_prog.results.report import collision_summary, payload_summary, report
+from offline_prog.results.timing_bound import timing_bound_report
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
 from offline_prog.viz.job_report_html import write_job_report_html
@@ -215,6 +216,9 @@ def job_report(job: JobPlan) -> dict:
         **collision_summary(job),
         "timings_s": job.timings_s,
     }
+    bound = timing_bound_report(job)
+    if bound is not None:  # beside the predicted quality (issue 28)
+        summary.setdefault("quality", {})["timing_bound"] = bound
     if not job.cell.seams:  # path: (one seam): its one-seam keys stay where they were
         for key, value in summary["seams"][0].items():
             if key != "seam":

@@ -329,6 +329,18 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
     assert not without_joint_limits(short, "sin2")[1]
     plan, folder = planned_folder("seal_plate_kr16")
     assert plan.cell.motion.time_law == "time_optimal"  # the default
-    assert plan.nominal_duration_s <= plan.trajectory.duration <= 1.001 * plan.nominal_duration_s
+    duration, fastest = plan.trajectory.duration, plan.nominal_duration_s
+    if plan.joints.unbounded_s is not None:  # a process model's bound (issue 28): the
+        # sin² staircase holds the bead better than the fastest ramps; the law under the
+        # user's own caps is the one that reaches the fastest motion
+        motion = plan.cell.motion
+        user = sin2_time_law(
+            plan.path.length,
+            v_max=motion.speed,
+            a_max=motion.max_acceleration,
+            j_max=motion.max_jerk,
+        )
+        duration, fastest = plan.joints.unbounded_s, without_joint_limits(user, "time_optimal")[0]
+    assert fastest <= duration <= 1.001 * fastest
     # The seal demo reaches its speed: report.json does not call its path short.
     assert json.loads((folder / "report.json").read_text())["motion"]["top_speed_reduced"] is False
