@@ -87,12 +87,14 @@ class QualitySummary:
 @dataclasses.dataclass(frozen=True)
 class ProcessQuality:
     """The quality along a job: ``values`` (N,) SI, NaN off the dispensing rows and at a
-    standstill; the summary of the job and of each seam (by name, in run order)."""
+    standstill; the summary of the job and of each seam (by name, in run order); for
+    the bead ``uncompensated`` (N,) the same with compensation off (else None)."""
 
     model: BeadModel | HeatInputModel | TapeHeatingModel
     values: np.ndarray
     job: QualitySummary
     seams: dict[str, QualitySummary]
+    uncompensated: np.ndarray | None = None
 
     @property
     def column(self) -> np.ndarray:
@@ -178,12 +180,13 @@ def process_quality(
     weights = _row_weights(np.nan_to_num(np.asarray(path_m, float)), seam_of)
     low, high = model.band
     inside = dispensing & (values >= low) & (values <= high)
-    uncompensated = None
+    uncompensated, off_shown = None, None
     if isinstance(model, BeadModel):
         u_off = _uncompensated_command(t, v, settings, events)
         off_values, off_dispensing = _values(model, t, v, u_off, gate & (seam_of >= 0), settings)
         off_inside = off_dispensing & (off_values >= low) & (off_values <= high)
         uncompensated = (off_inside, off_dispensing)
+        off_shown = np.where(off_dispensing & np.isfinite(off_values), off_values, np.nan)
     causes = _cause_rows(model, v, seam_of, len(names), settings)
     stretches = _stretches(
         values, dispensing & ~inside, model.band, seam_of, names, t, path_m, causes
@@ -196,7 +199,7 @@ def process_quality(
         return dataclasses.replace(s, stretches=listed)
 
     seams = {name: summary(seam_of == k, name) for k, name in enumerate(names)}
-    return ProcessQuality(model, shown, summary(seam_of >= 0), seams)
+    return ProcessQuality(model, shown, summary(seam_of >= 0), seams, off_shown)
 
 
 def _values(model, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]:

@@ -178,6 +178,13 @@ def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
     for seam in report["seams"].values():
         assert seam["share_within_band"] >= seam["share_within_band_uncompensated"]
     assert report["share_within_band"] > 0.95
+    # Everywhere: no row is outside the band with compensation where it is inside
+    # without (the lead never spoils a good bead), and compensation wins somewhere.
+    quality, (low, high) = job.quality, job.quality.model.band
+    inside_on = (quality.values >= low) & (quality.values <= high)
+    inside_off = (quality.uncompensated >= low) & (quality.uncompensated <= high)
+    assert not np.any(inside_off & ~inside_on)
+    assert np.count_nonzero(inside_on & ~inside_off) > 0
 
 
 def law_replay(job, *, per_mps: float, lead_s: float, offset: float, low: float, high: float):
