@@ -13,6 +13,7 @@ path, expressed in I, so that w_IE_I = w_s · ṡ.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 
 import numpy as np
@@ -55,6 +56,40 @@ class FlangeSamples:
     dw_s: np.ndarray
 
 
+PART_SAMPLES_KEPT = 16  # (path, normal, s) evaluations kept by part_samples,
+PART_SAMPLES_MOST = 5000  # of at most this many samples each (≤ 1.5 MB)
+_part_samples: collections.OrderedDict = collections.OrderedDict()
+
+
+def part_samples(path: ArcLengthPath, normal: NormalField, s: np.ndarray) -> tuple:
+    """(p_PF, dp_PF, ddp_PF, R_PF, dR_PF, ddR_PF) at s (N,): the path point (N, 3) and
+    process frame (N, 3, 3) in P with their first two s-derivatives, read-only.
+
+    They depend on neither X_IT nor X_PE (nor the tool turn): the tool rotations tried
+    for one seam, placement candidates and session edits evaluate the same path at the
+    same σ grid again and again, so the last PART_SAMPLES_KEPT evaluations (of grids up
+    to PART_SAMPLES_MOST) are kept: the same path and normal objects, the same s bit
+    for bit, the same arrays (read-only, so no caller changes what another gets).
+
+    Raises:
+        NormalTangentError: from :func:`process_frames`.
+    """
+    if len(s) > PART_SAMPLES_MOST:
+        return (*path(s, order=2), *process_frames(path, normal, s))
+    key = (id(path), id(normal), s.tobytes())
+    kept = _part_samples.get(key)
+    if kept is not None and kept[0] is path and kept[1] is normal:
+        _part_samples.move_to_end(key)
+        return kept[2]
+    values = (*path(s, order=2), *process_frames(path, normal, s))
+    for value in values:
+        value.setflags(write=False)
+    _part_samples[key] = (path, normal, values)  # holds path and normal: ids stay theirs
+    while len(_part_samples) > PART_SAMPLES_KEPT:
+        _part_samples.popitem(last=False)
+    return values
+
+
 class FlangePath:
     """X_IE(s) for a part carried past the fixed tool.
 
@@ -92,8 +127,7 @@ class FlangePath:
 
     def __call__(self, s: np.ndarray) -> FlangeSamples:
         s = np.asarray(s, dtype=float)
-        p_PF, dp_PF, ddp_PF = self.path(s, order=2)
-        R_PF, dR_PF, ddR_PF = process_frames(self.path, self.normal, s)
+        p_PF, dp_PF, ddp_PF, R_PF, dR_PF, ddR_PF = part_samples(self.path, self.normal, s)
         R_IT = self.X_IT.rotation().matrix()
         p_IT = self.X_IT.translation()
         R_PE = self.X_PE.rotation().matrix()

@@ -76,6 +76,7 @@ class DrakeCell:
     # Robot link pairs not checked for self-collision (robots/<robot>/self_collision.yaml:
     # every class but "check"), or None when the robot has no matrix (all pairs checked).
     skipped_self_pairs: list | None = None
+    _motion_radii: np.ndarray | None = dataclasses.field(default=None, repr=False, compare=False)
 
     @property
     def frame_E(self):
@@ -90,7 +91,13 @@ class DrakeCell:
     def motion_radii(self) -> np.ndarray:
         """(6,) ρ_k [m]: no collision geometry outboard of joint k (the part included) is
         farther than ρ_k from the joint's origin, at any joint position (serial chain:
-        ρ_k = max(reach of link k's geometry, |p_LkJk+1| + ρ_k+1), frames fixed in link k)."""
+        ρ_k = max(reach of link k's geometry, |p_LkJk+1| + ρ_k+1), frames fixed in link k).
+        Computed once per cell (the model is built and does not change)."""
+        if self._motion_radii is None:
+            self._motion_radii = self._reach()
+        return self._motion_radii.copy()
+
+    def _reach(self) -> np.ndarray:
         plant, context = self.plant, self.plant.CreateDefaultContext()
         inspector = self.diagram.scene_graph().model_inspector()
         joints = [plant.get_joint(j) for j in plant.GetJointIndices(self.robot)]

@@ -85,9 +85,11 @@ def exact_shape_of_drake(shape: Shape) -> ExactShape:
 
 def bounding_radius(shape: Shape) -> float:
     """Radius [m] of a sphere about the shape frame's origin that holds the Drake shape."""
-    exact = exact_shape_of_drake(shape) if isinstance(shape, Convex | Mesh) else None
-    if exact is not None:
-        return float(np.linalg.norm(exact.mesh.vertices, axis=1).max())
+    if isinstance(shape, Convex | Mesh):  # the farthest point of a hull is one of its
+        # vertices: Drake's hull points give it without building the mesh (nor trimesh)
+        hull = shape.GetConvexHull()
+        points = np.array([hull.vertex(i) for i in range(hull.num_vertices())])
+        return float(np.linalg.norm(points, axis=1).max())
     if isinstance(shape, Box):
         return float(np.linalg.norm([shape.width(), shape.depth(), shape.height()]) / 2)
     if isinstance(shape, Sphere):
