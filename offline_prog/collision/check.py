@@ -37,7 +37,7 @@ from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     write_collisions_json,
 )
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.scene.exact_distance import exact_distance, exact_shape, exact_shape_of_drake
+from offline_prog.scene.exact_distance import exact_distance, exact_shape
 from offline_prog.scene.filters import allow_fixed_layout
 
 # A pair certified above clearance + this is not evaluated (its minimum is then over
@@ -115,13 +115,12 @@ class _Pairs:
     def _components(self, name: str):
         """[(ExactShape, a GeometryId giving its pose X_IG)] of a shape name."""
         if name not in self._exact:
-            inspector = self.cell.diagram.scene_graph().model_inspector()
             ids = [g for g, label in self.cell.labels.items() if label.name == name]
             shape = self.cell.labels[ids[0]].shape
             self._exact[name] = (
                 [(exact_shape(shape.kind, shape.size_m, shape.mesh), ids[0])]
                 if shape is not None
-                else [(exact_shape_of_drake(inspector.GetShape(g)), g) for g in ids]
+                else [(self.cell.exact_shape(g), g) for g in ids]
             )
         return self._exact[name]
 

@@ -29,7 +29,7 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
-from offline_prog.scene.exact_distance import bounding_radius
+from offline_prog.scene.exact_distance import ExactShape, bounding_radius, exact_shape_of_drake
 from offline_prog.scene.filters import filter_contacts, filter_self_pairs
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
@@ -77,6 +77,7 @@ class DrakeCell:
     # every class but "check"), or None when the robot has no matrix (all pairs checked).
     skipped_self_pairs: list | None = None
     _motion_radii: np.ndarray | None = dataclasses.field(default=None, repr=False, compare=False)
+    _exact: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def frame_E(self):
@@ -87,6 +88,14 @@ class DrakeCell:
         context = self.plant.CreateDefaultContext()
         self.plant.SetPositions(context, self.robot, q)
         return self.frame_E.CalcPoseInWorld(context)
+
+    def exact_shape(self, g: GeometryId) -> ExactShape:
+        """The ExactShape of collision geometry g (its Drake shape; a mesh by its hull),
+        built once per cell: every collision check of a plan asks for the same shapes."""
+        if g not in self._exact:
+            inspector = self.diagram.scene_graph().model_inspector()
+            self._exact[g] = exact_shape_of_drake(inspector.GetShape(g))
+        return self._exact[g]
 
     def motion_radii(self) -> np.ndarray:
         """(6,) ρ_k [m]: no collision geometry outboard of joint k (the part included) is
