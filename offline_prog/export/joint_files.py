@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.arrays import csv_text
 from offline_prog.atomic import write_atomic
 from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
@@ -74,16 +75,16 @@ def job_joint_csv_text(data: JobProgramData) -> str:
     for segment in data.segments:
         labels[segment.start : segment.stop] = segment.label
     header = ["t_s", "segment", *(f"{name}_rad" for name in job.joint_names)]
-    columns = [np.char.mod("%.10g", job.t), labels.astype(str)]
-    columns += [np.char.mod("%.10g", q) for q in job.q.T]
+    columns, formats = [job.t, labels.astype(str), *job.q.T], ["%.10g"] * (2 + job.q.shape[1])
     if data.digital is not None:
         header.append(f"do{io.digital_output}")
-        columns.append(np.char.mod("%d", data.digital))
+        columns.append(data.digital)
+        formats.append("%d")
     if data.analog is not None:
         header.append(f"ao{io.analog_output}")
-        columns.append(np.char.mod("%.6g", data.analog))
-    rows = np.column_stack(columns)
-    return ",".join(header) + "\n" + "".join(",".join(row) + "\n" for row in rows)
+        columns.append(data.analog)
+        formats.append("%.6g")
+    return csv_text(header, columns, formats)
 
 
 def job_ros_json(data: JobProgramData) -> dict:
