@@ -54,3 +54,22 @@ def test_plan_imports_stay_within_budget(tmp_path):
     assert "scipy.optimize" not in seen["start"] and "pydrake.all" not in seen["plan"]
     assert len(seen["start"]) <= BUDGET_START, len(seen["start"])
     assert len(seen["plan"]) <= BUDGET_PLAN, len(seen["plan"])
+
+
+TOPPRA_PLOTS = """
+import sys
+from offline_prog.timing.time_optimal import _toppra_algorithm
+algorithm = _toppra_algorithm()
+assert "matplotlib" not in sys.modules
+import toppra.algorithm.algorithm as module
+assert callable(module.plt.subplot)  # the stand-in imports matplotlib.pyplot on use
+assert "matplotlib.pyplot" in sys.modules
+print("ok")
+"""
+
+
+def test_toppra_loads_without_matplotlib_and_can_still_plot():
+    done = subprocess.run(
+        [sys.executable, "-c", TOPPRA_PLOTS], cwd=REPO, capture_output=True, text=True, check=True
+    )
+    assert done.stdout.strip() == "ok"
