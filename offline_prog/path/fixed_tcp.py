@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import threading
 
 import numpy as np
 from pydrake.math import RigidTransform
@@ -60,22 +61,25 @@ PART_SAMPLES_KEPT = 16  # evaluations kept by part_samples and part_in_tool each
 PART_SAMPLES_MOST = 5000  # of at most this many samples each (≤ 2 MB)
 _part_samples: collections.OrderedDict = collections.OrderedDict()
 _part_in_tool: collections.OrderedDict = collections.OrderedDict()
+_lock = threading.Lock()
 
 
 def _kept(cache: collections.OrderedDict, key: tuple, owners: tuple, compute) -> tuple:
     """compute()'s arrays, made read-only and kept under key (the last
     PART_SAMPLES_KEPT); ``owners`` are the objects whose ids the key holds (kept with
     the entry, so an id is theirs while it lives)."""
-    entry = cache.get(key)
-    if entry is not None and all(a is b for a, b in zip(entry[0], owners, strict=True)):
-        cache.move_to_end(key)
-        return entry[1]
+    with _lock:
+        entry = cache.get(key)
+        if entry is not None and all(a is b for a, b in zip(entry[0], owners, strict=True)):
+            cache.move_to_end(key)
+            return entry[1]
     values = compute()
     for value in values:
         value.setflags(write=False)
-    cache[key] = (owners, values)
-    while len(cache) > PART_SAMPLES_KEPT:
-        cache.popitem(last=False)
+    with _lock:  # threads may plan at once (a Dask worker's threads)
+        cache[key] = (owners, values)
+        while len(cache) > PART_SAMPLES_KEPT:
+            cache.popitem(last=False)
     return values
 
 

@@ -26,6 +26,8 @@ around the seam (θ's total turn taken out first); on an open one the ends are h
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.ndimage import gaussian_filter1d
@@ -38,6 +40,7 @@ GRID_SPACING_M = 5e-4  # θ and θ̄ sampled every 0.5 mm
 SPAN_REFINE = 16
 SPAN_MARGIN_RAD = 1e-7
 RESIDUALS_KEPT = 4  # σ grids whose θ − θ̄ a turn keeps (see SmoothTurn._residual)
+_lock = threading.Lock()
 
 
 def turn_rates(path: ArcLengthPath, normal: NormalField, s: np.ndarray, axis: int):
@@ -118,11 +121,13 @@ class SmoothTurn:
         (``with_offset`` copies share the splines and this cache), so the tool rotations
         tried for a seam evaluate the splines once per σ grid (the last RESIDUALS_KEPT)."""
         key = s.tobytes()
-        if key not in self._residuals:
-            if len(self._residuals) >= RESIDUALS_KEPT:
-                self._residuals.pop(next(iter(self._residuals)))
+        residual = self._residuals.get(key)
+        if residual is None:
             residual = tuple(self._theta(s, nu) - self._smooth(s, nu) for nu in range(3))
             for value in residual:
                 value.setflags(write=False)
-            self._residuals[key] = residual
-        return self._residuals[key]
+            with _lock:  # threads may plan at once (a Dask worker's threads)
+                while len(self._residuals) >= RESIDUALS_KEPT:
+                    self._residuals.pop(next(iter(self._residuals)))
+                self._residuals[key] = residual
+        return residual
