@@ -32,7 +32,8 @@ def _columns(plan_dir: Path) -> dict[str, np.ndarray]:
     step = max(1, len(body) // MAX_PLOT_POINTS)
     body = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
     out = {}
-    for name, values in zip(header, zip(*body, strict=True), strict=True):
+    by_column = zip(*body, strict=True) if body else [()] * len(header)
+    for name, values in zip(header, by_column, strict=True):
         if name == "segment":
             out[name] = np.array(values, dtype=object)
         else:  # empty cells (sigma on links) are NaN
