@@ -35,12 +35,13 @@ def ros_json(data: ProgramData) -> dict:
     """A JointTrajectory message as JSON: joint names from the URDF, positions
     [rad], velocities [rad/s], time_from_start {sec, nanosec} (ROS 2 Duration)."""
     points = []
-    for t, q, qd in zip(data.t, data.q, data.qd, strict=True):
+    rows = zip(data.t, np.asarray(data.q).tolist(), np.asarray(data.qd).tolist(), strict=True)
+    for t, q, qd in rows:  # tolist: the same Python floats, without a call per value
         sec, nanosec = divmod(int(round(t * 1e9)), 1_000_000_000)
         points.append(
             {
-                "positions": [float(v) for v in q],
-                "velocities": [float(v) for v in qd],
+                "positions": q,
+                "velocities": qd,
                 "accelerations": [],
                 "effort": [],
                 "time_from_start": {"sec": sec, "nanosec": nanosec},
