@@ -25,6 +25,7 @@ robot base) and 2 when both move. Hence, per geometry pair g (each queried alone
 from __future__ import annotations
 
 import time
+from bisect import bisect_right
 
 import numpy as np
 
@@ -191,6 +192,23 @@ def check_trajectory(
         bisect(g, xa, da, xm, dm, motion / 2)
         bisect(g, xm, dm, xb, db, motion / 2)
 
+    # The loop below for one pair, in Python floats (the same arithmetic, a third of the
+    # time: numpy's per-call cost dominates a 1-element array).
+    c_list, clear_list, cumulative_list = pairs.c.tolist(), clear_g.tolist(), cumulative.tolist()
+
+    def _step_one(g: int, i: int) -> None:
+        d = pairs.distance(g)
+        found.append(([g], [float(i)], [d]))
+        c, clear = c_list[g], clear_list[g]
+        if c == 0.0:  # nothing moves: measured once
+            due[g] = n
+        else:
+            reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c) - 1
+            due[g] = n if reach >= n - 1 else max(reach, i + 1)
+        if i and last_i[g] == i - 1 and (last_d[g] + d - c * step[i - 1]) / 2 < clear:
+            bisect(g, i - 1.0, last_d[g], float(i), d, step[i - 1])
+        last_i[g], last_d[g] = i, d
+
     # Per geometry pair: the next sample to evaluate (n: certified to the end).
     due = np.zeros(len(pairs.ids), dtype=int)
     last_i, last_d = np.full(len(due), -2), np.zeros(len(due))
@@ -200,6 +218,9 @@ def check_trajectory(
         while len(due) and (i := int(due.min())) < n:
             now = np.flatnonzero(due == i)
             pairs.set(q[i])
+            if len(now) == 1:  # one pair due (the usual case near an obstacle)
+                _step_one(int(now[0]), i)
+                continue
             d = np.array([pairs.distance(g) for g in now], dtype=float)
             found.append((now, np.full(len(now), float(i)), d))
             budget = (d - clear_g[now] - margin) / pairs.c[now]
