@@ -51,6 +51,7 @@ MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drak
 MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
 TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
 OWNER_ORDER = ("part", "tool", "robot", "obstacle")
+FEW_PAIRS = 16  # pairs due at one sample that the check steps in Python floats
 
 
 class _Pairs:
@@ -192,22 +193,27 @@ def check_trajectory(
         bisect(g, xa, da, xm, dm, motion / 2)
         bisect(g, xm, dm, xb, db, motion / 2)
 
-    # The loop below for one pair, in Python floats (the same arithmetic, a third of the
-    # time: numpy's per-call cost dominates a 1-element array).
+    # The loop below for a few pairs, in Python floats (the same arithmetic, a third of
+    # the time: numpy's per-call cost dominates arrays of a few elements).
     c_list, clear_list, cumulative_list = pairs.c.tolist(), clear_g.tolist(), cumulative.tolist()
 
-    def _step_one(g: int, i: int) -> None:
-        d = pairs.distance(g)
-        found.append(([g], [float(i)], [d]))
-        c, clear = c_list[g], clear_list[g]
-        if c == 0.0:  # nothing moves: measured once
-            due[g] = n
-        else:
-            reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c) - 1
-            due[g] = n if reach >= n - 1 else max(reach, i + 1)
-        if i and last_i[g] == i - 1 and (last_d[g] + d - c * step[i - 1]) / 2 < clear:
+    def step_few(now: list[int], i: int) -> None:
+        d_now = [pairs.distance(g) for g in now]  # all at q[i] before any bisection
+        found.append((now, [float(i)] * len(now), d_now))
+        split = []
+        for g, d in zip(now, d_now, strict=True):
+            c, clear = c_list[g], clear_list[g]
+            if c == 0.0:  # nothing moves: measured once
+                due[g] = n
+            else:  # the last sample the distance budget reaches (searchsorted, right)
+                reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
+                due[g] = n if reach - 1 >= n - 1 else max(reach - 1, i + 1)
+            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step[i - 1]) / 2 < clear:
+                split.append((g, d))
+        for g, d in split:
             bisect(g, i - 1.0, last_d[g], float(i), d, step[i - 1])
-        last_i[g], last_d[g] = i, d
+        for g, d in zip(now, d_now, strict=True):
+            last_i[g], last_d[g] = i, d
 
     # Per geometry pair: the next sample to evaluate (n: certified to the end).
     due = np.zeros(len(pairs.ids), dtype=int)
@@ -218,8 +224,8 @@ def check_trajectory(
         while len(due) and (i := int(due.min())) < n:
             now = np.flatnonzero(due == i)
             pairs.set(q[i])
-            if len(now) == 1:  # one pair due (the usual case near an obstacle)
-                _step_one(int(now[0]), i)
+            if len(now) <= FEW_PAIRS:  # the usual case: a pair or two near an obstacle
+                step_few(now.tolist(), i)
                 continue
             d = np.array([pairs.distance(g) for g in now], dtype=float)
             found.append((now, np.full(len(now), float(i)), d))
