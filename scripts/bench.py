@@ -32,12 +32,15 @@ from pathlib import Path
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
-from offline_prog.collision.check import check_trajectory
-from offline_prog.config.cell import transform
-from offline_prog.joints.drake_ik import solve_path, solve_pose
-from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch
-from offline_prog.plan import plan_cell, plan_job
-from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell
+# This checkout's package, not an installed one (the subprocess figures run it too).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from offline_prog.collision.check import check_trajectory  # noqa: E402
+from offline_prog.config.cell import transform  # noqa: E402
+from offline_prog.joints.drake_ik import solve_path, solve_pose  # noqa: E402
+from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch  # noqa: E402
+from offline_prog.plan import plan_cell, plan_job  # noqa: E402
+from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # py_opw_reference
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_timing

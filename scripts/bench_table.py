@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:  # this checkout's package for the in-process figures
+    sys.path.insert(0, str(ROOT))
 CELLS = ROOT / "cells"
 PLACE_JOB = CELLS / "placement" / "seal_job_far_kr16.yaml"
 CANDIDATES = 5
