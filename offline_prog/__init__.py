@@ -10,6 +10,13 @@ frame on the path, T fixed tool (TCP).
 """
 
 import logging
+import os
+
+# One BLAS thread unless the user says otherwise (before numpy loads, if it has not):
+# the least-squares fits and 6×6 solves here are small, and OpenBLAS's spinning threads
+# cost 6–10× on a machine whose cores are busy (the preview drawn on the second core,
+# placement workers, other jobs). Results are the same bit for bit (scripts/compare_outputs.py).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 __version__ = "0.1.0"
 

@@ -1,7 +1,9 @@
 """Benchmark: plan the demo cells stage by stage, and compare path IK with references.
 
 Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]
-[--only command|collision|timing|session|place]``; ``--only place`` runs
+[--only table|command|collision|timing|session|place] [--runs 3] [--big-runs 1]``;
+``--only table`` prints issue 25's table (scripts/bench_table.py: each figure with the
+import floor of the same run), which a full run prints first; ``--only place`` runs
 scripts/bench_place.py (the placement search, ~10 minutes)
 
 All figures come from the same process on the same machine, so the ratios
@@ -30,16 +32,20 @@ from pathlib import Path
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 
-from offline_prog.collision.check import check_trajectory
-from offline_prog.config.cell import transform
-from offline_prog.joints.drake_ik import solve_path, solve_pose
-from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch
-from offline_prog.plan import plan_cell, plan_job
-from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell
+# This checkout's package, not an installed one (the subprocess figures run it too).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from offline_prog.collision.check import check_trajectory  # noqa: E402
+from offline_prog.config.cell import transform  # noqa: E402
+from offline_prog.joints.drake_ik import solve_path, solve_pose  # noqa: E402
+from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch  # noqa: E402
+from offline_prog.plan import plan_cell, plan_job  # noqa: E402
+from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # py_opw_reference
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_timing
 
+from bench_table import bench_table  # noqa: E402
 from bench_timing import bench_timing  # noqa: E402
 
 CELLS = Path(__file__).resolve().parents[1] / "cells"
@@ -268,11 +274,17 @@ def main() -> None:
     parser.add_argument("--drake-samples", type=int, default=300)
     parser.add_argument(
         "--only",
-        choices=["command", "collision", "timing", "session", "place"],
+        choices=["table", "command", "collision", "timing", "session", "place"],
         help="run one part of the benchmark",
     )
+    parser.add_argument("--runs", type=int, default=3, help="runs of each table figure")
+    parser.add_argument("--big-runs", type=int, default=1, help="runs of the 30-seam job")
     args = parser.parse_args()
     cells = sorted(CELLS.glob("*.yaml"))
+    if args.only in (None, "table"):
+        bench_table(args.runs, args.big_runs)
+        if args.only == "table":
+            return
     if args.only == "session":
         bench_session(cells)
         return

@@ -25,6 +25,7 @@ robot base) and 2 when both move. Hence, per geometry pair g (each queried alone
 from __future__ import annotations
 
 import time
+from bisect import bisect_right
 
 import numpy as np
 
@@ -37,7 +38,7 @@ from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     write_collisions_json,
 )
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.scene.exact_distance import exact_distance, exact_shape, exact_shape_of_drake
+from offline_prog.scene.exact_distance import exact_distance, exact_shape
 from offline_prog.scene.filters import allow_fixed_layout
 
 # A pair certified above clearance + this is not evaluated (its minimum is then over
@@ -50,6 +51,7 @@ MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drak
 MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
 TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
 OWNER_ORDER = ("part", "tool", "robot", "obstacle")
+FEW_PAIRS = 16  # pairs due at one sample that the check steps in Python floats
 
 
 class _Pairs:
@@ -115,13 +117,12 @@ class _Pairs:
     def _components(self, name: str):
         """[(ExactShape, a GeometryId giving its pose X_IG)] of a shape name."""
         if name not in self._exact:
-            inspector = self.cell.diagram.scene_graph().model_inspector()
             ids = [g for g, label in self.cell.labels.items() if label.name == name]
             shape = self.cell.labels[ids[0]].shape
             self._exact[name] = (
                 [(exact_shape(shape.kind, shape.size_m, shape.mesh), ids[0])]
                 if shape is not None
-                else [(exact_shape_of_drake(inspector.GetShape(g)), g) for g in ids]
+                else [(self.cell.exact_shape(g), g) for g in ids]
             )
         return self._exact[name]
 
@@ -192,6 +193,28 @@ def check_trajectory(
         bisect(g, xa, da, xm, dm, motion / 2)
         bisect(g, xm, dm, xb, db, motion / 2)
 
+    # The loop below for a few pairs, in Python floats (the same arithmetic, a third of
+    # the time: numpy's per-call cost dominates arrays of a few elements).
+    c_list, clear_list, cumulative_list = pairs.c.tolist(), clear_g.tolist(), cumulative.tolist()
+
+    def step_few(now: list[int], i: int) -> None:
+        d_now = [pairs.distance(g) for g in now]  # all at q[i] before any bisection
+        found.append((now, [float(i)] * len(now), d_now))
+        split = []
+        for g, d in zip(now, d_now, strict=True):
+            c, clear = c_list[g], clear_list[g]
+            if c == 0.0:  # nothing moves: measured once
+                due[g] = n
+            else:  # the last sample the distance budget reaches (searchsorted, right)
+                reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
+                due[g] = n if reach - 1 >= n - 1 else max(reach - 1, i + 1)
+            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step[i - 1]) / 2 < clear:
+                split.append((g, d))
+        for g, d in split:
+            bisect(g, i - 1.0, last_d[g], float(i), d, step[i - 1])
+        for g, d in zip(now, d_now, strict=True):
+            last_i[g], last_d[g] = i, d
+
     # Per geometry pair: the next sample to evaluate (n: certified to the end).
     due = np.zeros(len(pairs.ids), dtype=int)
     last_i, last_d = np.full(len(due), -2), np.zeros(len(due))
@@ -201,6 +224,9 @@ def check_trajectory(
         while len(due) and (i := int(due.min())) < n:
             now = np.flatnonzero(due == i)
             pairs.set(q[i])
+            if len(now) <= FEW_PAIRS:  # the usual case: a pair or two near an obstacle
+                step_few(now.tolist(), i)
+                continue
             d = np.array([pairs.distance(g) for g in now], dtype=float)
             found.append((now, np.full(len(now), float(i)), d))
             budget = (d - clear_g[now] - margin) / pairs.c[now]

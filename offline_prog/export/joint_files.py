@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.arrays import csv_text
 from offline_prog.atomic import write_atomic
 from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
@@ -34,12 +35,13 @@ def ros_json(data: ProgramData) -> dict:
     """A JointTrajectory message as JSON: joint names from the URDF, positions
     [rad], velocities [rad/s], time_from_start {sec, nanosec} (ROS 2 Duration)."""
     points = []
-    for t, q, qd in zip(data.t, data.q, data.qd, strict=True):
+    rows = zip(data.t, np.asarray(data.q).tolist(), np.asarray(data.qd).tolist(), strict=True)
+    for t, q, qd in rows:  # tolist: the same Python floats, without a call per value
         sec, nanosec = divmod(int(round(t * 1e9)), 1_000_000_000)
         points.append(
             {
-                "positions": [float(v) for v in q],
-                "velocities": [float(v) for v in qd],
+                "positions": q,
+                "velocities": qd,
                 "accelerations": [],
                 "effort": [],
                 "time_from_start": {"sec": sec, "nanosec": nanosec},
@@ -74,16 +76,16 @@ def job_joint_csv_text(data: JobProgramData) -> str:
     for segment in data.segments:
         labels[segment.start : segment.stop] = segment.label
     header = ["t_s", "segment", *(f"{name}_rad" for name in job.joint_names)]
-    columns = [np.char.mod("%.10g", job.t), labels.astype(str)]
-    columns += [np.char.mod("%.10g", q) for q in job.q.T]
+    columns, formats = [job.t, labels.astype(str), *job.q.T], ["%.10g"] * (2 + job.q.shape[1])
     if data.digital is not None:
         header.append(f"do{io.digital_output}")
-        columns.append(np.char.mod("%d", data.digital))
+        columns.append(data.digital)
+        formats.append("%d")
     if data.analog is not None:
         header.append(f"ao{io.analog_output}")
-        columns.append(np.char.mod("%.6g", data.analog))
-    rows = np.column_stack(columns)
-    return ",".join(header) + "\n" + "".join(",".join(row) + "\n" for row in rows)
+        columns.append(data.analog)
+        formats.append("%.6g")
+    return csv_text(header, columns, formats)
 
 
 def job_ros_json(data: JobProgramData) -> dict:

@@ -13,7 +13,9 @@ path, expressed in I, so that w_IE_I = w_s · ṡ.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
+import threading
 
 import numpy as np
 from pydrake.math import RigidTransform
@@ -55,6 +57,85 @@ class FlangeSamples:
     dw_s: np.ndarray
 
 
+PART_SAMPLES_KEPT = 16  # evaluations kept by part_samples and part_in_tool each,
+PART_SAMPLES_MOST = 5000  # of at most this many samples each (≤ 2 MB)
+_part_samples: collections.OrderedDict = collections.OrderedDict()
+_part_in_tool: collections.OrderedDict = collections.OrderedDict()
+_lock = threading.Lock()
+
+
+def _kept(cache: collections.OrderedDict, key: tuple, owners: tuple, compute) -> tuple:
+    """compute()'s arrays, made read-only and kept under key (the last
+    PART_SAMPLES_KEPT); ``owners`` are the objects whose ids the key holds (kept with
+    the entry, so an id is theirs while it lives)."""
+    with _lock:
+        entry = cache.get(key)
+        if entry is not None and all(a is b for a, b in zip(entry[0], owners, strict=True)):
+            cache.move_to_end(key)
+            return entry[1]
+    values = compute()
+    for value in values:
+        value.setflags(write=False)
+    with _lock:  # threads may plan at once (a Dask worker's threads)
+        cache[key] = (owners, values)
+        while len(cache) > PART_SAMPLES_KEPT:
+            cache.popitem(last=False)
+    return values
+
+
+def part_samples(path: ArcLengthPath, normal: NormalField, s: np.ndarray) -> tuple:
+    """(p_PF, dp_PF, ddp_PF, R_PF, dR_PF, ddR_PF) at s (N,): the path point (N, 3) and
+    process frame (N, 3, 3) in P with their first two s-derivatives, read-only.
+
+    They depend on neither X_IT nor X_PE (nor the tool turn): the tool rotations tried
+    for one seam, placement candidates and session edits evaluate the same path at the
+    same σ grid again and again, so the last PART_SAMPLES_KEPT evaluations (of grids up
+    to PART_SAMPLES_MOST) are kept: the same path and normal objects, the same s bit
+    for bit, the same arrays (read-only, so no caller changes what another gets).
+
+    Raises:
+        NormalTangentError: from :func:`process_frames`.
+    """
+
+    def compute():
+        return (*path(s, order=2), *process_frames(path, normal, s))
+
+    if len(s) > PART_SAMPLES_MOST:
+        return compute()
+    return _kept(_part_samples, (id(path), id(normal), s.tobytes()), (path, normal), compute)
+
+
+def part_in_tool(path: ArcLengthPath, normal: NormalField, X_PE, s: np.ndarray) -> tuple:
+    """(p_PF, R_PF, p_TE_T, dp_TE_T, ddp_TE_T, M, dM, ddM) at s (N,): what of the flange
+    path depends on the part and X_PE only, not on X_IT or the tool's turn (kept as
+    :func:`part_samples` keeps its values; every tool rotation tried reuses them).
+
+    p_TE_T (N, 3): the flange origin from T's origin in T, R_TP (p_PE − p_PF) (paper
+    eqs. 5, 7), and its first two s-derivatives; M (N, 3, 3) = R_TP R_PE, the flange
+    orientation in T before the tool's turn (eqs. 6, 8), and its derivatives.
+    """
+
+    def compute():
+        p_PF, dp_PF, ddp_PF, R_PF, dR_PF, ddR_PF = part_samples(path, normal, s)
+        R_PE = X_PE.rotation().matrix()
+        d = X_PE.translation() - p_PF
+        R_TP, dR_TP, ddR_TP = (np.swapaxes(M, 1, 2) for M in (R_PF, dR_PF, ddR_PF))
+        p_TE_T = np.einsum("nij,nj->ni", R_TP, d)
+        dp_TE_T = np.einsum("nij,nj->ni", dR_TP, d) - np.einsum("nij,nj->ni", R_TP, dp_PF)
+        ddp_TE_T = (
+            np.einsum("nij,nj->ni", ddR_TP, d)
+            - 2.0 * np.einsum("nij,nj->ni", dR_TP, dp_PF)
+            - np.einsum("nij,nj->ni", R_TP, ddp_PF)
+        )
+        M, dM, ddM = R_TP @ R_PE, dR_TP @ R_PE, ddR_TP @ R_PE
+        return p_PF, R_PF, p_TE_T, dp_TE_T, ddp_TE_T, M, dM, ddM
+
+    if len(s) > PART_SAMPLES_MOST:
+        return compute()
+    pose = X_PE.GetAsMatrix4().tobytes()
+    return _kept(_part_in_tool, (id(path), id(normal), pose, s.tobytes()), (path, normal), compute)
+
+
 class FlangePath:
     """X_IE(s) for a part carried past the fixed tool.
 
@@ -92,24 +173,14 @@ class FlangePath:
 
     def __call__(self, s: np.ndarray) -> FlangeSamples:
         s = np.asarray(s, dtype=float)
-        p_PF, dp_PF, ddp_PF = self.path(s, order=2)
-        R_PF, dR_PF, ddR_PF = process_frames(self.path, self.normal, s)
+        p_PF, R_PF, p_TE_T, dp_TE_T, ddp_TE_T, M, dM, ddM = part_in_tool(
+            self.path, self.normal, self.X_PE, s
+        )
         R_IT = self.X_IT.rotation().matrix()
         p_IT = self.X_IT.translation()
-        R_PE = self.X_PE.rotation().matrix()
-        p_PE = self.X_PE.translation()
 
-        # p_IE = p_IT + R_IT R_PFᵀ d, with d = p_PE − p_PF (paper eqs. 5, 7).
-        d = p_PE - p_PF
-        R_TP, dR_TP, ddR_TP = (np.swapaxes(M, 1, 2) for M in (R_PF, dR_PF, ddR_PF))
-        p_TE_T = np.einsum("nij,nj->ni", R_TP, d)
-        dp_TE_T = np.einsum("nij,nj->ni", dR_TP, d) - np.einsum("nij,nj->ni", R_TP, dp_PF)
-        ddp_TE_T = (
-            np.einsum("nij,nj->ni", ddR_TP, d)
-            - 2.0 * np.einsum("nij,nj->ni", dR_TP, dp_PF)
-            - np.einsum("nij,nj->ni", R_TP, ddp_PF)
-        )
-        # G = R_IT · R_axis(φ(s)): the tool frame the process frame is laid onto.
+        # p_IE = p_IT + G p_TE_T (paper eqs. 5, 7), G = R_IT · R_axis(φ(s)): the tool
+        # frame the process frame is laid onto.
         G, dG, ddG = self._tool_rotation(s, R_IT)
         p_IE = p_IT + np.einsum("nij,nj->ni", G, p_TE_T)
         dp_IE = np.einsum("nij,nj->ni", dG, p_TE_T) + np.einsum("nij,nj->ni", G, dp_TE_T)
@@ -120,7 +191,6 @@ class FlangePath:
         )
 
         # R_IE = R_IT R_TP R_PE (paper eqs. 6, 8) and its derivatives.
-        M, dM, ddM = R_TP @ R_PE, dR_TP @ R_PE, ddR_TP @ R_PE
         R_IE = G @ M
         dR_IE = dG @ M + G @ dM
         ddR_IE = ddG @ M + 2.0 * dG @ dM + G @ ddM

@@ -26,6 +26,8 @@ around the seam (θ's total turn taken out first); on an open one the ends are h
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.ndimage import gaussian_filter1d
@@ -37,6 +39,8 @@ from offline_prog.path.process_frames import NormalField, process_frames
 GRID_SPACING_M = 5e-4  # θ and θ̄ sampled every 0.5 mm
 SPAN_REFINE = 16
 SPAN_MARGIN_RAD = 1e-7
+RESIDUALS_KEPT = 4  # σ grids whose θ − θ̄ a turn keeps (see SmoothTurn._residual)
+_lock = threading.Lock()
 
 
 def turn_rates(path: ArcLengthPath, normal: NormalField, s: np.ndarray, axis: int):
@@ -75,6 +79,7 @@ class SmoothTurn:
             raise ValueError(f"tool turn: width must be > 0 m, got {width_m}")
         self.path, self.normal, self.axis = path, normal, "xyz".index(axis)
         self.width_m, self.offset_rad, self.scale = width_m, offset_rad, scale
+        self._residuals: dict[bytes, tuple] = {}  # σ grid ↦ θ − θ̄ (shared with copies)
         length = path.length
         s = np.linspace(0.0, length, max(int(np.ceil(length / GRID_SPACING_M)), 10) + 1)
         # θ: the antiderivative of a quintic spline through the exact θ′ (module doc).
@@ -107,6 +112,22 @@ class SmoothTurn:
         s = np.clip(np.asarray(s, dtype=float), 0.0, self.path.length)
         k = self.scale
         return tuple(
-            (self.offset_rad if nu == 0 else 0.0) + k * (self._theta(s, nu) - self._smooth(s, nu))
-            for nu in range(3)
+            (self.offset_rad if nu == 0 else 0.0) + k * residual
+            for nu, residual in enumerate(self._residual(s))
         )
+
+    def _residual(self, s: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(θ − θ̄, its first and second derivatives) at s (N,): the same for every φ₀
+        (``with_offset`` copies share the splines and this cache), so the tool rotations
+        tried for a seam evaluate the splines once per σ grid (the last RESIDUALS_KEPT)."""
+        key = s.tobytes()
+        residual = self._residuals.get(key)
+        if residual is None:
+            residual = tuple(self._theta(s, nu) - self._smooth(s, nu) for nu in range(3))
+            for value in residual:
+                value.setflags(write=False)
+            with _lock:  # threads may plan at once (a Dask worker's threads)
+                while len(self._residuals) >= RESIDUALS_KEPT:
+                    self._residuals.pop(next(iter(self._residuals)))
+                self._residuals[key] = residual
+        return residual

@@ -10,13 +10,13 @@ folder holding files we did not write is refused.
 from __future__ import annotations
 
 import datetime
-import io
 import json
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog import __version__
+from offline_prog.arrays import csv_text
 from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.config.cell import transform
@@ -101,13 +101,8 @@ def job_table(job: JobPlan) -> tuple[list[str], list[np.ndarray]]:
 def trajectory_csv(job: JobPlan) -> str:
     """CSV text of :func:`job_table` (SI units; sigma empty on links)."""
     header, columns = job_table(job)
-    out = io.StringIO()
-    out.write(",".join(header) + "\n")
-    text = [c if c.dtype == object else np.char.mod("%.10g", c.astype(float)) for c in columns]
-    table = np.column_stack(text)
-    table[table == "nan"] = ""
-    out.writelines(",".join(row) + "\n" for row in table)
-    return out.getvalue()
+    columns = [c if c.dtype == object else c.astype(float) for c in columns]
+    return csv_text(header, columns, nan="")
 
 
 def _segment_times(job: JobPlan) -> dict[str, float]:

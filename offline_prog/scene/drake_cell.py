@@ -29,7 +29,7 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
-from offline_prog.scene.exact_distance import bounding_radius
+from offline_prog.scene.exact_distance import ExactShape, bounding_radius, exact_shape_of_drake
 from offline_prog.scene.filters import filter_contacts, filter_self_pairs
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
@@ -76,6 +76,8 @@ class DrakeCell:
     # Robot link pairs not checked for self-collision (robots/<robot>/self_collision.yaml:
     # every class but "check"), or None when the robot has no matrix (all pairs checked).
     skipped_self_pairs: list | None = None
+    _motion_radii: np.ndarray | None = dataclasses.field(default=None, repr=False, compare=False)
+    _exact: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def frame_E(self):
@@ -87,10 +89,24 @@ class DrakeCell:
         self.plant.SetPositions(context, self.robot, q)
         return self.frame_E.CalcPoseInWorld(context)
 
+    def exact_shape(self, g: GeometryId) -> ExactShape:
+        """The ExactShape of collision geometry g (its Drake shape; a mesh by its hull),
+        built once per cell: every collision check of a plan asks for the same shapes."""
+        if g not in self._exact:
+            inspector = self.diagram.scene_graph().model_inspector()
+            self._exact[g] = exact_shape_of_drake(inspector.GetShape(g))
+        return self._exact[g]
+
     def motion_radii(self) -> np.ndarray:
         """(6,) ρ_k [m]: no collision geometry outboard of joint k (the part included) is
         farther than ρ_k from the joint's origin, at any joint position (serial chain:
-        ρ_k = max(reach of link k's geometry, |p_LkJk+1| + ρ_k+1), frames fixed in link k)."""
+        ρ_k = max(reach of link k's geometry, |p_LkJk+1| + ρ_k+1), frames fixed in link k).
+        Computed once per cell (the model is built and does not change)."""
+        if self._motion_radii is None:
+            self._motion_radii = self._reach()
+        return self._motion_radii.copy()
+
+    def _reach(self) -> np.ndarray:
         plant, context = self.plant, self.plant.CreateDefaultContext()
         inspector = self.diagram.scene_graph().model_inspector()
         joints = [plant.get_joint(j) for j in plant.GetJointIndices(self.robot)]

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.optimize import brentq
 
 
 @dataclasses.dataclass(frozen=True)
@@ -194,6 +193,8 @@ def sin2_plateau_law(
         if need(i, lower) >= room and lower > 0.0:
             speeds[i] = lower
         else:  # the highest speed whose transitions fit (slightly below, for rounding)
+            from scipy.optimize import brentq  # 0.3 s of import: only where a plateau is cut
+
             speeds[i] = brentq(
                 lambda v, i=i, room=room: need(i, v) - room,
                 lower,

@@ -19,7 +19,10 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import importlib
+import sys
 import time
+import types
 
 import numpy as np
 
@@ -91,6 +94,7 @@ def _speed_curve(v_max: np.ndarray, dof: int, a_max: np.ndarray | None = None):
     """A toppra constraint σ̇ ≤ v_max (G,) at the grid points, and |σ̈| ≤ a_max (G,)
     on the step after each if given, vectorised (toppra's
     JointVelocityConstraintVarying calls Python once per grid point)."""
+    _toppra_algorithm()  # toppra without matplotlib
     from toppra.constraint import LinearConstraint
 
     class SpeedCurve(LinearConstraint):
@@ -129,11 +133,43 @@ def topp_grid(sigma: np.ndarray, ramp: float, most: int) -> np.ndarray:
     return np.unique(np.concatenate([uniform, np.clip(near, 0, last)]))
 
 
+class _Deferred(types.ModuleType):
+    """Stands for a module while toppra loads; the real one is imported on first use."""
+
+    def __getattr__(self, name: str):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(importlib.import_module(self.__name__), name)
+
+
+def _toppra_algorithm():
+    """toppra.algorithm, imported here only (a plan without the time-optimal law does
+    without it) and without matplotlib: toppra imports matplotlib.pyplot at load for its
+    plot helpers only, 0.35 s of a plan's start. While toppra loads, matplotlib and
+    matplotlib.pyplot are stand-ins that import the real module if toppra ever plots."""
+    if "toppra.algorithm" not in sys.modules:
+        deferred = {
+            name: _Deferred(name)
+            for name in ("matplotlib", "matplotlib.pyplot")
+            if name not in sys.modules
+        }
+        if "matplotlib" in deferred and "matplotlib.pyplot" in deferred:
+            deferred["matplotlib"].pyplot = deferred["matplotlib.pyplot"]
+        sys.modules.update(deferred)
+        try:
+            importlib.import_module("toppra.algorithm")
+        finally:
+            for name in deferred:
+                del sys.modules[name]
+    return sys.modules["toppra.algorithm"]
+
+
 @functools.lru_cache(maxsize=32)
 def _joint_constraints(v: tuple[float, ...], a: tuple[float, ...]):
     """toppra's joint velocity and acceleration constraints for limits v, a (7,),
     made once per limits: their constructors format every limit into a string (~4 ms
     a solve on this machine, a fifth of it)."""
+    _toppra_algorithm()  # toppra without matplotlib
     import toppra.constraint as constraint
 
     v, a = np.array(v), np.array(a)
@@ -183,7 +219,7 @@ def topp_profile(
             returned ``sigma``), from σ̇ = ends[0] at i to σ̇ = ends[1] at j [m/s]; the
             whole path, rest to rest, if None (``resolve_locally``).
     """
-    import toppra.algorithm as algorithm  # 0.3 s (it imports matplotlib): only here
+    algorithm = _toppra_algorithm()
 
     keep = topp_grid(rates.sigma, v_cap**2 / (2.0 * a_path), grid_points)
     if span is not None:

@@ -33,18 +33,22 @@ def _columns(plan_dir: Path) -> dict[str, np.ndarray]:
     step = max(1, len(body) // MAX_PLOT_POINTS)
     body = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
     out = {}
-    for j, name in enumerate(header):
-        values = [r[j] for r in body]
-        out[name] = (
-            np.array(values, dtype=object)
-            if name == "segment"
-            else np.array([float(v) if v else np.nan for v in values])
-        )
+    by_column = zip(*body, strict=True) if body else [()] * len(header)
+    for name, values in zip(header, by_column, strict=True):
+        if name == "segment":
+            out[name] = np.array(values, dtype=object)
+        else:  # empty cells (sigma on links) are NaN
+            text = np.array(values)
+            out[name] = np.where(text == "", "nan", text).astype(float)
     return out
 
 
 def _series(values: np.ndarray, scale: float = 1.0) -> list:
-    return [None if not np.isfinite(v) else round(float(v) * scale, 6) for v in values]
+    finite = np.isfinite(values).tolist()
+    return [
+        round(v * scale, 6) if ok else None
+        for v, ok in zip(np.asarray(values, dtype=float).tolist(), finite, strict=True)
+    ]
 
 
 def _plots(report: dict, col: dict) -> dict:

@@ -104,3 +104,43 @@ def test_tool_turn_about_the_symmetry_axis(rng):
     w_fd = rotation_log(hi.R_IE @ np.swapaxes(lo.R_IE, 1, 2)) / (2 * h)
     assert np.abs(w_fd - f.w_s).max() <= 1e-5 * np.abs(f.w_s).max()
     assert np.abs((hi.w_s - lo.w_s) / (2 * h) - f.dw_s).max() <= 1e-5 * np.abs(f.dw_s).max()
+
+
+def _fresh(flange, s):
+    """The flange samples with nothing kept from earlier evaluations."""
+    from offline_prog.path import fixed_tcp
+
+    fixed_tcp._part_samples.clear()
+    fixed_tcp._part_in_tool.clear()
+    return flange(s)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_kept_part_values_give_the_same_flange_poses(rng, closed):
+    """Tool rotations, session edits and placement candidates evaluate one path on one σ
+    grid with other X_IT, X_PE and tool-turn offsets: each answer is the one computed
+    from scratch, bit for bit, and no caller can change a kept array."""
+    from offline_prog.path.fixed_tcp import FlangePath
+    from offline_prog.path.tool_turn import SmoothTurn
+
+    from conftest import random_transform
+
+    base = random_flange_path(rng, closed=closed)
+    s = np.linspace(0.0, base.length, 400)
+    turn = SmoothTurn(base.path, base.normal, axis="y", width_m=0.02)
+    variants = [
+        FlangePath(base.path, base.normal, X_IT=X_IT, X_PE=X_PE, tool_turn=t, axis=(0, 1, 0))
+        for X_PE in (base.X_PE, random_transform(rng, 0.3))
+        for X_IT in (base.X_IT, random_transform(rng))
+        for t in (None, turn, turn.with_offset(0.2), turn.with_offset(-0.4, 0.5))
+    ]
+    grids = [s, np.sort(rng.uniform(0.0, base.length, 300))]
+    expected = [[_fresh(flange, grid) for grid in grids] for flange in variants]
+    for _ in range(2):  # kept values are reused on the second pass and later
+        for flange, wanted in zip(variants, expected, strict=True):
+            for grid, want in zip(grids, wanted, strict=True):
+                got = flange(grid)
+                for name in ("p_PF", "R_PF", "p_IE", "dp_IE", "ddp_IE", "R_IE", "w_s", "dw_s"):
+                    np.testing.assert_array_equal(getattr(got, name), getattr(want, name))
+    with pytest.raises(ValueError, match="read-only"):
+        variants[0](s).p_PF[0, 0] = 1.0

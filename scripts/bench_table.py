@@ -1,0 +1,134 @@
+"""Issue 25's table: interactive speed, each figure with the import floor of the same run.
+
+    python scripts/bench.py --only table [--runs 3] [--big-runs 1]
+
+Whole commands are fresh processes as a user runs them (stdout piped: no progress
+display), median of ``--runs``; the 30-seam job (tests/job/many_seams.py, order auto)
+median of ``--big-runs``. The import floor is the median wall time of
+``python -c "import pydrake.all"`` measured between the other figures, so each ratio
+holds on a noisy machine. The placement candidate is the seal job's placement demo
+(cells/placement/seal_job_far_kr16.yaml) through ``place``'s own serial engine, after
+the cell is loaded (as a worker runs it), median over candidates; the session re-plan
+is a tool-pose change (X_IT x ± 5 mm, a fresh value each time) on every demo cell.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:  # this checkout's package for the in-process figures
+    sys.path.insert(0, str(ROOT))
+CELLS = ROOT / "cells"
+PLACE_JOB = CELLS / "placement" / "seal_job_far_kr16.yaml"
+CANDIDATES = 5
+GOALS_S = {
+    "plan seal_plate_kr16": 1.5,
+    "plan seal_job_kr16 (4 seams)": 3.0,
+    "plan 30-seam job": 15.0,
+    "place: one job candidate": 1.0,
+    "session re-plan, tool pose (slowest cell)": 0.3,
+}
+
+
+def _wall(command: list[str]) -> float:
+    start = time.perf_counter()
+    subprocess.run(command, cwd=ROOT, check=False, capture_output=True)
+    return time.perf_counter() - start
+
+
+def import_floor(runs: int) -> float:
+    """Median wall time [s] of ``python -c "import pydrake.all"``."""
+    return statistics.median(
+        _wall([sys.executable, "-c", "import pydrake.all"]) for _ in range(runs)
+    )
+
+
+def plan_command(cell: Path, runs: int) -> float:
+    """Median wall time [s] of ``offline-prog plan CELL --out TMP``."""
+    with tempfile.TemporaryDirectory() as out:
+        command = [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", out]
+        return statistics.median(_wall(command) for _ in range(runs))
+
+
+def many_seams_command(n: int, runs: int) -> float:
+    sys.path.insert(0, str(ROOT / "tests" / "job"))
+    from many_seams import many_seam_cell
+
+    with tempfile.TemporaryDirectory() as folder:
+        return plan_command(many_seam_cell(Path(folder), n), runs)
+
+
+def place_candidate() -> float:
+    """Median seconds of one job candidate through place's serial engine."""
+    from offline_prog.config.cell import load_cell
+    from offline_prog.placement.engine import SerialEngine
+    from offline_prog.placement.payload import cell_payload
+    from offline_prog.placement.space import check_place
+
+    cell = load_cell(PLACE_JOB)
+    _, space = check_place(PLACE_JOB, cell)
+    rng = np.random.default_rng(0)
+    batch = [space.candidate(x, 0) for x in rng.uniform(0.1, 0.9, (CANDIDATES, 4))]
+    engine = SerialEngine(cell_payload(PLACE_JOB, cell))
+    try:
+        engine.map("screen", batch[:1])  # loads the cell, as a worker has
+        seconds = []
+        for candidate in batch:
+            start = time.perf_counter()
+            engine.map("plan", [candidate])
+            seconds.append(time.perf_counter() - start)
+    finally:
+        engine.close()
+    return statistics.median(seconds)
+
+
+def session_tool_pose(cell: Path, repeats: int) -> float:
+    """Median seconds of a session re-plan after a tool-pose change."""
+    from offline_prog.session.replan import Replanner
+    from offline_prog.session.state import values, with_value
+
+    planner = Replanner(cell)
+    planner.plan(planner.initial)
+    x = values(planner.initial)["X_IT.x"]
+    seconds = []
+    for step in ([5.0, -5.0] * repeats)[:repeats]:
+        result = planner.plan(with_value(planner.initial, "X_IT.x", x + step))
+        seconds.append(result.seconds)
+    return statistics.median(seconds)
+
+
+def bench_table(runs: int = 3, big_runs: int = 1) -> None:
+    print(f"== issue 25: interactive speed (medians; floor = import pydrake.all, {runs} runs) ==")
+    rows: list[tuple[str, float, float]] = []
+
+    def row(name: str, seconds: float) -> None:
+        floor = import_floor(runs)  # measured next to each figure
+        rows.append((name, seconds, floor))
+        goal = GOALS_S.get(name)
+        verdict = (
+            "" if goal is None else f"goal < {goal:g} s: {'holds' if seconds < goal else 'NOT met'}"
+        )
+        print(
+            f"  {name:44s} {seconds:7.2f} s  {seconds / floor:6.1f}× floor"
+            f" ({floor:.2f} s)  {verdict}"
+        )
+
+    row("plan seal_plate_kr16", plan_command(CELLS / "seal_plate_kr16.yaml", runs))
+    row("plan seal_job_kr16 (4 seams)", plan_command(CELLS / "seal_job_kr16.yaml", runs))
+    row("plan 30-seam job", many_seams_command(30, big_runs))
+    row("place: one job candidate", place_candidate())
+    slowest = 0.0
+    for cell in sorted(CELLS.glob("*.yaml")):
+        seconds = session_tool_pose(cell, runs)
+        slowest = max(slowest, seconds)
+        row(f"session re-plan, tool pose: {cell.stem}", seconds)
+    row("session re-plan, tool pose (slowest cell)", slowest)
+    print(f"  import floor, median of all: {statistics.median(r[2] for r in rows):.2f} s")
