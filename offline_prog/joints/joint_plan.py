@@ -19,6 +19,7 @@ import numpy as np
 from offline_prog.arrays import true_runs
 from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
+from offline_prog.joints.jerk_check import verified_timing
 from offline_prog.joints.path_ik import (
     BranchResult,
     base_poses,
@@ -247,7 +248,14 @@ def plan_joint_trajectory(
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
-    retiming = time_path(controller, PathLimits.of(robot, nominal), time_law, process)
+    retiming, controller = verified_timing(
+        lambda rates: time_path(rates, PathLimits.of(robot, nominal), time_law, process),
+        controller,
+        path,
+        robot,
+        chosen.q,
+        rate_hz=rate_hz,
+    )
     if not retiming.feasible:
         joint, sigma, use = retiming.worst
         jerk = retiming.law_kind is TimeLaw.TIME_OPTIMAL
