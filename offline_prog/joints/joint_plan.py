@@ -4,7 +4,8 @@ Stages: pick one configuration branch and 2π start for the whole path
 (``path_ik``), get q′(σ), q″(σ) exactly from the flange path's analytic
 σ-derivatives through the robot's Jacobian (``robot.jacobian``), time the path
 under the joint limits (``time_optimal`` + ``jerk_stage``, or the paper's sin²
-law with ``joint_timing``), and
+law with ``joint_timing``; the time-optimal law's joint jerk checked once more on the
+output samples with the exact path, ``jerk_check``), and
 sample the final trajectory with its joint positions, speeds, accelerations,
 singularity distances and joint steps. Failures are results that say where
 (σ, t) and why.
