@@ -4,7 +4,8 @@ Stages: pick one configuration branch and 2π start for the whole path
 (``path_ik``), get q′(σ), q″(σ) exactly from the flange path's analytic
 σ-derivatives through the robot's Jacobian (``robot.jacobian``), time the path
 under the joint limits (``time_optimal`` + ``jerk_stage``, or the paper's sin²
-law with ``joint_timing``), and
+law with ``joint_timing``; the time-optimal law's joint jerk checked once more on the
+output samples with the exact path, ``jerk_check``), and
 sample the final trajectory with its joint positions, speeds, accelerations,
 singularity distances and joint steps. Failures are results that say where
 (σ, t) and why.
@@ -19,6 +20,7 @@ import numpy as np
 from offline_prog.arrays import true_runs
 from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
+from offline_prog.joints.jerk_check import verified_timing
 from offline_prog.joints.path_ik import (
     BranchResult,
     base_poses,
@@ -247,7 +249,14 @@ def plan_joint_trajectory(
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
-    retiming = time_path(controller, PathLimits.of(robot, nominal), time_law, process)
+    retiming, controller = verified_timing(
+        lambda rates: time_path(rates, PathLimits.of(robot, nominal), time_law, process),
+        controller,
+        path,
+        robot,
+        chosen.q,
+        rate_hz=rate_hz,
+    )
     if not retiming.feasible:
         joint, sigma, use = retiming.worst
         jerk = retiming.law_kind is TimeLaw.TIME_OPTIMAL

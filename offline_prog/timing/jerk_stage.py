@@ -17,8 +17,8 @@ Each round samples the law at LIMIT_CHECK_RATE_HZ and checks every joint's veloc
 acceleration and jerk (a LIMIT_SHARE of each limit). Where a term that grows with
 the speed alone is over (q′σ̇, q″σ̇², q‴σ̇³) the speed cap is lowered there; where a
 term of the speed change is over (q′σ̈, q′σ⃛ + 3q″σ̇σ̈) the path acceleration and jerk
-of the stretch hosting that change are softened. q‴ is the σ-difference of the
-exact q″ on the rates' grid (this check only).
+of the stretch hosting that change are softened. q‴ is ``limit_use.with_jerk``'s (the
+σ-difference of the exact q″ on the rates' grid, unless ``joints.jerk_check`` set it).
 """
 
 from __future__ import annotations

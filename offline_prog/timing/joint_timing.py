@@ -40,12 +40,16 @@ class JointRates:
     Attributes:
         sigma: (G,) grid of the time law's parameter [m].
         q, dq, ddq: (G, 6) q(σ) [rad], q′ [rad/m], q″ [rad/m²].
+        dddq: (G, 6) q‴ [rad/m³] where known better than the σ-difference of q″
+            (``limit_use.with_jerk``; ``joints.jerk_check`` sets it from the exact
+            path), or None.
     """
 
     sigma: np.ndarray
     q: np.ndarray
     dq: np.ndarray
     ddq: np.ndarray
+    dddq: np.ndarray | None = None
 
     def at(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(q′, q″) linearly interpolated at σ (N,), each (N, 6)."""

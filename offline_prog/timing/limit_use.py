@@ -44,7 +44,11 @@ class Slowdown:
 
 
 def with_jerk(rates: JointRates) -> np.ndarray:
-    """(G, 6) q‴ [rad/m³]: the σ-difference of the exact q″ on the rates' grid."""
+    """(G, 6) q‴ [rad/m³]: ``rates.dddq`` if set, else the σ-difference of the exact q″
+    on the rates' grid (it smooths q‴'s peaks over a grid step: ``joints.jerk_check``
+    finds where that let the joints' jerk over its limit, and sets ``rates.dddq``)."""
+    if rates.dddq is not None:
+        return rates.dddq
     return np.gradient(rates.ddq, rates.sigma, axis=0)
 
 

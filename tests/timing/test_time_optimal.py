@@ -234,6 +234,23 @@ def csv_limit_use(plan) -> tuple[float, float, float]:
     )
 
 
+def fixed_turn_seal_text(max_jerk: float | None = None) -> str:
+    """The seal demo cell's text with the nozzle's turn fixed (no turn_smoothing_mm),
+    without its process model (no ``process:`` block, no ``tool.process_io``), and
+    with the path jerk cap ``max_jerk`` [m/s³] if given."""
+    from conftest import CELLS
+
+    text = (CELLS / "seal_plate_kr16.yaml").read_text()
+    text = re.sub(r"\n  turn_smoothing_mm: .*", "", text)
+    text = re.sub(r"\nprocess:.*\n  model: bead\n  bead: .*", "", text)
+    text = re.sub(r"\n  process_io:\n(    .*\n)+", "\n", text)
+    assert "model: bead" not in text and "process_io" not in text
+    if max_jerk is not None:
+        assert "  max_jerk: 10.0\n" in text
+        text = text.replace("  max_jerk: 10.0\n", f"  max_jerk: {max_jerk}\n")
+    return text
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("process", ["constant_speed", "cycle_time"])
 def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
@@ -244,8 +261,9 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
 
     from conftest import CELLS
 
-    # The nozzle's turn fixed (no tool.turn_smoothing_mm): the wrist's jerk binds.
-    text = re.sub(r"\n  turn_smoothing_mm: .*", "", (CELLS / "seal_plate_kr16.yaml").read_text())
+    # The nozzle's turn fixed (no tool.turn_smoothing_mm): the wrist's jerk binds. No
+    # process model: its dispenser caps the path jerk (tests/process); this is the law's.
+    text = fixed_turn_seal_text()
     fixed = CELLS / f"_test_fixed_turn_{process}.yaml"
     fixed.write_text(text)
     cell = CELLS / f"_test_time_optimal_{process}.yaml"
@@ -344,3 +362,63 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
     assert fastest <= duration <= 1.001 * fastest
     # The seal demo reaches its speed: report.json does not call its path short.
     assert json.loads((folder / "report.json").read_text())["motion"]["top_speed_reduced"] is False
+
+
+@pytest.mark.slow
+def test_low_path_jerk_cap_keeps_the_wrist_jerk_limit():
+    """With the path jerk capped low (1.5625 m/s³, as the bead's dispenser asks) the
+    fixed-turn seal cell's law slows where the path's q‴ peaks between the joint-rate
+    grid's points (a spline knot next to a corner): trajectory.csv's joint jerk stays
+    within the limit by finite differences (it was 1.022 of the wrist's limit, the
+    exact jerk 1.042, while the law's check said 0.97)."""
+    from offline_prog.plan import plan_cell
+
+    from conftest import CELLS
+
+    cell = CELLS / "_test_low_jerk_cap.yaml"
+    cell.write_text(
+        fixed_turn_seal_text(max_jerk=1.5625).replace(
+            "speed_reference: tcp",
+            "speed_reference: tcp\n  time_law: time_optimal\n  process: cycle_time",
+        )
+    )
+    try:
+        plan = plan_cell(cell)
+    finally:
+        cell.unlink()
+    assert max(csv_limit_use(plan)) <= 1.01
+    assert plan.joints.retiming.feasible
+
+
+def test_jerk_envelope_keeps_a_peak_between_grid_points():
+    """q‴ that rises to a peak and jumps down between two grid points: the grid's
+    σ-difference of q″ misses the peak, the envelope of the exact values does not,
+    for linear interpolation anywhere on the grid step."""
+    from offline_prog.joints.jerk_check import envelope
+    from offline_prog.timing.joint_timing import JointRates
+    from offline_prog.timing.limit_use import with_jerk
+
+    def third(s):  # rises linearly, then drops at the knot 0.0103 m
+        return np.where(s < 0.0103, 1e5 * s / 0.0103, 2e4)[:, None] * np.ones((1, 6))
+
+    fine = np.linspace(0.0, 0.02, 200001)
+    ddq = np.concatenate(
+        [
+            [np.zeros(6)],
+            np.cumsum(0.5 * (third(fine)[1:] + third(fine)[:-1]) * np.diff(fine)[:, None], axis=0),
+        ]
+    )
+    grid = np.linspace(0.0, 0.02, 41)  # 0.5 mm: the knot lies inside a step
+    rates = JointRates(
+        grid,
+        np.zeros((41, 6)),
+        np.zeros((41, 6)),
+        np.interp(grid, fine, ddq[:, 0])[:, None] * np.ones((1, 6)),
+    )
+    near = np.linspace(0.0095, 0.0110, 301)
+    grid_view = np.interp(near, grid, with_jerk(rates)[:, 0])
+    assert grid_view.max() < 0.96e5  # the peak smoothed away
+    local = (fine > 0.009) & (fine < 0.012)
+    raised = envelope(with_jerk(rates), grid, fine[local], third(fine[local]))
+    seen = np.interp(near, grid, raised[:, 0])
+    assert np.all(seen >= third(near)[:, 0] - 1.0)
