@@ -352,12 +352,18 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     plan = job.quality.column[rows]
     top = job.tcp_speed[rows].max()
     check = np.isfinite(plan) & (job.tcp_speed[rows] > 0.05 * top)
-    assert check.sum() > 0.9 * len(rows)
+    # The ramps from and to rest (longer under the dispenser's jerk cap) are the rest.
+    assert check.sum() > 0.8 * len(rows)
     # Within the band (and 5 % around it) the replay agrees within 1 %; on the ramps
     # from and to rest, far outside the band, a motion's one AO value is coarser than
     # the plan's continuous schedule (up to 6 % there): the same rows are outside.
     low, high = model.band[0] * model.unit_scale, model.band[1] * model.unit_scale
     near = check & (plan >= 0.95 * low) & (plan <= 1.05 * high)
+    # After the flow's idle edge the bead is the lag's decay from where the AO stopped:
+    # the program stops it at the planned sample nearest the plan's position (0.08 mm
+    # off here), a sample's shift of that decay; the share below still counts it.
+    (stop,) = [e for e in job.io.events if e.signal.value == "analog" and not e.state]
+    near &= s.t[rows] < stop.t_s
     assert near.sum() > 0.7 * len(rows)  # a 240 mm stripe: its ramps are a fifth of it
     np.testing.assert_allclose(bead[rows][near], plan[near], rtol=0.01)
     inside_plan = (plan >= low) & (plan <= high)

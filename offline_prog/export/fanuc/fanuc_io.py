@@ -12,9 +12,9 @@ chain of ``L`` points (approach, seam, retract) is split at planned samples unti
 - every motion holds at most one digital event: where two fall on one motion, the
   first planned sample at or after the earlier one becomes an ``L`` point;
 - while the flow is live, the plan's flow (the ``ao`` column: the flow at the speed the
-  tool has ``lag_s`` later) varies by at most ``FLOW_STEP_V`` on a motion (where the
-  tool speeds up or slows down, a planned sample starts a new motion), and the motion's
-  value is the middle of that range.
+  tool has ``lag_s`` later) varies by at most ``FLOW_STEP_V`` and ``FLOW_STEP_SHARE`` of
+  its value on a motion (where the tool speeds up or slows down, a planned sample starts
+  a new motion), and the motion's value is the middle of that range.
 
 Every inserted point is a planned sample (trajectory.csv's rows on the approach and
 retract, the seam's densified samples on the seam), so the program still moves through
@@ -33,6 +33,7 @@ from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
 FLOW_STEP_V = 0.05  # a live motion's AO value is within half this of the plan's flow on it
+FLOW_STEP_SHARE = 0.01  # ... and within half this share of it (a low flow on a ramp)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -145,7 +146,8 @@ def _flow(samples, a, b, edges, io, flow_at) -> float | None:
 
 
 def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
-    """Points split so the plan's flow varies by at most FLOW_STEP_V on a live motion."""
+    """Points split so the plan's flow varies by at most FLOW_STEP_V, and by at most
+    FLOW_STEP_SHARE of its value, on a live motion."""
     out = [points[0]]
     for a, b in zip(points, points[1:], strict=False):
         if _live(samples, a, edges):
@@ -154,7 +156,8 @@ def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[in
             for k in range(1, len(values)):
                 span = values[start : k + 1]
                 moved = samples.sigma[a + k - 1] - samples.sigma[out[-1]] > SAME_POINT_M
-                if span.max() - span.min() > FLOW_STEP_V and k - 1 > start and moved:
+                step = min(FLOW_STEP_V, FLOW_STEP_SHARE * span.max())
+                if span.max() - span.min() > step and k - 1 > start and moved:
                     start = k - 1  # no L motion of zero length: at rest the flow waits
                     out.append(a + start)
         out.append(b)
