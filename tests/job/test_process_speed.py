@@ -5,31 +5,23 @@ nothing written. The demo sealing job with a bead model whose flow keys the bead
 import numpy as np
 import pytest
 from bead_job import bead_job
-
-from offline_prog.cli import main
+from config.test_cell_errors import BASE
+from test_job_errors import run
 
 from conftest import CELLS
 
 JOB = (CELLS / "seal_job_kr16.yaml").read_text()
 BEAD_JOB = bead_job()
-PATH = """\
-name: one_seam
-robot:
-  model: kuka_kr16_2
-  X_IB: {translation: [0, 0, 0], rotation: !Rpy {deg: [0, 0, 0]}}
-tool:
-  X_IT: {translation: [1.0, 0, 0.5], rotation: !Rpy {deg: [90, 0, 0]}}
-part:
-  X_PE: {translation: [0, 0, 0.1], rotation: !Rpy {deg: [180, 0, 0]}}
-path:
-  analytic: {kind: line, start: [-100, 0, 0], end: [100, 0, 0]}
-  units: mm
-  normal: [0, 0, 1]
-motion:
-  speed: SPEED
-  max_acceleration: 1.0
-  max_jerk: 10.0
-"""
+# The one-seam cell of the cell-file tests, on a 200 mm line at SPEED.
+PATH = (
+    BASE.replace("name: test", "name: one_seam")
+    .replace(
+        "  points: path.csv\n  units: mm\n  closed: false\n",
+        "  analytic: {kind: line, start: [-100, 0, 0], end: [100, 0, 0]}\n  units: mm\n",
+    )
+    .replace("speed: 0.1", "speed: SPEED")
+)
+assert "analytic" in PATH and "SPEED" in PATH
 TAPE = """\
 process:
   model: tape_heating
@@ -49,14 +41,6 @@ process:
   model: heat_input
   heat_input: {voltage_v: 24.0, current_a: 180.0, efficiency: 0.8, target_kj_mm: [0.5, 0.7]}
 """
-
-
-def run(tmp_path, text, capsys):
-    cell = tmp_path / "cell.yaml"
-    cell.write_text(text)
-    out = tmp_path / "out"
-    code = main(["plan", str(cell), "--out", str(out)])
-    return code, capsys.readouterr().err, out
 
 
 @pytest.mark.parametrize(
