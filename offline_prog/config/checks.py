@@ -57,10 +57,11 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
         raise _error(file, "seams", "give exactly one of path (one seam) or seams (a job)")
     for key, path in seam_keys(cell):
         _check_path(file, key, path, cell)
-    check_job(file, cell)
+    # The process model first: it decides which of the flow's keys the cell gives.
     check_process(
         file, cell.process, None if cell.tool.process_io is None else cell.tool.process_io.flow
     )
+    check_job(file, cell)
     for key, value in (
         ("motion.speed", motion.speed),
         ("motion.max_acceleration", motion.max_acceleration),

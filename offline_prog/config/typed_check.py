@@ -95,7 +95,12 @@ def _check_value(file, key, raw, schema):
     if not expected(raw):
         hint = ""
         if schema is float and isinstance(raw, str) and _is_float_text(raw):
-            hint = f" (YAML reads {raw} as text: write {float(raw):.1e})"
+            value = float(raw)
+            hint = (
+                f" (YAML reads {raw} as text: write {value:.1e})"
+                if math.isfinite(value)
+                else f" (YAML reads {raw} as text; it is not a finite number)"
+            )
         raise InputError(file, key, f"expected {schema.__name__}, got {short_repr(raw)}{hint}")
     if schema is float and not math.isfinite(raw):
         raise InputError(file, key, f"{raw} is not a finite number")

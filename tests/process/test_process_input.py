@@ -44,6 +44,10 @@ BAD = [
     (TAPE, "thickness_mm: 0.2", "thickness_mm: -0.2", "process.tape_heating.thickness_mm"),
     (TAPE, "max_power_w: 3000", "max_power_w: 0", "process.tape_heating.max_power_w"),
     (TAPE, "w_per_unit: 300", "w_per_unit: 0", "process.tape_heating.power_output.w_per_unit"),
+    # The model is checked before the flow keys it decides (not "flow.per_mps missing").
+    (SEAL, "model: bead", "model: beads", "process.model"),
+    (SEAL, "model: bead", "model: heat_input", "process.heat_input"),
+    (SEAL, "area_mm2: 12.0", "area_mm2: .nan", "process.bead.area_mm2"),
 ]
 
 
@@ -83,3 +87,15 @@ def test_the_flows_own_lag_is_named_without_a_bead(capsys, tmp_path):
     io = "tool:\n  process_io:\n    flow: {analog_output: 1, per_mps: 40.0, lag_s: 1.0}\n"
     code, err = plan(capsys, tmp_path, with_own_io(SEAL, io))
     assert code == 2 and len(err) == 1 and ": tool.process_io.flow.lag_s: " in err[0], err
+
+
+@pytest.mark.parametrize(
+    ("written", "hint"),
+    [("nan", "not a finite number"), ("1e400", "not a finite number"), ("1e3", "write 1.0e+03")],
+)
+def test_a_number_yaml_reads_as_text_gets_a_true_hint(capsys, tmp_path, written, hint):
+    """YAML 1.2 reads nan, 1e400 and 1e3 as text: the line says what to write, and never
+    suggests writing the same text again."""
+    code, err = plan(capsys, tmp_path, SEAL.replace("area_mm2: 12.0", f"area_mm2: {written}", 1))
+    assert code == 2 and len(err) == 1 and hint in err[0], err
+    assert f"write {written})" not in err[0]
