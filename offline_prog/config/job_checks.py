@@ -107,6 +107,7 @@ def check_job(file: Path, cell: Cell) -> None:
 # The process outputs each controller family can have (its own numbering):
 # KUKA KSS 8: $OUT[1..4096], $ANOUT[1..32]; UR e-Series: standard digital out 0..7,
 # standard analog out 0..1; ABB: signals named do<n> / ao<n> in the I/O configuration.
+IO_PARTS = ("on", "off", "flow")  # tool.process_io's outputs
 OUTPUT_RANGES = {
     "krl": {"digital_output": (1, 4096), "analog_output": (1, 32)},
     "urscript": {"digital_output": (0, 7), "analog_output": (0, 1)},
@@ -140,25 +141,24 @@ def _check_leads(file: Path, cell: Cell, io) -> None:
 
 
 def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
-    """The process output numbers exist on the robot's controller (``OUTPUT_RANGES``)."""
+    """The process output numbers exist on the robot's controller (``OUTPUT_RANGES``):
+    ``tool.process_io``'s and the tape heater's ``power_output``."""
     io = cell.tool.process_io
-    if io is None:
-        return
+    outputs = [] if io is None else [(f"tool.process_io.{n}", getattr(io, n)) for n in IO_PARTS]
+    tape = cell.process.tape_heating if cell.process is not None else None
+    if tape is not None and cell.process.model == "tape_heating":
+        outputs.append(("process.tape_heating.power_output", tape.power_output))
     ranges = OUTPUT_RANGES.get(language, {"digital_output": (0, 9999), "analog_output": (0, 9999)})
-    for name, kind in (
-        ("on", "digital_output"),
-        ("off", "digital_output"),
-        ("flow", "analog_output"),
-    ):
-        part = getattr(io, name)
+    for key, part in outputs:
         if part is None:
             continue
+        kind = "digital_output" if hasattr(part, "digital_output") else "analog_output"
         low, high = ranges[kind]
         number = getattr(part, kind)
         if not low <= number <= high:
             raise _error(
                 file,
-                f"tool.process_io.{name}.{kind}",
+                f"{key}.{kind}",
                 f"{number} is not an output of the robot's {language or 'controller'} "
                 f"controller (use {low}..{high})",
             )

@@ -45,6 +45,13 @@ BAD = [
     (TAPE, "max_power_w: 3000", "max_power_w: 0", "process.tape_heating.max_power_w"),
     (TAPE, "w_per_unit: 300", "w_per_unit: 0", "process.tape_heating.power_output.w_per_unit"),
     # The model is checked before the flow keys it decides (not "flow.per_mps missing").
+    # A UR has standard analog outputs 0 and 1: the heater's output is checked like the flow's.
+    (
+        TAPE,
+        "analog_output: 1, w_per_unit",
+        "analog_output: 2, w_per_unit",
+        "process.tape_heating.power_output.analog_output",
+    ),
     (SEAL, "model: bead", "model: beads", "process.model"),
     (SEAL, "model: bead", "model: heat_input", "process.heat_input"),
     (SEAL, "area_mm2: 12.0", "area_mm2: .nan", "process.bead.area_mm2"),
