@@ -29,6 +29,10 @@ CUSP_PEAK_RATIO = 3.0
 # Length units a cell file may use, in metres per unit.
 UNIT_SCALE = {"m": 1.0, "mm": 1e-3}
 
+# Below this TCP speed the tool stands: a bead's cross-section, a weld's heat input and
+# a tape's nip temperature (per metre of path) are not defined there [m/s].
+STANDSTILL_SPEED_M_S = 1e-4
+
 # Input limits: no hang and no runaway memory on a hostile or mistaken input. Each is
 # named here once; the message that enforces it quotes it.
 MAX_CELL_FILE_BYTES = 1_000_000  # a cell file is a few kB; larger is not a cell file

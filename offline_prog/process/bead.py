@@ -22,9 +22,8 @@ import dataclasses
 
 import numpy as np
 
+from offline_prog.process import per_metre
 from offline_prog.process.lag import first_order_response
-
-MIN_SPEED_M_S = 1e-4  # below it the bead's cross-section is not defined (a standstill)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,8 +67,7 @@ class BeadModel:
             (N,) A = k · y / v [m²], NaN where the tool stands (v < 0.1 mm/s).
         """
         flow = self.flow_m3_s_per_unit * first_order_response(t, command, self.lag_s)
-        v = np.asarray(v_tcp, float)
-        return np.where(v >= MIN_SPEED_M_S, flow / np.maximum(v, MIN_SPEED_M_S), np.nan)
+        return per_metre(flow, v_tcp)
 
     def speed_band(self, u_min: float, u_max: float) -> tuple[float, float]:
         """TCP speeds [m/s] at which the output within [u_min, u_max] can give A*:

@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-MIN_SPEED_M_S = 1e-4  # below it the heat input is not defined (a standstill)
+from offline_prog.process import per_metre
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,8 +41,7 @@ class HeatInputModel:
     def predict(self, t: np.ndarray, v_tcp: np.ndarray, command=None) -> np.ndarray:
         """(N,) heat input H = k U I / v [J/m] at TCP speeds v_tcp (N,) [m/s]; NaN where
         the tool stands. ``t`` and ``command`` are unused (no dynamics, no output)."""
-        v = np.asarray(v_tcp, float)
-        return np.where(v >= MIN_SPEED_M_S, self.arc_power_w / np.maximum(v, MIN_SPEED_M_S), np.nan)
+        return per_metre(np.full(np.shape(v_tcp), self.arc_power_w), v_tcp)
 
     def speed_band(self, u_min: float = 0.0, u_max: float = 0.0) -> tuple[float, float]:
         """TCP speeds [m/s] that give a heat input within the band: kUI/H_high .. kUI/H_low."""

@@ -11,7 +11,7 @@ Only the process stretches count (the rows of each seam's ``process`` segment). 
 a row is *dispensing* when the output is on and (bead, tape) its lagged flow or power is
 positive; elsewhere the quality column is NaN. The share within the band is weighted by
 path length (trapezoid weights from ``path_m``), over the dispensing length. A row
-where the tool stands (v below the model's ``MIN_SPEED_M_S``) while dispensing is out of
+where the tool stands (v below ``constants.STANDSTILL_SPEED_M_S``) while dispensing is out of
 the band (the bead piles up, the weld overheats) and NaN in the column, unless the
 output follows the speed to rest (the heater: no power, nothing dispensed).
 
@@ -42,8 +42,9 @@ import dataclasses
 
 import numpy as np
 
+from offline_prog.constants import STANDSTILL_SPEED_M_S
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
-from offline_prog.process.bead import MIN_SPEED_M_S, BeadModel
+from offline_prog.process.bead import BeadModel
 from offline_prog.process.heat_input import HeatInputModel
 from offline_prog.process.lag import first_order_response
 from offline_prog.process.tape_heating import TapeHeatingModel
@@ -216,12 +217,12 @@ def _values(model, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]
         if command is None:
             raise ValueError(f"process model {NAMES[type(model)]} needs its output's command")
         values = model.predict(t, v, command)
-        at_rest = float(settings.flow(MIN_SPEED_M_S))
+        at_rest = float(settings.flow(STANDSTILL_SPEED_M_S))
         if isinstance(model, BeadModel):
             amount = first_order_response(t, command, model.lag_s)
         else:
             amount = np.asarray(command, float)
-    slow = v < MIN_SPEED_M_S
+    slow = v < STANDSTILL_SPEED_M_S
     dispensing = on & (amount > 0) & ~(slow & (amount <= at_rest + SATURATION_TOL))
     values = np.where(dispensing & slow, np.inf, values)
     return values, dispensing
@@ -276,7 +277,7 @@ def _cause_rows(model, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
             limit = min(limit, model.max_command)
         saturated = (law > limit + SATURATION_TOL) | (law < settings.min - SATURATION_TOL)
     return {
-        "standstill": v < MIN_SPEED_M_S,
+        "standstill": v < STANDSTILL_SPEED_M_S,
         "output saturated": saturated,
         "start ramp": on & from_rest[seam] & (index < ramp_up_end[seam]),
         "end ramp": on & to_rest[seam] & (index > ramp_down_start[seam]),

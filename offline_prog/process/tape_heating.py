@@ -26,7 +26,7 @@ import dataclasses
 
 import numpy as np
 
-MIN_SPEED_M_S = 1e-4  # below it the tape stands under the heater: not defined
+from offline_prog.process import per_metre
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,14 +75,9 @@ class TapeHeatingModel:
     def predict(self, t: np.ndarray, v_tcp: np.ndarray, command: np.ndarray) -> np.ndarray:
         """(N,) nip temperature [°C] from the power output ``command`` (N,) [unit] at TCP
         speeds v_tcp (N,) [m/s]; NaN where the tape stands. ``t`` is unused."""
-        v = np.asarray(v_tcp, float)
         power = np.clip(np.asarray(command, float) * self.w_per_unit, 0.0, self.max_power_w)
-        rise = (
-            self.absorbed_fraction
-            * power
-            / (self.heat_capacity_j_k_m * np.maximum(v, MIN_SPEED_M_S))
-        )
-        return np.where(v >= MIN_SPEED_M_S, self.ambient_c + rise, np.nan)
+        heat = per_metre(self.absorbed_fraction * power, v_tcp)  # [J/m]
+        return self.ambient_c + heat / self.heat_capacity_j_k_m
 
     def speed_band(self, u_min: float = 0.0, u_max: float | None = None) -> tuple[float, float]:
         """TCP speeds [m/s] at which the heater can reach the band's low end:
