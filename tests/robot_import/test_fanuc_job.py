@@ -74,22 +74,27 @@ def fanuc_job(tmp_path_factory):
     return JobProgramData.load(work / "out"), work / "out" / "programs", job.robot, cell
 
 
+def _stripe_job() -> tuple[str, str]:
+    """The seal job on the M-20iA cut to its stripe, run forward in the given order:
+    (the text before ``seams:``, to edit; the rest from ``seams:`` on)."""
+    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    head, rest = text.split("seams:", 1)
+    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
+    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
+    return head, "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
+
+
 @pytest.fixture(scope="module")
 def stripe(tmp_path_factory):
     """(JobProgramData, plan folder, robot) of the stripe with on.lead_mm −100."""
     work = tmp_path_factory.mktemp("fanuc_stripe")
     _m20ia(work)
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
-    head, rest = text.split("seams:", 1)
-    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
-    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
+    head, seams = _stripe_job()
     head = head.replace("lead_mm: 5}", f"lead_mm: {ON_LEAD_MM}}}")
     head = head.replace("lead_mm: 2}", f"lead_mm: {OFF_LEAD_MM}}}")
     head = head.replace("min: 0.0, max: 10.0}", f"min: 0.0, max: 10.0, lag_s: {LAG_S}}}")
     cell = work / "stripe.yaml"
-    cell.write_text(
-        head + "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
-    )
+    cell.write_text(head + seams)
     io = load_cell(cell).tool.process_io
     assert (io.on.lead_mm, io.off.lead_mm, io.flow.lag_s) == (ON_LEAD_MM, OFF_LEAD_MM, LAG_S)
     assert (io.flow.per_mps, io.flow.offset) == (PER_MPS, OFFSET_V)
@@ -308,19 +313,14 @@ def bead_stripe(tmp_path_factory):
     sealing demo's bead (issue 28): the flow's gain and lead are the bead model's."""
     work = tmp_path_factory.mktemp("fanuc_bead")
     _m20ia(work)
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
-    head, rest = text.split("seams:", 1)
-    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
-    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
+    head, seams = _stripe_job()
     head = head.replace("per_mps: 40.0, offset: 0.5, ", "")
     bead = (
         "process:\n  model: bead\n"
         "  bead: {area_mm2: 12.0, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
     )
     cell = work / "bead.yaml"
-    cell.write_text(
-        bead + head + "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
-    )
+    cell.write_text(bead + head + seams)
     job = plan_job(cell)
     assert job.feasible, job.failure
     write_job_outputs(job, work / "plan")
