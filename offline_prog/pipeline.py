@@ -36,13 +36,13 @@ from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.job.home import home_pose
 from offline_prog.job.stages import (
     check_job,
-    choose_order,
     job_clearance,
     job_io,
     job_quality,
     link_job,
     seam_options,
 )
+from offline_prog.job.untimed import timed_order
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.process_frames import NormalTangentError
 from offline_prog.stages import (
@@ -105,13 +105,13 @@ JOB_STAGES = (
         seam_options,
         ("inputs", "scene", "seam_planner", "progress"),
     ),
-    Stage("order", "ordering the seams", choose_order, ("inputs", "seams", "home", "progress")),
     Stage(
-        "links",
-        "linking moves",
-        link_job,
-        ("inputs", "scene", "seams", "order", "home", "progress"),
+        "order",
+        "ordering the seams and timing the chosen ones",
+        timed_order,
+        ("inputs", "scene", "seams", "home", "seam_planner", "progress"),
     ),
+    Stage("links", "linking moves", link_job, ("inputs", "scene", "order", "home", "progress")),
     Stage("io", "process I/O", job_io, ("inputs", "links")),
     Stage("quality", "process quality", job_quality, ("inputs", "links", "io")),
     Stage("check", "collision check of the whole job", check_job, ("inputs", "scene", "links")),

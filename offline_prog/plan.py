@@ -34,7 +34,6 @@ from offline_prog.collision.profile import distance_profile
 from offline_prog.config.edits import CellValues
 from offline_prog.errors import PlanFailedError
 from offline_prog.job.records import JobPlan, Plan
-from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.pipeline import (
     JOB_CLEARANCE,
     JOB_STAGES,
@@ -118,30 +117,24 @@ def plan_seam(
         raise with_normal_hint(error, inputs, results["fit"], results["scene"]) from None
     fit, flanges, scene = results["fit"], results["frames"], results["scene"]
     chosen, avoidance = results["collision"]
-    traj = chosen.joints.trajectory
     profile = None
     if clearance_profile:
         profile = stage(
-            "clearance", "clearance profile", distance_profile, scene, chosen.joints.q, traj.t
+            "clearance",
+            "clearance profile",
+            distance_profile,
+            scene,
+            chosen.joints.q,
+            chosen.joints.trajectory.t,
         )
-    return Plan(
-        inputs.file,
-        inputs.cell,
-        inputs.points,
-        fit.fitted,
-        fit.path,
-        chosen.flange,
-        traj,
-        flanges.cusps,
-        stage.timings_s,
-        inputs.robot,
-        chosen.joints,
-        without_joint_limits(chosen.nominal, inputs.cell.motion.time_law)[0],
-        chosen.rotation,
-        chosen.collisions,
-        avoidance,
-        profile,
-        fit.normal_fit,
+    return Plan.of_attempt(
+        inputs,
+        fit,
+        flanges,
+        chosen,
+        timings_s=stage.timings_s,
+        avoidance=avoidance,
+        clearance_profile=profile,
     )
 
 
@@ -180,29 +173,19 @@ def plan_loaded_job(
             not change with the placement).
     """
     fits = {} if fits is None else fits
-
-    def one_seam(k: int, reverse: bool, seam_inputs: Inputs, seam_scene: DrakeCell) -> Plan:
-        results = {"scene": seam_scene}
-        if (k, reverse) in fits:
-            results["fit"] = fits[k, reverse]
-        plan = plan_seam(
-            seam_inputs, StageTimer(stage.progress), results=results, clearance_profile=False
-        )
-        fits[k, reverse] = results["fit"]
-        return plan
-
     stages = JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ())
-    results = {"inputs": inputs, "progress": stage.progress, "seam_planner": one_seam}
+    planner = SeamPlanner(stage.progress, fits)
+    results = {"inputs": inputs, "progress": stage.progress, "seam_planner": planner}
     run_stages(stages, results, stage)
-    linked = results["links"]
+    linked, timed = results["links"], results["order"]
     return JobPlan(
         inputs.file,
         inputs.cell,
         inputs.robot,
         results["home"],
-        results["seams"],
+        timed.options,
         linked.chosen,
-        results["order"],
+        timed.order,
         linked.links,
         linked.samples,
         linked.tcp_speed,
@@ -212,3 +195,34 @@ def plan_loaded_job(
         results.get("clearance"),
         results["quality"],
     )
+
+
+class SeamPlanner:
+    """One seam in one direction for the job's stages, by the one-seam pipeline: its
+    fit and frames alone (:meth:`geometry`), or its whole plan (called), each seam
+    direction's stage timings in one StageTimer. Keeps each fit in ``fits``
+    ((seam index, reversed) ↦ FittedPath)."""
+
+    def __init__(self, progress: Callable[[str], None], fits: dict):
+        self.progress, self.fits = progress, fits
+        self.timers: dict[tuple[int, bool], StageTimer] = {}
+
+    def geometry(self, k: int, reverse: bool, inputs: Inputs, scene: DrakeCell) -> dict:
+        """{fit, frames} of seam k in one direction (SEAM_STAGES' fit, frames)."""
+        results = {"scene": scene, "inputs": inputs, "progress": self.progress}
+        if (k, reverse) in self.fits:
+            results["fit"] = self.fits[k, reverse]
+        run_stages(SEAM_STAGES[:2], results, self.timer(k, reverse))
+        self.fits[k, reverse] = results["fit"]
+        return {name: results[name] for name in ("fit", "frames")}
+
+    def timer(self, k: int, reverse: bool) -> StageTimer:
+        """The StageTimer of seam k in one direction (its plan's ``timings_s``)."""
+        return self.timers.setdefault((k, reverse), StageTimer(self.progress))
+
+    def __call__(
+        self, k: int, reverse: bool, inputs: Inputs, scene: DrakeCell, *, known: dict
+    ) -> Plan:
+        """Seam k's plan in one direction, from the stages' results ``known``."""
+        results = {"scene": scene, **known}
+        return plan_seam(inputs, self.timer(k, reverse), results=results, clearance_profile=False)

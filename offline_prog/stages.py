@@ -32,11 +32,11 @@ from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn
 from offline_prog.process.model import process_model
-from offline_prog.process.timing_bound import process_caps
+from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.time_law import sin2_time_law
+from offline_prog.timing.time_law import Sin2TimeLaw, sin2_time_law
 from offline_prog.timing.trajectory import TimeLawParameter
 
 # Grid spacing for the checks of the fitted path [m] and the largest tangent turn
@@ -226,6 +226,41 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
+    run = motion_setup(inputs, flange)
+    motion = inputs.cell.motion
+    joints = plan_joint_trajectory(
+        inputs.robot,
+        inputs.X_IB,
+        run.flange,
+        run.parameter,
+        run.nominal,
+        rate_hz=motion.sample_rate_hz,
+        branch=branch,
+        time_law=motion.time_law,
+        process=motion.process,
+        process_caps=run.caps,
+    )
+    return Attempt(rotation, run.flange, run.nominal, joints, None)
+
+
+@dataclasses.dataclass(frozen=True)
+class MotionSetup:
+    """What :func:`plan_motion` runs on: the flange path as run (cusps smoothed when
+    ``motion.cusp_smoothing_mm`` is set), σ ↦ s, the path caps and the nominal law."""
+
+    flange: FlangePath | SmoothedFlangePath
+    parameter: TimeLawParameter
+    caps: ProcessCaps
+    nominal: Sin2TimeLaw
+
+
+def motion_setup(inputs: Inputs, flange) -> MotionSetup:
+    """The flange path as run, its parameter, caps and nominal law (:class:`MotionSetup`).
+
+    Raises:
+        InputError: ``motion.cusp_smoothing_mm`` that does not fit the path, or a plan of
+            more than MAX_SAMPLES samples.
+    """
     motion = inputs.cell.motion
     if motion.cusp_smoothing_mm is not None:
         try:
@@ -251,19 +286,7 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
             f" is {samples:,.0f} samples, more than {MAX_SAMPLES:,}; raise motion.speed or "
             "lower motion.sample_rate_hz",
         )
-    joints = plan_joint_trajectory(
-        inputs.robot,
-        inputs.X_IB,
-        flange,
-        parameter,
-        nominal,
-        rate_hz=motion.sample_rate_hz,
-        branch=branch,
-        time_law=motion.time_law,
-        process=motion.process,
-        process_caps=caps,
-    )
-    return Attempt(rotation, flange, nominal, joints, None)
+    return MotionSetup(flange, parameter, caps, nominal)
 
 
 def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:

@@ -150,3 +150,44 @@ def cartesian_move(
 def _fail(kind: str, seam: str, t: np.ndarray, i: int, reason: str, failure: Failure) -> None:
     message = f"{reason} ({kind} of seam {seam}, t = {t[i]:.3f} s into it)"
     raise PlanFailedError(PlanFailure(failure, 0.0, float(t[i]), message))
+
+
+def seam_ends(
+    inputs, flange, length_m: float, q_ends: np.ndarray, branch: int, seam
+) -> tuple[CartesianMove | None, CartesianMove | None]:
+    """The approach to a seam's first sample and the retract from its last.
+
+    Args:
+        inputs: the seam's ``stages.Inputs``; seam: its ``SeamConfig``.
+        flange: the seam's flange path as run; length_m: its path length [m].
+        q_ends: (2, 6) joints at σ = 0 and at the end [rad]; branch: their IK branch.
+
+    Raises:
+        PlanFailedError: a move the robot cannot make (kind, seam and why).
+    """
+    motion = inputs.cell.motion
+    R_PE = inputs.X_PE.rotation().matrix()
+    ends = flange(np.array([0.0, length_m]))
+    moves = []
+    for kind, i, spec in (("approach", 0, seam.approach), ("retract", -1, seam.retract)):
+        moves.append(
+            cartesian_move(
+                inputs.robot,
+                X_IB=inputs.X_IB,
+                kind=kind,
+                seam=seam.name,
+                spec=spec,
+                p_PF=ends.p_PF[i],
+                R_PF=ends.R_PF[i],
+                p_IE=ends.p_IE[i],
+                R_IE=ends.R_IE[i],
+                R_PE=R_PE,
+                q_seam=q_ends[i],
+                branch=branch,
+                speed=motion.speed,
+                a_max=motion.max_acceleration,
+                j_max=motion.max_jerk,
+                rate_hz=motion.sample_rate_hz,
+            )
+        )
+    return moves[0], moves[1]

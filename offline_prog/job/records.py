@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.check import CollisionResult
 from offline_prog.config.cell import Cell
 from offline_prog.errors import Failure
@@ -21,6 +22,7 @@ from offline_prog.job.links import LinkMotion
 from offline_prog.job.order import JobOrder
 from offline_prog.job.process_io import IoColumns
 from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
@@ -29,6 +31,7 @@ from offline_prog.path.inputs import NormalFit
 from offline_prog.path.sources import PathPoints
 from offline_prog.process.quality import ProcessQuality
 from offline_prog.robot.model import RobotModel
+from offline_prog.stages import FittedPath, FlangePaths, Inputs
 from offline_prog.timing.trajectory import WorkspaceTrajectory
 
 
@@ -55,6 +58,39 @@ class Plan:
     clearance_profile: tuple | None = None
     normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
 
+    @classmethod
+    def of_attempt(
+        cls,
+        inputs: Inputs,
+        fit: FittedPath,
+        flanges: FlangePaths,
+        chosen: Attempt,
+        *,
+        timings_s: dict[str, float],
+        avoidance: dict | None = None,
+        clearance_profile: tuple | None = None,
+    ) -> Plan:
+        """The plan of a seam whose joints are ``chosen`` (a checked attempt)."""
+        return cls(
+            inputs.file,
+            inputs.cell,
+            inputs.points,
+            fit.fitted,
+            fit.path,
+            chosen.flange,
+            chosen.joints.trajectory,
+            flanges.cusps,
+            timings_s,
+            inputs.robot,
+            chosen.joints,
+            without_joint_limits(chosen.nominal, inputs.cell.motion.time_law)[0],
+            chosen.rotation,
+            chosen.collisions,
+            avoidance,
+            clearance_profile,
+            fit.normal_fit,
+        )
+
     @property
     def feasible(self) -> bool:
         """Every check passed (collision-free at the clearance)."""
@@ -72,30 +108,66 @@ class Plan:
         return None if self.feasible else Failure.COLLISION
 
 
+@dataclasses.dataclass(frozen=True)
+class UntimedSeam:
+    """A seam option decided before its time law (``job.untimed``): the path IK on its
+    branch follows the whole path within the joint limits and the path is collision-free
+    at the clearances; the time law runs only if the order chooses it.
+
+    Attributes:
+        inputs: the seam's inputs in its direction; fit, frames: its stages' results.
+        rotation: the tool's turn about its symmetry axis [rad]; flange: the flange path
+            the time law gets (``stages.plan_motion``); branch: the IK branch.
+        q_ends: (2, 6) joints at σ = 0 and at the path's end [rad], as the timed plan has
+            them.
+        first: the direction's first option (best rotation and branch); the others
+            are the further branches offered beside it.
+    """
+
+    inputs: Inputs
+    fit: FittedPath
+    frames: FlangePaths
+    rotation: float
+    flange: FlangePath | SmoothedFlangePath
+    branch: int
+    q_ends: np.ndarray
+    first: bool
+
+
 @dataclasses.dataclass
 class SeamOption:
-    """One way to run a seam: its plan in one direction, the approach and retract, and
+    """One way to run a seam: its plan in one direction (None while ``untimed``: the
+    time law runs for the options the order chooses), the approach and retract, and
     the link ends q_in / q_out (6,) [rad]."""
 
     seam: int
     name: str
     reverse: bool
-    plan: Plan
+    plan: Plan | None
     approach: CartesianMove | None
     retract: CartesianMove | None
+    untimed: UntimedSeam | None = None
+
+    @property
+    def branch(self) -> int:
+        return self.untimed.branch if self.plan is None else self.plan.joints.branch
 
     @property
     def q_in(self) -> np.ndarray:
-        return self.approach.q[0] if self.approach else self.plan.joints.q[0]
+        if self.approach:
+            return self.approach.q[0]
+        return self.untimed.q_ends[0] if self.plan is None else self.plan.joints.q[0]
 
     @property
     def q_out(self) -> np.ndarray:
-        return self.retract.q[-1] if self.retract else self.plan.joints.q[-1]
+        if self.retract:
+            return self.retract.q[-1]
+        return self.untimed.q_ends[1] if self.plan is None else self.plan.joints.q[-1]
 
     @property
     def label(self) -> str:
         direction = "reverse" if self.reverse else "forward"
-        return f"{self.name} {direction} branch {self.plan.joints.branch}"
+        return f"{self.name} {direction} branch {self.branch}"
 
 
 @dataclasses.dataclass

@@ -15,10 +15,9 @@ from offline_prog.collision.check import CollisionResult, check_trajectory
 from offline_prog.collision.motion import MotionChecker
 from offline_prog.collision.profile import distance_profile
 from offline_prog.errors import InputError, PlanFailedError
-from offline_prog.job.approach import CartesianMove, cartesian_move
+from offline_prog.job.approach import CartesianMove, seam_ends
 from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
-from offline_prog.job.order import JobOrder, order_job
 from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
 from offline_prog.job.process_speed import check_speed_bands
 from offline_prog.job.records import SeamOption
@@ -29,20 +28,27 @@ from offline_prog.job.seams import (
     seam_inputs,
     seam_key,
 )
+from offline_prog.job.untimed import (
+    MAX_OTHER_BRANCHES,
+    SeamChoices,
+    TimedOrder,
+    untimed_options,
+)
 from offline_prog.process.model import process_model
 from offline_prog.process.quality import ProcessQuality, process_quality
 from offline_prog.progress import Step
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs, attempt_motion
 
-MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
 
 
-def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[list[SeamOption]]:
-    """Each seam planned in each direction it may run (``direction``), with approach and
-    retract. A direction the robot cannot do is dropped when the other one works.
-    ``plan_seam(k, reverse, seam_inputs, scene)`` plans seam k in one direction.
+def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamChoices:
+    """Each seam's options in each direction it may run (``direction``), with approach
+    and retract, decided before their time law where the path IK and a collision check
+    decide them (``job.untimed``), else planned in full. A direction the robot cannot do
+    is dropped when the other one works. ``plan_seam(k, reverse, seam_inputs, scene,
+    known=...)`` plans seam k in one direction from the stages' results it is given.
 
     Raises:
         InputError: naming ``seams[k].<key>`` (a process speed outside the process
@@ -50,38 +56,62 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> list[
         PlanFailedError: a seam cannot be done in any direction (its reason, named).
     """
     check_speed_bands(inputs)
-    options, seams = [], job_seams(inputs.cell)
+    options, errors, seams = [], [], job_seams(inputs.cell)
     for k, seam in enumerate(seams):
         directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]
-        found, errors = [], []
+        found, failed = [], {}
         for reverse in directions:
             text = f"seam {k + 1}/{len(seams)}: {seam.name} ({'reverse' if reverse else 'forward'})"
             progress(Step(text, stage="seams", done=k, total=len(seams)))
             try:
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
-                    plan = plan_seam(k, reverse, seam_in, scene)
-                    # A path: cell's one seam keeps the branch its pipeline chose (the
-                    # plan as before issue 24, not planned again on other branches).
-                    others = _other_branches(seam_in, scene, plan) if inputs.cell.seams else []
-                    for variant in [plan, *others]:
-                        try:
-                            approach, retract = _ends(seam_in, variant, seam)
-                        except PlanFailedError:
-                            if variant is plan:
-                                raise
-                            continue  # this branch cannot approach or retract
-                        found.append(SeamOption(k, seam.name, reverse, variant, approach, retract))
+                    found += _direction_options(inputs, seam_in, scene, plan_seam, k, reverse, seam)
             except PlanFailedError as error:
-                errors.append(error)
+                failed[reverse] = error
         if not found:
-            failure = errors[0].failure
+            failure = failed[directions[0]].failure
             if inputs.cell.seams:  # name the seam (a path: cell has only the one)
                 failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
             raise PlanFailedError(failure)
         options.append(found)
+        errors.append(failed)
     progress(Step(f"{len(seams)} seams planned", stage="seams", done=len(seams), total=len(seams)))
-    return options
+    return SeamChoices(options, errors)
+
+
+def _direction_options(inputs, seam_in: Inputs, scene: DrakeCell, plan_seam, k, reverse, seam):
+    """Seam k's options in one direction (``seam_in``: its inputs): untimed where they can
+    be and the order has a choice (``job.untimed``), else planned in full, with up to
+    MAX_OTHER_BRANCHES other branches in a ``seams:`` job."""
+    known = plan_seam.geometry(k, reverse, seam_in, scene)
+    if inputs.cell.seams or seam.direction == "auto":  # the order has a choice
+        untimed = untimed_options(
+            seam_in,
+            scene,
+            known["fit"],
+            known["frames"],
+            seam,
+            k=k,
+            reverse=reverse,
+            branches=bool(inputs.cell.seams),
+        )
+        if untimed is not None:
+            return untimed
+    plan = plan_seam(k, reverse, seam_in, scene, known=known)
+    # A path: cell's one seam keeps the branch its pipeline chose (the plan as before
+    # issue 24, not planned again on other branches).
+    others = _other_branches(seam_in, scene, plan) if inputs.cell.seams else []
+    found = []
+    for variant in [plan, *others]:
+        try:
+            approach, retract = plan_ends(seam_in, variant, seam)
+        except PlanFailedError:
+            if variant is plan:
+                raise
+            continue  # this branch cannot approach or retract
+        found.append(SeamOption(k, seam.name, reverse, variant, approach, retract))
+    return found
 
 
 def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
@@ -117,58 +147,10 @@ def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
     return variants
 
 
-def _ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
-    """The approach to the plan's first sample and the retract from its last."""
-    motion, joints = inputs.cell.motion, plan.joints
-    R_PE = inputs.X_PE.rotation().matrix()
-    ends = plan.flange(np.array([0.0, plan.path.length]))
-    moves = []
-    for kind, i, spec in (("approach", 0, seam.approach), ("retract", -1, seam.retract)):
-        moves.append(
-            cartesian_move(
-                inputs.robot,
-                X_IB=inputs.X_IB,
-                kind=kind,
-                seam=seam.name,
-                spec=spec,
-                p_PF=ends.p_PF[i],
-                R_PF=ends.R_PF[i],
-                p_IE=ends.p_IE[i],
-                R_IE=ends.R_IE[i],
-                R_PE=R_PE,
-                q_seam=joints.q[i],
-                branch=joints.branch,
-                speed=motion.speed,
-                a_max=motion.max_acceleration,
-                j_max=motion.max_jerk,
-                rate_hz=motion.sample_rate_hz,
-            )
-        )
-    return moves[0], moves[1]
-
-
-def choose_order(
-    inputs: Inputs, options: list[list[SeamOption]], q_home, progress=lambda message: None
-) -> JobOrder:
-    """Seam order and direction (``job.order``) for the least estimated air time; the
-    search's rounds told to ``progress`` (its budget spent as the bar)."""
-    flat = [option for seam in options for option in seam]
-    robot = inputs.robot
-
-    def search_round(rounds: int, air_time_s: float, used: int, budget: int) -> None:
-        text = f"seam order: round {rounds}, estimated air time {air_time_s:.2f} s"
-        progress(Step(text, stage="order", done=used, total=budget))
-
-    return order_job(
-        [(o.seam, o.label, o.q_in, o.q_out) for o in flat],
-        q_home,
-        qd_max=robot.qd_max,
-        qdd_max=robot.qdd_max,
-        n_seams=len(options),
-        mode=job_config(inputs.cell).order,
-        controller_joints=robot.controller_joints,
-        progress=search_round,
-    )
+def plan_ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
+    """The approach to a timed plan's first sample and the retract from its last."""
+    q_ends = plan.joints.q[[0, -1]]
+    return seam_ends(inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
 
 
 def job_pieces(
@@ -245,15 +227,14 @@ class LinkedJob:
 def link_job(
     inputs: Inputs,
     scene: DrakeCell,
-    options: list[list[SeamOption]],
-    order: JobOrder,
+    timed: TimedOrder,
     q_home: np.ndarray,
     progress,
 ) -> LinkedJob:
     """The chosen options linked from home and back (:func:`job_pieces`), laid out as
     one trajectory (``job.assemble.lay_out``)."""
-    flat = [option for seam in options for option in seam]
-    chosen = [flat[i] for i in order.sequence]
+    flat = [option for seam in timed.options for option in seam]
+    chosen = [flat[i] for i in timed.order.sequence]
     pieces, links = job_pieces(inputs, scene, chosen, q_home, progress)
     samples = lay_out(pieces)
     return LinkedJob(chosen, links, samples, tool_speed(inputs, samples, chosen))

@@ -199,6 +199,26 @@ def _time_at(law: Sin2TimeLaw, sigma: float) -> float:
     return float(np.interp(sigma, law(t)[0], t))
 
 
+def path_branches(
+    robot: RobotModel, X_IB, flange, parameter: TimeLawParameter, branch: int | None = None
+) -> tuple[np.ndarray, list[BranchResult], BranchResult, BranchPath]:
+    """The path IK on the σ grid, before any time law: (grid (M,) σ [m], every branch's
+    verdict on it, the chosen one (``branch`` if given, else the best; its ``q`` (M, 6)
+    [rad] on the grid), the chosen branch's exact q(σ)). A robot of family drake has
+    one verdict, Drake IK's along the grid."""
+    length = parameter.length
+    grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
+    if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
+        from offline_prog.joints.drake_path import DrakeIkPath
+
+        path = DrakeIkPath(robot, X_IB, flange, parameter)
+        chosen = path.choose(grid)
+        return grid, [chosen], chosen, path
+    results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
+    chosen = choose_branch(results) if branch is None else results[branch]
+    return grid, results, chosen, BranchPath(robot, X_IB, flange, parameter, chosen.branch)
+
+
 def plan_joint_trajectory(
     robot: RobotModel,
     X_IB,
@@ -229,18 +249,7 @@ def plan_joint_trajectory(
             they are below the user's, the same path is timed under the user's caps
             too, for the trade-off in cycle time (``JointTrajectory.unbounded_s``).
     """
-    length = parameter.length
-    grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
-    if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
-        from offline_prog.joints.drake_path import DrakeIkPath
-
-        path = DrakeIkPath(robot, X_IB, flange, parameter)
-        chosen = path.choose(grid)
-        results = [chosen]
-    else:
-        results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
-        chosen = choose_branch(results) if branch is None else results[branch]
-        path = BranchPath(robot, X_IB, flange, parameter, chosen.branch)
+    grid, results, chosen, path = path_branches(robot, X_IB, flange, parameter, branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
         raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason, chosen.kind)

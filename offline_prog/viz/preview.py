@@ -164,13 +164,15 @@ def draw_cell(scene: StaticScene, drake) -> dict[str, object]:
     by node path."""
     plant, inspector = drake.plant, drake.diagram.scene_graph().model_inspector()
     bodies = {}
-    for g in inspector.GetAllGeometryIds(Role.kIllustration):
+    # Numbered in the scene's order, not by GeometryId: ids count every geometry the
+    # process registered before, so the same cell would draw under other names.
+    for i, g in enumerate(inspector.GetAllGeometryIds(Role.kIllustration)):
         body = plant.GetBodyFromFrameId(inspector.GetFrameId(g)) or plant.world_body()
         node = f"/drake/{plant.GetModelInstanceName(body.model_instance())}/{body.name()}"
         bodies[node] = body
         props = inspector.GetIllustrationProperties(g)
         rgba = props.GetPropertyOrDefault("phong", "diffuse", Rgba(*DEFAULT_RGBA))
-        path = f"{node}/{inspector.GetName(g).replace('/', '_')}_{g.get_value()}"
+        path = f"{node}/{inspector.GetName(g).replace('/', '_')}_{i}"
         color = (rgba.r(), rgba.g(), rgba.b(), rgba.a())
         _draw_shape(scene, f"{path}/shape", inspector.GetShape(g), color)
         scene.set_transform(path, inspector.GetPoseInFrame(g).GetAsMatrix4())

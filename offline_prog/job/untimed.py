@@ -1,0 +1,278 @@
+"""Seam options decided before their time law; the law runs for the chosen ones only.
+
+The seam order (``job.order``) reads each option's link ends q_in, q_out and nothing of
+its timing, so an option is offered on what decides whether it exists: its path IK on
+its branch follows the whole path within the joint limits, its path is collision-free
+at the clearances (checked on the IK grid by ``collision.check`` without the pruning
+margin: the verdict, not the minima), and its approach and retract exist. The time
+law, the joint retiming and the collision check of the timed samples then run only for
+the option the order chooses for each seam (:func:`timed_order`). Where a timed check
+refuses what the untimed one passed, the plan goes the way it went when every option
+was timed: a first option that collides goes through the collision avoidance, a
+direction whose first option cannot be timed is dropped with its other branches,
+another branch that fails is dropped, and the order is searched again without it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.collision.check import check_trajectory
+from offline_prog.errors import PlanFailedError
+from offline_prog.job.approach import seam_ends
+from offline_prog.job.order import JobOrder, order_job
+from offline_prog.job.records import Plan, SeamOption, UntimedSeam
+from offline_prog.job.seams import errors_named_for, job_config, job_seams, seam_key
+from offline_prog.joints.joint_plan import path_branches
+from offline_prog.progress import Step
+from offline_prog.scene.drake_cell import DrakeCell
+from offline_prog.stages import (
+    FittedPath,
+    FlangePaths,
+    Inputs,
+    MotionSetup,
+    check_attempt,
+    motion_setup,
+    plan_motion,
+)
+
+MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
+
+
+@dataclasses.dataclass
+class SeamChoices:
+    """Stage ``seams``: every option of each seam (``options[k]``: the forward ones
+    first, each direction's first option first) and why a direction of seam k was
+    dropped (``errors[k][reverse]``)."""
+
+    options: list[list[SeamOption]]
+    errors: list[dict[bool, PlanFailedError]]
+
+
+@dataclasses.dataclass
+class TimedOrder:
+    """Stage ``order``: the seams' options with the chosen ones timed, and the order."""
+
+    options: list[list[SeamOption]]
+    order: JobOrder
+
+
+def untimed_options(
+    inputs: Inputs,
+    scene: DrakeCell,
+    fit: FittedPath,
+    frames: FlangePaths,
+    seam,
+    *,
+    k: int,
+    reverse: bool,
+    branches: bool,
+) -> list[SeamOption] | None:
+    """Seam k's options in one direction before their time law (``inputs``: the seam's,
+    ``seam``: its SeamConfig): the first (the best tool rotation and branch) and, with
+    ``branches``, up to MAX_OTHER_BRANCHES other branches (largest joint-limit margin
+    first). None where the first option takes more than
+    its path IK and a collision check to decide (its IK, path or approach fails): the
+    caller plans that direction in full.
+
+    Raises:
+        InputError: ``motion.cusp_smoothing_mm`` or the sample count (``motion_setup``).
+    """
+    if inputs.robot.family == "drake":  # no analytic branches: planned in full
+        return None
+    rotation, flange = frames.rotations[0]
+    run = motion_setup(inputs, flange)
+    first, results = _untimed(inputs, scene, fit, frames, rotation, flange, run, None)
+    if first is None:
+        return None
+    try:
+        moves = _ends(inputs, run, first, seam)
+    except PlanFailedError:
+        return None
+    options = [SeamOption(k, seam.name, reverse, None, *moves, untimed=first)]
+    if not branches:
+        return options
+    others = sorted(
+        (b for b in results if b.feasible and b.branch != first.branch),
+        key=lambda b: -b.margin_rad,
+    )[:MAX_OTHER_BRANCHES]
+    for other in others:
+        # As the timed plan of another branch gets it: the first option's path as run.
+        again = motion_setup(inputs, run.flange)
+        variant, _ = _untimed(inputs, scene, fit, frames, rotation, run.flange, again, other.branch)
+        if variant is None:
+            continue
+        try:
+            moves = _ends(inputs, run, variant, seam)
+        except PlanFailedError:
+            continue
+        options.append(SeamOption(k, seam.name, reverse, None, *moves, untimed=variant))
+    return options
+
+
+def _untimed(
+    inputs: Inputs,
+    scene: DrakeCell,
+    fit: FittedPath,
+    frames: FlangePaths,
+    rotation: float,
+    flange,
+    run: MotionSetup,
+    branch: int | None,
+) -> tuple[UntimedSeam | None, list]:
+    """(the option on ``branch`` (None: the best), or None if its path IK fails or its
+    path collides; every branch's verdict)."""
+    motion = inputs.cell.motion
+    grid, results, chosen, path = path_branches(
+        inputs.robot, inputs.X_IB, run.flange, run.parameter, branch
+    )
+    if not chosen.feasible:
+        return None, results
+    verdict = check_trajectory(
+        scene,
+        chosen.q,
+        grid / motion.speed,  # only labels the verdict's stretches
+        grid,
+        clearance=motion.clearance,
+        self_clearance=motion.self_clearance,
+        margin=0.0,
+    )
+    if not verdict.collision_free:
+        return None, results
+    q_ends = path.q(grid[[0, -1]], chosen.q[[0, -1]])
+    first = branch is None
+    return UntimedSeam(inputs, fit, frames, rotation, flange, chosen.branch, q_ends, first), results
+
+
+def _ends(inputs: Inputs, run: MotionSetup, untimed: UntimedSeam, seam):
+    """Approach and retract of an untimed option, on the direction's first flange path
+    as run (the timed plan's ``flange``)."""
+    length = untimed.fit.path.length
+    return seam_ends(inputs, run.flange, length, untimed.q_ends, untimed.branch, seam)
+
+
+def choose_order(
+    inputs: Inputs, options: list[list[SeamOption]], q_home, progress=lambda message: None
+) -> JobOrder:
+    """Seam order and direction (``job.order``) for the least estimated air time; the
+    search's rounds told to ``progress`` (its budget spent as the bar)."""
+    flat = [option for seam in options for option in seam]
+    robot = inputs.robot
+
+    def search_round(rounds: int, air_time_s: float, used: int, budget: int) -> None:
+        text = f"seam order: round {rounds}, estimated air time {air_time_s:.2f} s"
+        progress(Step(text, stage="order", done=used, total=budget))
+
+    return order_job(
+        [(o.seam, o.label, o.q_in, o.q_out) for o in flat],
+        q_home,
+        qd_max=robot.qd_max,
+        qdd_max=robot.qdd_max,
+        n_seams=len(options),
+        mode=job_config(inputs.cell).order,
+        controller_joints=robot.controller_joints,
+        progress=search_round,
+    )
+
+
+def timed_order(
+    inputs: Inputs,
+    scene: DrakeCell,
+    choices: SeamChoices,
+    q_home: np.ndarray,
+    seam_planner,
+    progress=lambda message: None,
+) -> TimedOrder:
+    """Stage ``order``: the seam order (:func:`choose_order`), the chosen options timed,
+    and the order searched again while the timed checks drop a chosen option.
+
+    Raises:
+        PlanFailedError: a seam none of whose options can be timed (its first reason).
+    """
+    options = [list(seam) for seam in choices.options]
+    errors = [dict(e) for e in choices.errors]
+    while True:
+        order = choose_order(inputs, options, q_home, progress)
+        flat = [(k, j) for k, seam in enumerate(options) for j in range(len(seam))]
+        chosen = [flat[i] for i in order.sequence]
+        pending = [(k, j) for k, j in chosen if options[k][j].plan is None]
+        changed = False
+        for done, (k, j) in enumerate(pending):
+            text = f"timing seam {options[k][j].label}"
+            progress(Step(text, stage="timing", done=done, total=len(pending)))
+            name = options[k][j].name
+            with errors_named_for(seam_key(inputs.cell, k)):
+                seam = job_seams(inputs.cell)[k]
+                options[k], same = _time(options[k], j, scene, seam_planner, errors[k], seam)
+            changed |= not same
+            if not options[k]:
+                failure = errors[k][min(errors[k])].failure  # forward's reason first
+                if inputs.cell.seams:
+                    failure = dataclasses.replace(failure, reason=f"seam {name}: {failure.reason}")
+                raise PlanFailedError(failure)
+        if not changed:
+            return TimedOrder(options, order)
+
+
+def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
+    """Seam k's ``options`` with option j timed, its direction's first option before it:
+    (the options, whether they are the same ones as before)."""
+    option = options[j]
+    first = next(i for i, o in enumerate(options) if o.reverse == option.reverse)
+    options, same = _time_first(list(options), first, scene, seam_planner, errors, seam)
+    if j == first or not same:
+        return options, same
+    u = options[j].untimed
+    try:
+        attempt = plan_motion(u.inputs, u.rotation, u.flange, u.branch)
+        attempt = check_attempt(u.inputs, scene, attempt)
+    except PlanFailedError:
+        attempt = None
+    if attempt is None or not attempt.collisions.collision_free:
+        return options[:j] + options[j + 1 :], False
+    plan = dataclasses.replace(
+        options[first].plan,
+        joints=attempt.joints,
+        trajectory=attempt.joints.trajectory,
+        collisions=attempt.collisions,
+        clearance_profile=None,
+    )
+    options[j] = dataclasses.replace(option, plan=plan, untimed=None)
+    return options, True
+
+
+def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, seam):
+    """``options`` with the direction's first option (at i) timed, if it is not: as
+    planned, or its direction planned again in full (the collision avoidance, which
+    offers no other branches) or dropped; and whether the options are the same ones."""
+    option = options[i]
+    if option.plan is not None:
+        return options, True
+    u, reverse = option.untimed, option.reverse
+    timer = seam_planner.timer(option.seam, reverse)  # the stages' names and wall times
+    known = {"fit": u.fit, "frames": u.frames}
+    try:
+        unchecked = timer("joints", "joint trajectory", plan_motion, u.inputs, u.rotation, u.flange)
+        attempt = timer("check", "collision check", check_attempt, u.inputs, scene, unchecked)
+        known |= {"joints": unchecked, "check": attempt}
+    except PlanFailedError:
+        attempt = None  # the full plan below says why, as it did for every option
+    if attempt is not None and attempt.collisions.collision_free:
+        timer("collision", "collision avoidance: not needed", lambda: None)
+        plan = Plan.of_attempt(u.inputs, u.fit, u.frames, attempt, timings_s=timer.timings_s)
+        options[i] = dataclasses.replace(option, plan=plan, untimed=None)
+        return options, True
+    # The direction planned in full from here: the collision avoidance for timed
+    # samples that collide (no other branches offered then), or the failure named.
+    block = []
+    try:
+        plan = seam_planner(option.seam, reverse, u.inputs, scene, known=known)
+        q_ends = plan.joints.q[[0, -1]]
+        moves = seam_ends(u.inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
+        block = [SeamOption(option.seam, option.name, reverse, plan, *moves)]
+    except PlanFailedError as error:
+        errors[reverse] = error
+    kept = [o for o in options if o.reverse != reverse]
+    return sorted(kept + block, key=lambda o: o.reverse), False
