@@ -6,10 +6,11 @@ import pytest
 
 import offline_prog.job.untimed as untimed
 import offline_prog.stages as stages
-from conftest import CELLS
 from offline_prog.errors import Failure
 from offline_prog.joints.joint_plan import JointPlanError
 from offline_prog.plan import plan_job
+
+from conftest import CELLS
 
 JOB = CELLS / "seal_job_kr16.yaml"
 
