@@ -8,7 +8,8 @@ Every file of REF must exist in NEW and the other way round. Per file:
   is a measured run time (``timings_s``, ``time_s``, ``*_solve_s``, ``planning_time_s``)
   and the ``generated`` stamp are skipped: they change from run to run.
 - ``.npz``: the same arrays, shapes and dtypes; numbers within tolerance, strings equal
-  after masking time stamps (``meta`` holds the report's header).
+  after masking time stamps and the checkout's folder (``meta`` holds the report's
+  header and the robot's files: two checkouts have them in two places).
 - everything else (CSV, programs, HTML): read as text, cut into numbers and the text
   between them; the text must be equal (time stamps masked, run times listed in
   VOLATILE_TEXT masked), the numbers within tolerance.
@@ -30,10 +31,17 @@ import numpy as np
 
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 STAMP = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(?:\.\d+)?(?:[+-]\d\d:\d\d|Z)?")
+# The checkout a folder was planned from (two trees: two places of the bundled robots).
+CHECKOUT = re.compile(r"/[^'\"\s]*?/(?=offline_prog/robots)")
 VOLATILE_KEYS = {"timings_s", "time_s", "planning_time_s", "generated", "seconds", "elapsed_s"}
 VOLATILE_TEXT = re.compile(
     r"(planning_time_s|time_s|_solve_s|timings_s|elapsed_s)\W{1,4}[-+.\deE]+"
 )
+
+
+def _masked(text: str) -> str:
+    """``text`` with time stamps and the checkout's folder masked."""
+    return CHECKOUT.sub("<checkout>/", STAMP.sub("<stamp>", text))
 
 
 def _volatile(key: str) -> bool:
@@ -62,7 +70,7 @@ def _walk(a, b, path: str, worst: list, rtol: float, atol: float) -> None:
     elif _is_number(a) and _is_number(b):
         worst.append((*_numbers(np.array([a], float), np.array([b], float), atol), path))
     elif isinstance(a, str) and isinstance(b, str):
-        if STAMP.sub("<stamp>", a) != STAMP.sub("<stamp>", b):
+        if _masked(a) != _masked(b):
             worst.append((np.inf, f"{path}: {a[:40]!r} != {b[:40]!r}"))
     elif a != b:
         worst.append((np.inf, f"{path}: {a!r} != {b!r}"))
@@ -87,7 +95,7 @@ def _numbers(a: np.ndarray, b: np.ndarray, atol: float) -> tuple[float]:
 
 def compare_text(ref: str, new: str, atol: float) -> tuple[float, str]:
     """(worst relative difference, where) of two texts cut into numbers and the rest."""
-    ref, new = (VOLATILE_TEXT.sub("<time>", STAMP.sub("<stamp>", t)) for t in (ref, new))
+    ref, new = (VOLATILE_TEXT.sub("<time>", _masked(t)) for t in (ref, new))
     ref_text, new_text = NUMBER.split(ref), NUMBER.split(new)
     if ref_text != new_text:
         i = next(

@@ -175,7 +175,7 @@ def tool_rotations(
     count = int(np.ceil((hi - lo) / (2.0 * ROTATION_STEP_RAD)))
     angles = np.linspace(lo, hi, 2 * count + 1) if count else np.array([lo])
     s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
-    ranked = []
+    flanges = []
     for phi in sorted(angles, key=abs):
         if smooth_turn is None:
             X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
@@ -183,13 +183,18 @@ def tool_rotations(
         else:
             turn = smooth_turn.with_offset(float(phi), scale)
             flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=unit)
-        if robot.family == "drake":  # no analytic IK to rank with: smallest |φ₀| first
-            ranked.append(((True, 0.0), -abs(phi), float(phi), flange))
-            continue
-        f = flange(s)
-        result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
+        flanges.append((float(phi), flange))
+    if robot.family == "drake":  # no analytic IK to rank with: smallest |φ₀| first
+        return flanges
+    # Every φ₀'s trial poses through the analytic IK at once (per-call overhead, not
+    # arithmetic, dominates 400 poses), then each φ₀'s branches.
+    X_BE = np.concatenate([base_poses(X_IB, *flange.poses(s)) for _, flange in flanges])
+    solutions = robot.inverse(X_BE).reshape(len(flanges), len(s), 8, 6)
+    ranked = []
+    for (phi, flange), solved in zip(flanges, solutions, strict=True):
+        result = choose_branch(branch_results(robot, solutions=solved))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)
-        ranked.append((score, -abs(phi), float(phi), flange))
+        ranked.append((score, -abs(phi), phi, flange))
     ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)
     return [(phi, flange) for _, _, phi, flange in ranked]
 

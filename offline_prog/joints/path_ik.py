@@ -84,9 +84,14 @@ def best_turns(q: np.ndarray, lower: np.ndarray, upper: np.ndarray):
     return offsets, np.take_along_axis(margin, best[..., None], axis=-1)[..., 0]
 
 
-def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
-    """Evaluate all eight branches along the poses X_BE (N, 4, 4)."""
-    solutions = np.swapaxes(robot.inverse(X_BE), 0, 1)  # (8, N, 6)
+def branch_results(
+    robot: RobotModel, X_BE: np.ndarray | None = None, *, solutions: np.ndarray | None = None
+) -> list[BranchResult]:
+    """Evaluate all eight branches along the poses X_BE (N, 4, 4), or along their IK
+    ``solutions`` (N, 8, 6) [rad] (``robot.inverse(X_BE)``) when given."""
+    if solutions is None:
+        solutions = robot.inverse(X_BE)
+    solutions = np.swapaxes(solutions, 0, 1)  # (8, N, 6)
     reachable = ~np.isnan(solutions).any(axis=-1)  # (8, N)
     filled = np.where(reachable[..., None], solutions, 0.0)
     # Unwrap along the path: each step taken as its equivalent in [−π, π).

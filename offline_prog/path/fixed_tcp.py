@@ -200,8 +200,17 @@ class FlangePath:
         dw_s = vee(ddR_IE @ R_EI + dR_IE @ np.swapaxes(dR_IE, 1, 2))
         return FlangeSamples(s, p_PF, R_PF, p_IE, dp_IE, ddp_IE, R_IE, w_s, dw_s)
 
-    def _tool_rotation(self, s: np.ndarray, R_IT: np.ndarray):
-        """(G, G′, G″), each (N, 3, 3): G = R_IT·exp(K φ(s)), K = skew(axis)."""
+    def poses(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(p_IE (N, 3) [m], R_IE (N, 3, 3)) at s (N,): the flange poses alone, the
+        same numbers as ``self(s)`` gives (no derivatives)."""
+        s = np.asarray(s, dtype=float)
+        _, _, p_TE_T, _, _, M, _, _ = part_in_tool(self.path, self.normal, self.X_PE, s)
+        G = self._tool_rotation(s, self.X_IT.rotation().matrix(), order=0)[0]
+        return self.X_IT.translation() + np.einsum("nij,nj->ni", G, p_TE_T), G @ M
+
+    def _tool_rotation(self, s: np.ndarray, R_IT: np.ndarray, order: int = 2):
+        """(G, G′, G″), each (N, 3, 3): G = R_IT·exp(K φ(s)), K = skew(axis) (G alone,
+        the others None, for ``order`` 0)."""
         n = len(s)
         if self.tool_turn is None:
             G = np.broadcast_to(R_IT, (n, 3, 3))
@@ -216,6 +225,8 @@ class FlangePath:
             + (1.0 - np.cos(phi))[:, None, None] * (K @ K)
         )  # Rodrigues
         G = R_IT @ A
+        if order == 0:
+            return G, None, None
         dG = G @ K * dphi[:, None, None]
         ddG = G @ (K @ K * (dphi**2)[:, None, None] + K * ddphi[:, None, None])
         return G, dG, ddG
