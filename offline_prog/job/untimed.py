@@ -8,9 +8,12 @@ margin: the verdict, not the minima), and its approach and retract exist. The ti
 law, the joint retiming and the collision check of the timed samples then run only for
 the option the order chooses for each seam (:func:`timed_order`). Where a timed check
 refuses what the untimed one passed, the plan goes the way it went when every option
-was timed: a first option that collides goes through the collision avoidance, a
-direction whose first option cannot be timed is dropped with its other branches,
-another branch that fails is dropped, and the order is searched again without it.
+was timed: a first option that collides goes through the collision avoidance (its
+direction then offers no other branch), a first option that cannot be timed drops its
+direction, another branch that fails is dropped; and the order is searched again
+without it. One difference is left on purpose: another branch that can be timed is
+kept even where its direction's first could not have been (every option timed dropped
+the whole direction with its first).
 """
 
 from __future__ import annotations
@@ -217,28 +220,37 @@ def timed_order(
 
 
 def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
-    """Seam k's ``options`` with option j timed, its direction's first option before it:
-    (the options, whether they are the same ones as before)."""
+    """Seam k's ``options`` with option j timed: (the options, whether they are the same
+    ones as before). Another branch is timed on its direction's first flange path as
+    run, and its plan holds that path and nominal law as the first's does."""
     option = options[j]
     first = next(i for i, o in enumerate(options) if o.reverse == option.reverse)
-    options, same = _time_first(list(options), first, scene, seam_planner, errors, seam)
-    if j == first or not same:
-        return options, same
-    u = options[j].untimed
+    if j == first:
+        return _time_first(list(options), first, scene, seam_planner, errors, seam)
+    u = option.untimed
+    timer = seam_planner.timer(option.seam, option.reverse)
     try:
-        attempt = plan_motion(u.inputs, u.rotation, u.flange, u.branch)
-        attempt = check_attempt(u.inputs, scene, attempt)
+        attempt = timer(
+            "joints", "joint trajectory", plan_motion, u.inputs, u.rotation, u.flange, u.branch
+        )
+        attempt = timer("check", "collision check", check_attempt, u.inputs, scene, attempt)
     except PlanFailedError:
         attempt = None
     if attempt is None or not attempt.collisions.collision_free:
         return options[:j] + options[j + 1 :], False
-    plan = dataclasses.replace(
-        options[first].plan,
-        joints=attempt.joints,
-        trajectory=attempt.joints.trajectory,
-        collisions=attempt.collisions,
-        clearance_profile=None,
-    )
+    if options[first].plan is None:
+        run = motion_setup(u.inputs, options[first].untimed.flange)  # the first's, as run
+        as_first = dataclasses.replace(attempt, flange=run.flange, nominal=run.nominal)
+        plan = Plan.of_attempt(u.inputs, u.fit, u.frames, as_first, timings_s=timer.timings_s)
+    else:
+        plan = dataclasses.replace(
+            options[first].plan,
+            joints=attempt.joints,
+            trajectory=attempt.joints.trajectory,
+            collisions=attempt.collisions,
+            clearance_profile=None,
+        )
+    options = list(options)
     options[j] = dataclasses.replace(option, plan=plan, untimed=None)
     return options, True
 
