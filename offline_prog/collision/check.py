@@ -203,21 +203,27 @@ def check_trajectory(
         bisect(g, xm, dm, xb, db, motion / 2)
 
     # In Python floats and a heap (numpy's per-call cost dominates arrays of a few
-    # elements: usually a pair or two near an obstacle are due at a sample).
+    # elements: usually a pair or two near an obstacle are due at a sample), the
+    # sample loop's calls bound once: most of a long seam is one pair at every sample.
     cumulative_list, step_list, rows = cumulative.tolist(), step.tolist(), list(q)
+    set_positions, context = pairs._set_positions, pairs.plant_context
+    query, ids = pairs.query.ComputeSignedDistancePairClosestPoints, pairs.ids
     # (next sample to evaluate, g) of each pair not yet certified to the end; pairs due
     # at the same sample pop in the order of g.
     heap = [(0, g) for g in range(len(pairs.ids))]
     last_i, last_d = [-2] * len(heap), [0.0] * len(heap)
+    evaluated = 0  # evaluations at samples (bisections count in pairs.distance)
     while heap and (i := heap[0][0]) < n:
-        now = []
+        now = [heappop(heap)[1]]
         while heap and heap[0][0] == i:
             now.append(heappop(heap)[1])
-        pairs.set(rows[i])
-        d_now = [distance(g) for g in now]  # all at q[i] before any bisection
-        found_g.extend(now)
-        found_x.extend([float(i)] * len(now))
-        found_d.extend(d_now)
+        set_positions(context, rows[i])
+        x = float(i)
+        d_now = [query(*ids[g]).distance for g in now]  # all at q[i] before bisections
+        evaluated += len(now)
+        found_g += now
+        found_x += [x] * len(now)
+        found_d += d_now
         split = []
         for g, d in zip(now, d_now, strict=True):
             c, clear = c_list[g], clear_list[g]
@@ -228,10 +234,12 @@ def check_trajectory(
                     heappush(heap, (max(reach - 1, i + 1), g))
             if i and last_i[g] == i - 1 and (last_d[g] + d - c * step_list[i - 1]) / 2 < clear:
                 split.append((g, d))
+            last_i[g] = i
         for g, d in split:
-            bisect(g, i - 1.0, last_d[g], float(i), d, step_list[i - 1])
+            bisect(g, i - 1.0, last_d[g], x, d, step_list[i - 1])
         for g, d in zip(now, d_now, strict=True):
-            last_i[g], last_d[g] = i, d
+            last_d[g] = d
+    pairs.evaluations += evaluated
     g = np.array(found_g, dtype=int)
     x, d = np.array(found_x, dtype=float), np.array(found_d, dtype=float)
     s = pairs.shape_of[g]
