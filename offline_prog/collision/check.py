@@ -317,8 +317,9 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         if not (e == 0.0 and d <= 0.0) and abs(e - d) > EXACT_MISMATCH_TOL_M:
             pair.note = f"Drake {d * 1e3:.2f} mm, exact {e * 1e3:.2f} mm"
             notes.append(f"{pair.a} vs {pair.b} at σ = {pair.sigma_m:.4f} m: {pair.note}")
-    overlaps = [k for k in np.lexsort((dist, x)) if dist[k] < -TOUCH_TOL_M]
-    first = entry(overlaps[0]) if overlaps else None
+    by_point = np.lexsort((dist, x))  # by point, the closest first
+    overlaps = by_point[dist[by_point] < -TOUCH_TOL_M]
+    first = entry(int(overlaps[0])) if len(overlaps) else None
     stretch = next(
         (
             r
