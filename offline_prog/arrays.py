@@ -29,7 +29,7 @@ def interp_rows(x: np.ndarray, xp: np.ndarray, *tables: np.ndarray) -> list[np.n
     w = np.clip((x - xp[i]) / (xp[i + 1] - xp[i]), 0.0, 1.0)[:, None]
     # t[i + 1] − t[i] taken from the grid's differences (G − 1 rows, usually far fewer
     # than N): the same numbers, one gather less per table.
-    return [t[i] + w * np.diff(t, axis=0)[i] for t in tables]
+    return [np.take(t, i, axis=0) + w * np.take(np.diff(t, axis=0), i, axis=0) for t in tables]
 
 
 def csv_text(
