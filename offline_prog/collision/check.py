@@ -213,10 +213,38 @@ def check_trajectory(
     heap = [(0, g) for g in range(len(pairs.ids))]
     last_i, last_d = [-2] * len(heap), [0.0] * len(heap)
     evaluated = 0  # evaluations at samples (bisections count in pairs.distance)
+
+    def _run_alone(g: int, i: int, other: int) -> None:
+        """Pair g due alone at sample i, while no other pair falls due before
+        ``other``: the loop's own steps for one pair, sample after sample (most of a
+        seam with a tool near the part), without the heap in between."""
+        nonlocal evaluated
+        pair, c, clear = ids[g], c_list[g], clear_list[g]
+        while True:
+            set_positions(context, rows[i])
+            d = query(*pair).distance
+            found_g.append(g)
+            found_x.append(float(i))
+            found_d.append(d)
+            evaluated += 1
+            reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
+            due = n if reach - 1 >= n - 1 else max(reach - 1, i + 1)
+            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step_list[i - 1]) / 2 < clear:
+                bisect(g, i - 1.0, last_d[g], float(i), d, step_list[i - 1])
+            last_i[g], last_d[g] = i, d
+            if due >= other:  # certified to the end, or another pair is due by then
+                if due < n:
+                    heappush(heap, (due, g))
+                return
+            i = due
+
     while heap and (i := heap[0][0]) < n:
         now = [heappop(heap)[1]]
         while heap and heap[0][0] == i:
             now.append(heappop(heap)[1])
+        if len(now) == 1 and c_list[now[0]] != 0.0:  # one moving pair alone: a run
+            _run_alone(now[0], i, heap[0][0] if heap else n)
+            continue
         set_positions(context, rows[i])
         x = float(i)
         d_now = [query(*ids[g]).distance for g in now]  # all at q[i] before bisections
