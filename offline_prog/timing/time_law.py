@@ -90,6 +90,10 @@ class Sin2TimeLaw:
         object.__setattr__(self, "_last", (key, values))  # frozen: a cache, not a field
         return values
 
+    def __getstate__(self) -> dict:
+        """Pickled (a placement worker's answer) without the kept evaluation."""
+        return {k: v for k, v in self.__dict__.items() if k != "_last"}
+
     def _evaluate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
         t = np.clip(t, 0.0, self.duration)
         starts, state = self._segment_starts()
