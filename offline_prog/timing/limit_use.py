@@ -76,9 +76,9 @@ class _Use(dict):
     """joint_use's answer: each use (and each term) computed when first read, since
     most callers read a few of them."""
 
-    def __init__(self, rates: tuple, limits, **known):
+    def __init__(self, rates: tuple, terms: dict, limits, **known):
         super().__init__(known)
-        self._rates, self._limits, self._terms = rates, limits, {}
+        self._rates, self._limits, self._terms = rates, limits, terms
 
     def __missing__(self, key: str) -> np.ndarray:
         if key not in _USES:
@@ -103,9 +103,30 @@ def joint_use(rates: JointRates, dddq: np.ndarray, law, t: np.ndarray, limits) -
         limits: (qd_max, qdd_max, qddd_max), each (6,) [rad/s, rad/s², rad/s³].
     """
     sigma, sd, sdd, sddd = law(t)
-    dq, ddq, d3q = interp_rows(sigma, rates.sigma, rates.dq, rates.ddq, dddq)
-    rates_at_t = (dq, ddq, d3q, sd[:, None], sdd[:, None], sddd[:, None])
-    return _Use(rates_at_t, limits, sigma=sigma, speed=sd, sdd=sdd, sddd=sddd)
+    arrays = (sigma, sd, sdd, sddd, rates.sigma, rates.dq, rates.ddq, dddq)
+    key = (
+        tuple(np.shape(a) for a in arrays),
+        b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays),
+    )
+    kept = _last_rates  # one read: threads may replace it
+    if kept is not None and kept[0] == key:  # the same law and path: other limits
+        rates_at_t, terms = kept[1], kept[2]
+    else:
+        dq, ddq, d3q = interp_rows(sigma, rates.sigma, rates.dq, rates.ddq, dddq)
+        rates_at_t, terms = (dq, ddq, d3q, sd[:, None], sdd[:, None], sddd[:, None]), {}
+        _keep(key, rates_at_t, terms)
+    return _Use(rates_at_t, terms, limits, sigma=sigma, speed=sd, sdd=sdd, sddd=sddd)
+
+
+# The last joint_use's rates at its times and the terms computed (they do not depend on
+# the limits): the jerk stage asks for the same law under its shared limits, then the
+# full ones, and its check once more.
+_last_rates: tuple | None = None
+
+
+def _keep(key: tuple, rates_at_t: tuple, terms: dict) -> None:
+    global _last_rates
+    _last_rates = (key, rates_at_t, terms)
 
 
 def worst_use(use: dict) -> tuple[int, float, float]:
