@@ -175,7 +175,7 @@ def tool_rotations(
     count = int(np.ceil((hi - lo) / (2.0 * ROTATION_STEP_RAD)))
     angles = np.linspace(lo, hi, 2 * count + 1) if count else np.array([lo])
     s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
-    trials = []
+    ranked = []
     for phi in sorted(angles, key=abs):
         if smooth_turn is None:
             X_IT_phi = X_IT @ RigidTransform(RotationMatrix(AngleAxis(phi, unit)), np.zeros(3))
@@ -183,16 +183,11 @@ def tool_rotations(
         else:
             turn = smooth_turn.with_offset(float(phi), scale)
             flange = FlangePath(path, normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn, axis=unit)
-        trials.append((phi, flange))
-    if robot.family != "drake":  # one IK call for every φ₀'s poses (N·φ₀ rows)
-        poses = [base_poses(X_IB, f.p_IE, f.R_IE) for f in (fl(s) for _, fl in trials)]
-        solutions = np.split(robot.inverse(np.concatenate(poses)), len(poses))
-    ranked = []
-    for k, (phi, flange) in enumerate(trials):
         if robot.family == "drake":  # no analytic IK to rank with: smallest |φ₀| first
             ranked.append(((True, 0.0), -abs(phi), float(phi), flange))
             continue
-        result = choose_branch(branch_results(robot, poses[k], solutions=solutions[k]))
+        f = flange(s)
+        result = choose_branch(branch_results(robot, base_poses(X_IB, f.p_IE, f.R_IE)))
         score = (result.feasible, result.margin_rad if result.feasible else result.sample)
         ranked.append((score, -abs(phi), float(phi), flange))
     ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)

@@ -84,13 +84,9 @@ def best_turns(q: np.ndarray, lower: np.ndarray, upper: np.ndarray):
     return offsets, np.take_along_axis(margin, best[..., None], axis=-1)[..., 0]
 
 
-def branch_results(
-    robot: RobotModel, X_BE: np.ndarray, *, solutions: np.ndarray | None = None
-) -> list[BranchResult]:
-    """Evaluate all eight branches along the poses X_BE (N, 4, 4); ``solutions``: their
-    ``robot.inverse(X_BE)`` (N, 8, 6) if the caller has it."""
-    solutions = robot.inverse(X_BE) if solutions is None else solutions
-    solutions = np.swapaxes(solutions, 0, 1)  # (8, N, 6)
+def branch_results(robot: RobotModel, X_BE: np.ndarray) -> list[BranchResult]:
+    """Evaluate all eight branches along the poses X_BE (N, 4, 4)."""
+    solutions = np.swapaxes(robot.inverse(X_BE), 0, 1)  # (8, N, 6)
     reachable = ~np.isnan(solutions).any(axis=-1)  # (8, N)
     filled = np.where(reachable[..., None], solutions, 0.0)
     # Unwrap along the path: each step taken as its equivalent in [−π, π).
