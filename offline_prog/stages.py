@@ -30,7 +30,7 @@ from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
 from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
-from offline_prog.path.tool_turn import SmoothTurn
+from offline_prog.path.tool_turn import SmoothTurn, smooth_turn_of
 from offline_prog.process.model import process_model
 from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
@@ -184,7 +184,7 @@ def smooth_turn(inputs: Inputs, fit: FittedPath) -> SmoothTurn | None:
     tool = inputs.cell.tool
     if tool.turn_smoothing_mm == 0.0:
         return None
-    return SmoothTurn(
+    return smooth_turn_of(
         fit.path, fit.normal, axis=tool.symmetry_axis, width_m=tool.turn_smoothing_mm * 1e-3
     )
 

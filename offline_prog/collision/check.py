@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from bisect import bisect_right
+from heapq import heappop, heappush
 
 import numpy as np
 
@@ -51,7 +52,6 @@ MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drak
 MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
 TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
 OWNER_ORDER = ("part", "tool", "robot", "obstacle")
-FEW_PAIRS = 16  # pairs due at one sample that the check steps in Python floats
 
 
 class _Pairs:
@@ -68,8 +68,12 @@ class _Pairs:
             allow_fixed_layout(
                 scene_graph, plant, cell.robot, cell.labels, self.sg_context, cell.allowed_contact
             )
-        self.port = scene_graph.get_query_output_port()
-        self.set(plant.GetPositions(self.plant_context, cell.robot))
+        # The robot's joints are the plant's only positions: the whole plant's are set.
+        assert plant.num_positions() == plant.num_positions(cell.robot), "robot only"
+        self._set_positions = plant.SetPositions
+        # The query object reads the context at each query (poses updated on demand):
+        # evaluated once, it answers for the positions last set.
+        self.query = scene_graph.get_query_output_port().Eval(self.sg_context)
         fixed = {b.name() for b in plant.GetBodiesWeldedTo(plant.world_body())}
         rank = {owner: i for i, owner in enumerate(OWNER_ORDER)}
         self.ids, self.names, shape_of, c = [], [], [], []
@@ -106,8 +110,8 @@ class _Pairs:
         self._exact, self.exact_checks, self.evaluations = {}, 0, 0
 
     def set(self, q: np.ndarray) -> None:
-        self.cell.plant.SetPositions(self.plant_context, self.cell.robot, q)
-        self.query = self.port.Eval(self.sg_context)
+        """Set the joint positions q (6,) [rad] the next distances are measured at."""
+        self._set_positions(self.plant_context, q)
 
     def distance(self, g: int) -> float:
         """Drake's signed distance [m] of geometry pair g at the last set q."""
@@ -178,68 +182,95 @@ def check_trajectory(
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]
     step = np.abs(np.diff(q, axis=0)) @ rho  # (N - 1,) motion bound of each step [m]
     cumulative = np.concatenate([[0.0], np.cumsum(step)])
-    # (geometry pairs g, points x, Drake distances) of each evaluation.
-    found: list[tuple] = [(np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))]
+    # (geometry pair g, point x, Drake distance) of each evaluation, in order.
+    found_g: list[int] = []
+    found_x: list[float] = []
+    found_d: list[float] = []
+    distance, c_list, clear_list = pairs.distance, pairs.c.tolist(), clear_g.tolist()
 
     def bisect(g: int, xa: float, da: float, xb: float, db: float, motion: float) -> None:
-        if (da + db - pairs.c[g] * motion) / 2 >= clear_g[g] or min(da, db) < -TOUCH_TOL_M:
+        if (da + db - c_list[g] * motion) / 2 >= clear_list[g] or min(da, db) < -TOUCH_TOL_M:
             return  # certified, or an overlap already found at an end
-        if motion <= max(clear_g[g], MIN_SUBSTEP_M):
+        if motion <= max(clear_list[g], MIN_SUBSTEP_M):
             return
         xm = (xa + xb) / 2
         pairs.set(at_index(q, xm))
-        dm = pairs.distance(g)
-        found.append(([g], [xm], [dm]))
+        dm = distance(g)
+        found_g.append(g)
+        found_x.append(xm)
+        found_d.append(dm)
         bisect(g, xa, da, xm, dm, motion / 2)
         bisect(g, xm, dm, xb, db, motion / 2)
 
-    # The loop below for a few pairs, in Python floats (the same arithmetic, a third of
-    # the time: numpy's per-call cost dominates arrays of a few elements).
-    c_list, clear_list, cumulative_list = pairs.c.tolist(), clear_g.tolist(), cumulative.tolist()
+    # In Python floats and a heap (numpy's per-call cost dominates arrays of a few
+    # elements: usually a pair or two near an obstacle are due at a sample), the
+    # sample loop's calls bound once: most of a long seam is one pair at every sample.
+    cumulative_list, step_list, rows = cumulative.tolist(), step.tolist(), list(q)
+    set_positions, context = pairs._set_positions, pairs.plant_context
+    query, ids = pairs.query.ComputeSignedDistancePairClosestPoints, pairs.ids
+    # (next sample to evaluate, g) of each pair not yet certified to the end; pairs due
+    # at the same sample pop in the order of g.
+    heap = [(0, g) for g in range(len(pairs.ids))]
+    last_i, last_d = [-2] * len(heap), [0.0] * len(heap)
+    evaluated = 0  # evaluations at samples (bisections count in pairs.distance)
 
-    def step_few(now: list[int], i: int) -> None:
-        d_now = [pairs.distance(g) for g in now]  # all at q[i] before any bisection
-        found.append((now, [float(i)] * len(now), d_now))
+    def _run_alone(g: int, i: int, other: int) -> None:
+        """Pair g due alone at sample i, while no other pair falls due before
+        ``other``: the loop's own steps for one pair, sample after sample (most of a
+        seam with a tool near the part), without the heap in between."""
+        nonlocal evaluated
+        pair, c, clear = ids[g], c_list[g], clear_list[g]
+        while True:
+            set_positions(context, rows[i])
+            d = query(*pair).distance
+            found_g.append(g)
+            found_x.append(float(i))
+            found_d.append(d)
+            evaluated += 1
+            reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
+            due = n if reach - 1 >= n - 1 else max(reach - 1, i + 1)
+            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step_list[i - 1]) / 2 < clear:
+                bisect(g, i - 1.0, last_d[g], float(i), d, step_list[i - 1])
+            last_i[g], last_d[g] = i, d
+            if due >= other:  # certified to the end, or another pair is due by then
+                if due < n:
+                    heappush(heap, (due, g))
+                return
+            i = due
+
+    while heap and (i := heap[0][0]) < n:
+        now = [heappop(heap)[1]]
+        while heap and heap[0][0] == i:
+            now.append(heappop(heap)[1])
+        if len(now) == 1 and c_list[now[0]] != 0.0:  # one moving pair alone: a run
+            _run_alone(now[0], i, heap[0][0] if heap else n)
+            continue
+        set_positions(context, rows[i])
+        x = float(i)
+        d_now = [query(*ids[g]).distance for g in now]  # all at q[i] before bisections
+        evaluated += len(now)
+        found_g += now
+        found_x += [x] * len(now)
+        found_d += d_now
         split = []
         for g, d in zip(now, d_now, strict=True):
             c, clear = c_list[g], clear_list[g]
-            if c == 0.0:  # nothing moves: measured once
-                due[g] = n
-            else:  # the last sample the distance budget reaches (searchsorted, right)
+            if c != 0.0:  # nothing moves (c = 0): measured once
+                # The last sample the distance budget reaches (searchsorted, right).
                 reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
-                due[g] = n if reach - 1 >= n - 1 else max(reach - 1, i + 1)
-            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step[i - 1]) / 2 < clear:
+                if reach - 1 < n - 1:
+                    heappush(heap, (max(reach - 1, i + 1), g))
+            if i and last_i[g] == i - 1 and (last_d[g] + d - c * step_list[i - 1]) / 2 < clear:
                 split.append((g, d))
+            last_i[g] = i
         for g, d in split:
-            bisect(g, i - 1.0, last_d[g], float(i), d, step[i - 1])
+            bisect(g, i - 1.0, last_d[g], x, d, step_list[i - 1])
         for g, d in zip(now, d_now, strict=True):
-            last_i[g], last_d[g] = i, d
-
-    # Per geometry pair: the next sample to evaluate (n: certified to the end).
-    due = np.zeros(len(pairs.ids), dtype=int)
-    last_i, last_d = np.full(len(due), -2), np.zeros(len(due))
-    # c = 0 (both fixed) divides by zero below: errstate once, not per sample (a tenth
-    # of the check's time on a 10,000-sample plan).
-    with np.errstate(divide="ignore", invalid="ignore"):
-        while len(due) and (i := int(due.min())) < n:
-            now = np.flatnonzero(due == i)
-            pairs.set(q[i])
-            if len(now) <= FEW_PAIRS:  # the usual case: a pair or two near an obstacle
-                step_few(now.tolist(), i)
-                continue
-            d = np.array([pairs.distance(g) for g in now], dtype=float)
-            found.append((now, np.full(len(now), float(i)), d))
-            budget = (d - clear_g[now] - margin) / pairs.c[now]
-            reach = np.searchsorted(cumulative, cumulative[i] + budget, side="right") - 1
-            due[now] = np.where(reach >= n - 1, n, np.maximum(reach, i + 1))
-            due[now[pairs.c[now] == 0.0]] = n  # nothing moves: measured once
-            lower = (last_d[now] + d - pairs.c[now] * step[i - 1]) / 2 if i else d
-            split = (last_i[now] == i - 1) & (lower < clear_g[now])  # steps to bisect
-            for g, d_g in zip(now[split], d[split], strict=True):
-                bisect(g, i - 1.0, last_d[g], float(i), d_g, step[i - 1])
-            last_i[now], last_d[now] = i, d
-    g, x, d = (np.concatenate([np.asarray(f[k]) for f in found]) for k in range(3))
-    s = pairs.shape_of[g.astype(int)]
+            last_d[g] = d
+    pairs.evaluations += evaluated
+    g = np.array(found_g, dtype=int)
+    x, d = np.array(found_x, dtype=float), np.array(found_d, dtype=float)
+    s = pairs.shape_of[g]
     order = np.lexsort((x, s))  # one row per (shape pair, point): its closest pieces
     s, x, d = s[order], x[order], d[order]
     rows = np.flatnonzero(np.r_[True, (s[1:] != s[:-1]) | (x[1:] != x[:-1])])
@@ -314,8 +345,9 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         if not (e == 0.0 and d <= 0.0) and abs(e - d) > EXACT_MISMATCH_TOL_M:
             pair.note = f"Drake {d * 1e3:.2f} mm, exact {e * 1e3:.2f} mm"
             notes.append(f"{pair.a} vs {pair.b} at σ = {pair.sigma_m:.4f} m: {pair.note}")
-    overlaps = [k for k in np.lexsort((dist, x)) if dist[k] < -TOUCH_TOL_M]
-    first = entry(overlaps[0]) if overlaps else None
+    by_point = np.lexsort((dist, x))  # by point, the closest first
+    overlaps = by_point[dist[by_point] < -TOUCH_TOL_M]
+    first = entry(int(overlaps[0])) if len(overlaps) else None
     stretch = next(
         (
             r

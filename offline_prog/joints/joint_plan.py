@@ -109,7 +109,7 @@ class BranchPath:
 
     def q(self, sigma: np.ndarray, q_near: np.ndarray) -> np.ndarray:
         """(N, 6) the branch's solution at σ, taken as the 2π-equivalent nearest q_near."""
-        raw = self.robot.inverse(self.poses(sigma))[:, self.branch]
+        raw = self.robot.inverse_branch(self.poses(sigma), self.branch)
         return q_near + wrap_to_pi(raw - q_near)
 
     def singularity_distances(self, q: np.ndarray, sigma: np.ndarray) -> dict:

@@ -174,6 +174,9 @@ class ArcLengthPath:
         self.map = ArcLengthMap(curve_speed(fitted), fitted.breakpoints, periodic=fitted.closed)
         self.length = self.map.length
         self._last: tuple[np.ndarray, list[np.ndarray]] | None = None
+        # (u, [c, dc/du, ...]): the spline's last evaluation, kept with the u it was at
+        # (the flange path asks for order 2, then the process frames for order 3).
+        self._spline: tuple[np.ndarray, list[np.ndarray]] | None = None
 
     def parameter(self, s: np.ndarray, order: int = 3) -> list[np.ndarray]:
         """[u, u', u'', u'''][: order + 1] of the fitted spline at arc length s.
@@ -188,5 +191,10 @@ class ArcLengthPath:
 
     def __call__(self, s: np.ndarray, order: int = 3) -> list[np.ndarray]:
         u = self.parameter(s, max(order, 1))
-        c = [self.fitted(u[0], nu) for nu in range(order + 1)]
-        return compose_derivatives(c, u)
+        kept = self._spline  # one read: threads may replace it
+        c = kept[1] if kept is not None and kept[0] is u[0] else []
+        if len(c) <= order:
+            c = c + [self.fitted(u[0], nu) for nu in range(len(c), order + 1)]
+            self._spline = (u[0], c)
+        # r itself is c's first array: a copy, so no caller changes the kept one.
+        return compose_derivatives([c[0].copy(), *c[1 : order + 1]], u)

@@ -165,6 +165,11 @@ class FlangePath:
         self.X_PE = X_PE
         self.tool_turn = tool_turn
         self.axis = np.asarray(axis, dtype=float)
+        # (s bytes, FlangeSamples) of the last evaluation: a joint plan evaluates the
+        # same samples several times in a row (the output samples four times: the
+        # workspace trajectory, the IK, the joint rates, the singularity distances).
+        # One tuple, replaced whole: threads may read it at once.
+        self._last: tuple = (None, None)
 
     @property
     def length(self) -> float:
@@ -172,7 +177,20 @@ class FlangePath:
         return self.path.length
 
     def __call__(self, s: np.ndarray) -> FlangeSamples:
+        """The flange path at s (N,) [m]; its arrays are read-only (an evaluation at the
+        same s, bit for bit, returns the same FlangeSamples)."""
         s = np.asarray(s, dtype=float)
+        key = s.tobytes()
+        last_key, last = self._last
+        if key == last_key:
+            return last
+        samples = self._compute(s.copy())  # the caller's s stays the caller's
+        for field in dataclasses.fields(samples):
+            getattr(samples, field.name).setflags(write=False)
+        self._last = (key, samples)
+        return samples
+
+    def _compute(self, s: np.ndarray) -> FlangeSamples:
         p_PF, R_PF, p_TE_T, dp_TE_T, ddp_TE_T, M, dM, ddM = part_in_tool(
             self.path, self.normal, self.X_PE, s
         )

@@ -26,6 +26,7 @@ around the seam (θ's total turn taken out first); on an open one the ends are h
 
 from __future__ import annotations
 
+import collections
 import threading
 
 import numpy as np
@@ -40,7 +41,9 @@ GRID_SPACING_M = 5e-4  # θ and θ̄ sampled every 0.5 mm
 SPAN_REFINE = 16
 SPAN_MARGIN_RAD = 1e-7
 RESIDUALS_KEPT = 4  # σ grids whose θ − θ̄ a turn keeps (see SmoothTurn._residual)
+TURNS_KEPT = 4  # SmoothTurns kept by smooth_turn_of
 _lock = threading.Lock()
+_turns: collections.OrderedDict = collections.OrderedDict()
 
 
 def turn_rates(path: ArcLengthPath, normal: NormalField, s: np.ndarray, axis: int):
@@ -131,3 +134,23 @@ class SmoothTurn:
                     self._residuals.pop(next(iter(self._residuals)))
                 self._residuals[key] = residual
         return residual
+
+
+def smooth_turn_of(
+    path: ArcLengthPath, normal: NormalField, *, axis: str, width_m: float
+) -> SmoothTurn:
+    """``SmoothTurn(path, normal, axis=axis, width_m=width_m)``, one of the last
+    TURNS_KEPT: the turn depends on neither X_IT nor X_PE, so a session's pose edits
+    and placement candidates reuse it (its splines, span and σ-grid residuals)."""
+    key = (id(path), id(normal), axis, width_m)
+    with _lock:
+        entry = _turns.get(key)
+        if entry is not None and entry[0] is path and entry[1] is normal:
+            _turns.move_to_end(key)
+            return entry[2]
+    turn = SmoothTurn(path, normal, axis=axis, width_m=width_m)
+    with _lock:  # threads may plan at once (a Dask worker's threads)
+        _turns[key] = (path, normal, turn)
+        while len(_turns) > TURNS_KEPT:
+            _turns.popitem(last=False)
+    return turn

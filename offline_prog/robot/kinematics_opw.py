@@ -197,10 +197,26 @@ def inverse(params: OpwParameters, X_BE: np.ndarray) -> np.ndarray:
     Raises:
         ValueError: If X_BE is not (N, 4, 4).
     """
+    return _solutions(params, X_BE, slice(0, 4), (False, True))
+
+
+def inverse_branch(params: OpwParameters, X_BE: np.ndarray, branch: int) -> np.ndarray:
+    """Solution ``branch`` (0-7) of :func:`inverse` alone, (N, 6) [rad]: the same
+    numbers as ``inverse(params, X_BE)[:, branch]`` for an eighth of the wrist work
+    (a joint path evaluates its chosen branch at every output sample)."""
+    if not 0 <= branch < 8:
+        raise ValueError(f"branch: expected 0..7, got {branch}")
+    arm = branch % 4
+    return _solutions(params, X_BE, slice(arm, arm + 1), (branch >= 4,))[:, 0]
+
+
+def _solutions(params: OpwParameters, X_BE: np.ndarray, arms: slice, flips: tuple) -> np.ndarray:
+    """(N, len(flips) · A, 6) the solutions of the arm branches ``arms`` (A of them),
+    first unflipped then flipped as ``flips`` says (module doc of :func:`inverse`)."""
     X_BE = check_poses(X_BE)
     R_BE = X_BE[:, :3, :3]
     p_BC = X_BE[:, :3, 3] - params.c4 * R_BE[:, :, 2]
-    theta1, theta2, theta3 = _arm_solutions(params, p_BC)
+    theta1, theta2, theta3 = (t[:, arms] for t in _arm_solutions(params, p_BC))
     # Wrist: R_CE = R_BC^T R_BE = Rz(theta4) Ry(theta5) Rz(theta6) (paper eq. 11-13).
     R_BC = _rot_z(theta1) @ _rot_y(theta2 + theta3)
     R_CE = np.swapaxes(R_BC, -1, -2) @ R_BE[:, None]
@@ -215,8 +231,10 @@ def inverse(params: OpwParameters, X_BE: np.ndarray) -> np.ndarray:
         np.arctan2(R_CE[..., 1, 0], cos6_singular),
         np.arctan2(R_CE[..., 2, 1], -R_CE[..., 2, 0]),
     )
-    theta = np.empty((X_BE.shape[0], 8, 6))
-    for flip, rows in ((False, slice(0, 4)), (True, slice(4, 8))):
+    count = theta1.shape[1]
+    theta = np.empty((X_BE.shape[0], count * len(flips), 6))
+    for k, flip in enumerate(flips):
+        rows = slice(k * count, (k + 1) * count)
         theta[:, rows, 0] = theta1
         theta[:, rows, 1] = theta2
         theta[:, rows, 2] = theta3

@@ -127,6 +127,19 @@ class RobotModel:
         module = kinematics_opw if self.family == "opw" else kinematics_ur
         return module.inverse(self.params, X_BE)
 
+    def inverse_branch(self, X_BE: np.ndarray, branch: int) -> np.ndarray:
+        """Solution ``branch`` (N, 6) [rad] of :meth:`inverse` for flange poses X_BE
+        (N, 4, 4) [m]: the same numbers, computed alone where the family can.
+
+        Raises:
+            ValueError: branch is not one of 0..7.
+        """
+        if branch not in range(8):
+            raise ValueError(f"branch: expected 0..7, got {branch!r}")
+        if self.family == "opw":
+            return kinematics_opw.inverse_branch(self.params, X_BE, branch)
+        return self.inverse(X_BE)[:, branch]
+
 
 def list_robots(robots_dir: Path | None = None) -> list[str]:
     """Names of the robot folders (those holding a robot.yaml), sorted; without

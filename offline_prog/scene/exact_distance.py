@@ -76,16 +76,30 @@ class ExactShape:
         return np.zeros(3) if self.mesh is None else np.asarray(self.mesh.vertices[0])
 
 
+MESH_SHAPES_KEPT = 8
+_mesh_shapes: dict[int, tuple] = {}  # id(mesh) ↦ (mesh, its ExactShape)
+
+
 def exact_shape(
     kind: str, size_m: tuple[float, ...], mesh: trimesh.Trimesh | ConvexSolid | None
 ) -> ExactShape:
-    """The ExactShape of a primitive (kind, size_m) or a triangle mesh in G [m]."""
+    """The ExactShape of a primitive (kind, size_m) or a triangle mesh in G [m].
+
+    A mesh's BVH is built once per mesh object (the last MESH_SHAPES_KEPT): every
+    collision check of a session's re-plans measures the same part mesh."""
     if kind == "mesh":
+        kept = _mesh_shapes.get(id(mesh))
+        if kept is not None and kept[0] is mesh:
+            return kept[1]
         model = fcl.BVHModel()
         model.beginModel(len(mesh.vertices), len(mesh.faces))
         model.addSubModel(np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int32))
         model.endModel()
-        return ExactShape(model, kind, (), mesh)
+        shape = ExactShape(model, kind, (), mesh)
+        _mesh_shapes[id(mesh)] = (mesh, shape)  # the mesh kept with it: its id stays its
+        while len(_mesh_shapes) > MESH_SHAPES_KEPT:
+            _mesh_shapes.pop(next(iter(_mesh_shapes)), None)
+        return shape
     factory = {
         "box": fcl.Box,
         "sphere": fcl.Sphere,

@@ -171,8 +171,22 @@ def read_matrix(robot_folder: Path) -> list[LinkPair] | None:
     file = Path(robot_folder) / MATRIX_FILE
     if not file.is_file():
         return None
+    text = file.read_text()
+    key = (str(file.resolve()), text)
+    pairs = _matrices.get(key)  # a plan (a session's re-plan) builds its cell each time
+    if pairs is None:
+        pairs = _parse_matrix(file, text)
+        _matrices.clear()  # the last file read only: one robot per cell
+        _matrices[key] = pairs
+    return list(pairs)
+
+
+_matrices: dict[tuple[str, str], tuple[LinkPair, ...]] = {}
+
+
+def _parse_matrix(file: Path, text: str) -> tuple[LinkPair, ...]:
     try:
-        record = yaml.safe_load(file.read_text())
+        record = yaml.safe_load(text)
         pairs = [
             LinkPair(
                 str(p["a"]),
@@ -189,7 +203,7 @@ def read_matrix(robot_folder: Path) -> list[LinkPair] | None:
     for p in pairs:
         if p.kind not in CLASSES:
             raise ValueError(f"{file}: pairs: class {p.kind!r} is not one of {', '.join(CLASSES)}")
-    return pairs
+    return tuple(pairs)
 
 
 def write_matrix(robot: RobotModel, file: Path, *, samples: int, seed: int):

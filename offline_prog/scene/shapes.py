@@ -129,21 +129,25 @@ def load_shape(config, base_dir: Path, *, key: str) -> CellShape:
 def mesh_shape(
     name: str, file: Path, scale: float, *, X_OG: RigidTransform | None = None, key: str = "mesh"
 ) -> CellShape:
-    """A mesh file (STL/OBJ/PLY/GLB) as a CellShape: original mesh plus convex pieces [m]."""
+    """A mesh file (STL/OBJ/PLY/GLB) as a CellShape: original mesh plus convex pieces [m].
+
+    The mesh read is kept (the last MESHES_KEPT files, by path, size, modification time
+    and scale): a session re-plans and placement builds a cell per candidate from the
+    same files. The kept mesh is shared: nothing changes a CellShape's mesh in place.
+    """
     file = Path(file)
     try:
         if not file.is_file():
             raise ValueError("no such file")
-        import trimesh
-
-        mesh = trimesh.load(file, force="mesh")
-        if len(mesh.faces) == 0:
-            raise ValueError("no triangles")
+        stat = file.stat()
+        cache_key = (str(file.resolve()), stat.st_size, stat.st_mtime_ns, scale)
+        kept = _meshes.get(cache_key)
+        if kept is None:
+            kept = _read_mesh(file, scale)
     except Exception as error:  # trimesh raises many kinds; report one line
         reason = (str(error).splitlines() or [""])[0] or type(error).__name__
         raise ShapeError(key, f"cannot read {str(file)!r} for {name!r} ({reason})") from None
-    mesh.apply_scale(scale)
-    extent = float(max(mesh.extents))
+    mesh, extent = kept
     if extent > MAX_MESH_EXTENT_M:  # before CoACD, which would take minutes on it
         hint = " (the file looks like mm: set mesh_units: mm)" if extent / 1000 < 5 else ""
         raise ShapeError(
@@ -153,7 +157,25 @@ def mesh_shape(
         )
     visual = as_obj(file, scale)
     pieces = (visual,) if mesh.is_convex else convex_pieces(file, scale, mesh)
+    _meshes[cache_key] = kept
+    while len(_meshes) > MESHES_KEPT:
+        _meshes.pop(next(iter(_meshes)), None)
     return CellShape(name, "mesh", X_OG or RigidTransform(), (), mesh, pieces, visual)
+
+
+MESHES_KEPT = 4
+_meshes: dict[tuple, tuple] = {}  # (path, size, mtime, scale) ↦ (mesh [m], extent [m])
+
+
+def _read_mesh(file: Path, scale: float) -> tuple:
+    """(the triangle mesh scaled to metres, its largest extent [m])."""
+    import trimesh
+
+    mesh = trimesh.load(file, force="mesh")
+    if len(mesh.faces) == 0:
+        raise ValueError("no triangles")
+    mesh.apply_scale(scale)
+    return mesh, float(max(mesh.extents))
 
 
 @dataclasses.dataclass(frozen=True)

@@ -7,6 +7,7 @@ the changed cell or exports the plan folder exactly as ``offline-prog plan`` wou
 
 - ``state``: the editable parameters, typed-value checks, and the Cell they make;
 - ``replan``: the cached pipeline (which stages a change re-runs);
+- ``heap``: the process keeps freed memory for the next re-plan (glibc);
 - ``sample_states``: each sample's state for the path colours;
 - ``cell_text``: Save: the changed values written into the original file's text;
 - ``scene_view``: the MeshCat scene (cell, coloured path, closest pair, pose at σ);

@@ -28,6 +28,7 @@ from offline_prog.pipeline import StageCache
 from offline_prog.plan import StageTimer, plan_seam
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.scene.drake_cell import DrakeCell
+from offline_prog.session.heap import keep_freed_memory
 from offline_prog.stages import Inputs, load_inputs
 
 
@@ -68,6 +69,7 @@ class Replanner:
 
     def __init__(self, cell_file: Path, robots_dir: Path = ROBOTS_DIR):
         self.file, self.robots_dir = Path(cell_file), robots_dir
+        keep_freed_memory()  # re-plans reuse their arrays' memory (session.heap)
         start = time.perf_counter()
         self.base = load_inputs(self.file, robots_dir)
         self.seam_names = [seam.name for seam in job_seams(self.base.cell)]

@@ -52,31 +52,81 @@ def with_jerk(rates: JointRates) -> np.ndarray:
     return np.gradient(rates.ddq, rates.sigma, axis=0)
 
 
+# Each term of the joint rates (N, 6) from q′, q″, q‴ and the law's σ̇, σ̈, σ⃛ (module doc).
+_TERMS = {
+    "velocity": lambda dq, ddq, d3q, sd, sdd, sddd: dq * sd,
+    "centripetal": lambda dq, ddq, d3q, sd, sdd, sddd: ddq * sd**2,
+    "tangential": lambda dq, ddq, d3q, sd, sdd, sddd: dq * sdd,
+    "jerk_speed": lambda dq, ddq, d3q, sd, sdd, sddd: d3q * sd**3,
+    "jerk_change": lambda dq, ddq, d3q, sd, sdd, sddd: 3 * ddq * sd * sdd + dq * sddd,
+}
+# Each use: the terms summed and the limit (index into limits) it is divided by.
+_USES = {
+    "velocity": (("velocity",), 0),
+    "acceleration": (("centripetal", "tangential"), 1),
+    "acceleration_speed": (("centripetal",), 1),
+    "acceleration_change": (("tangential",), 1),
+    "jerk": (("jerk_speed", "jerk_change"), 2),
+    "jerk_speed": (("jerk_speed",), 2),
+    "jerk_change": (("jerk_change",), 2),
+}
+
+
+class _Use(dict):
+    """joint_use's answer: each use (and each term) computed when first read, since
+    most callers read a few of them."""
+
+    def __init__(self, rates: tuple, terms: dict, limits, **known):
+        super().__init__(known)
+        self._rates, self._limits, self._terms = rates, limits, terms
+
+    def __missing__(self, key: str) -> np.ndarray:
+        if key not in _USES:
+            raise KeyError(key)
+        names, limit = _USES[key]
+        for name in names:
+            if name not in self._terms:
+                self._terms[name] = _TERMS[name](*self._rates)
+        total = sum((self._terms[name] for name in names[1:]), self._terms[names[0]])
+        self[key] = value = np.abs(total) / self._limits[limit]
+        return value
+
+
 def joint_use(rates: JointRates, dddq: np.ndarray, law, t: np.ndarray, limits) -> dict:
     """Each limit's use at times t: σ (N,) and per term (N, 6) |term| / limit.
+
+    Keys: sigma, speed, sdd, sddd (N,) of the law; velocity, acceleration (and its
+    acceleration_speed, acceleration_change parts: q″σ̇², q′σ̈), jerk (jerk_speed,
+    jerk_change: q‴σ̇³, 3q″σ̇σ̈ + q′σ⃛), each (N, 6), computed when first read.
 
     Args:
         limits: (qd_max, qdd_max, qddd_max), each (6,) [rad/s, rad/s², rad/s³].
     """
     sigma, sd, sdd, sddd = law(t)
-    dq, ddq, d3q = interp_rows(sigma, rates.sigma, rates.dq, rates.ddq, dddq)
-    qd_max, qdd_max, qddd_max = limits
-    sd, sdd, sddd = sd[:, None], sdd[:, None], sddd[:, None]
-    centripetal, tangential = ddq * sd**2, dq * sdd
-    jerk_speed, jerk_change = d3q * sd**3, 3 * ddq * sd * sdd + dq * sddd
-    return {
-        "sigma": sigma,
-        "speed": sd[:, 0],
-        "sdd": sdd[:, 0],
-        "sddd": sddd[:, 0],
-        "velocity": np.abs(dq * sd) / qd_max,
-        "acceleration": np.abs(centripetal + tangential) / qdd_max,
-        "acceleration_speed": np.abs(centripetal) / qdd_max,
-        "acceleration_change": np.abs(tangential) / qdd_max,
-        "jerk": np.abs(jerk_speed + jerk_change) / qddd_max,
-        "jerk_speed": np.abs(jerk_speed) / qddd_max,
-        "jerk_change": np.abs(jerk_change) / qddd_max,
-    }
+    arrays = (sigma, sd, sdd, sddd, rates.sigma, rates.dq, rates.ddq, dddq)
+    key = (
+        tuple(np.shape(a) for a in arrays),
+        b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in arrays),
+    )
+    kept = _last_rates  # one read: threads may replace it
+    if kept is not None and kept[0] == key:  # the same law and path: other limits
+        rates_at_t, terms = kept[1], kept[2]
+    else:
+        dq, ddq, d3q = interp_rows(sigma, rates.sigma, rates.dq, rates.ddq, dddq)
+        rates_at_t, terms = (dq, ddq, d3q, sd[:, None], sdd[:, None], sddd[:, None]), {}
+        _keep(key, rates_at_t, terms)
+    return _Use(rates_at_t, terms, limits, sigma=sigma, speed=sd, sdd=sdd, sddd=sddd)
+
+
+# The last joint_use's rates at its times and the terms computed (they do not depend on
+# the limits): the jerk stage asks for the same law under its shared limits, then the
+# full ones, and its check once more.
+_last_rates: tuple | None = None
+
+
+def _keep(key: tuple, rates_at_t: tuple, terms: dict) -> None:
+    global _last_rates
+    _last_rates = (key, rates_at_t, terms)
 
 
 def worst_use(use: dict) -> tuple[int, float, float]:

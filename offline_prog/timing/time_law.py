@@ -73,8 +73,29 @@ class Sin2TimeLaw:
         return starts, state
 
     def __call__(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
-        """(σ, σ̇, σ̈, σ⃛) at times t (N,) [m, m/s, m/s², m/s³]; clamped outside."""
-        t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        """(σ, σ̇, σ̈, σ⃛) at times t (N,) [m, m/s, m/s², m/s³]; clamped outside.
+
+        The arrays are read-only: the law keeps its last answer (a joint plan asks for
+        the same output times four times: the jerk stage, its check, the workspace
+        trajectory and the joints), one tuple replaced whole (threads may share a law).
+        """
+        t = np.asarray(t, dtype=float)
+        key = (t.shape, t.tobytes())
+        last = self.__dict__.get("_last")
+        if last is not None and last[0] == key:
+            return last[1]
+        values = self._evaluate(t)
+        for value in values:
+            value.setflags(write=False)
+        object.__setattr__(self, "_last", (key, values))  # frozen: a cache, not a field
+        return values
+
+    def __getstate__(self) -> dict:
+        """Pickled (a placement worker's answer) without the kept evaluation."""
+        return {k: v for k, v in self.__dict__.items() if k != "_last"}
+
+    def _evaluate(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        t = np.clip(t, 0.0, self.duration)
         starts, state = self._segment_starts()
         seg = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(starts) - 1)
         tau = t - starts[seg]

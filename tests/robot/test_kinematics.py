@@ -103,6 +103,24 @@ def test_inverse_round_trip(name):
 
 
 @pytest.mark.parametrize("name", ROBOTS)
+def test_inverse_branch_is_that_column_of_inverse(name):
+    """A joint path evaluates its chosen branch alone: the same numbers, bit for bit,
+    NaN rows included (poses out of reach of some branches, and the wrist singularity)."""
+    robot = load_robot(name)
+    q = random_joints(robot, N_SAMPLES, seed=5)
+    q[::7, 4] = 0.0
+    X_BE = robot.forward(q)
+    X_BE[::11, :3, 3] *= 1.6  # some beyond the reach of some branches
+    solutions = robot.inverse(X_BE)
+    assert np.isnan(solutions).any() and not np.isnan(solutions).all()
+    for branch in range(8):
+        alone = robot.inverse_branch(X_BE, branch)
+        assert np.array_equal(alone, solutions[:, branch], equal_nan=True)
+    with pytest.raises(ValueError, match="branch"):
+        robot.inverse_branch(X_BE, 8)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
 def test_inverse_at_wrist_singularity(name):
     robot = load_robot(name)
     q = random_joints(robot, 100, seed=2)
