@@ -25,7 +25,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.density import rotation_angles, rotation_matrices
+from offline_prog.export.deviation import rotation_angles, rotation_matrices
 from offline_prog.export.program import ProgramData
 
 DENSE_SPACING_M = 1e-4  # grid step along s; its own chord error is ~h²/(8r) = 1.3 µm at r = 1 mm
