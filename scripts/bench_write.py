@@ -1,16 +1,18 @@
 """Benchmark: writing the plan folder (everything after planning), per demo cell.
 
-Run: ``python scripts/bench_write.py [CELL.yaml ...] [--runs 5]`` (default: the demo
-cells in cells/). Each cell is planned once; then ``write_job_outputs`` writes its
-folder ``--runs`` times into a temporary folder and the median wall time is printed,
-with the median of each part measured alone in the same process (the report, the
-CSVs, the program data, the npz files, each program format, report.html, and
-preview.html, which the folder writes in a second process beside the rest).
+Run: ``python scripts/bench_write.py [CELL.yaml ...] [--runs 5] [--package=DIR]
+[--baseline]`` (default: the demo cells in cells/). Each cell is planned once; then
+``write_job_outputs`` writes its folder ``--runs`` times into a temporary folder and
+the median wall time is printed, with the median of each part measured alone in the
+same process (the report, the CSVs, the program data, the npz files, each program
+format, report.html, and preview.html, which the folder writes in a second process
+beside the rest). ``--package=/work/main`` times that checkout's writers instead of
+this one's: a before/after on the same machine at about the same time.
 
 ``--baseline`` also times the KRL point selection as it was before it was batched
 (``process_points`` with one deviation per candidate segment and numpy call, kept in
-tests/selection_reference.py) against today's on each seam, and checks that
-both select the same points with the same deviations.
+tests/selection_reference.py) against today's on each seam, and checks that both
+select the same points with the same deviations.
 """
 
 from __future__ import annotations
@@ -23,8 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-# This checkout's package, not an installed one.
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+# This checkout's package, or the one of --package (another checkout, e.g. the tree
+# before a change, to compare on the same machine at the same time).
+_PACKAGE = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--package=")), None)
+sys.path.insert(0, _PACKAGE or str(Path(__file__).resolve().parents[1]))
 
 from offline_prog.export.densify import densify  # noqa: E402
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M  # noqa: E402
@@ -34,10 +38,6 @@ from offline_prog.plan import plan_job  # noqa: E402
 from offline_prog.results import job_folder  # noqa: E402
 from offline_prog.viz.job_preview import write_job_preview_html  # noqa: E402
 from offline_prog.viz.job_report_html import write_job_report_html  # noqa: E402
-
-# The point selection as it was (one segment per numpy call), kept with the tests.
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from selection_reference import reference_process_points  # noqa: E402
 
 CELLS = Path(__file__).resolve().parents[1] / "cells"
 DEMO_CELLS = (
@@ -84,6 +84,10 @@ def parts(job, folder: Path, runs: int) -> dict[str, float]:
 
 def baseline(job, summary: dict, runs: int) -> None:
     """The KRL point selection of every seam, before and after, and whether they agree."""
+    # The point selection as it was (one segment per numpy call), kept with the tests.
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from selection_reference import reference_process_points
+
     data = job_folder.job_program_data(job, summary)
     for style in ("external_tcp", "flange"):
         old = new = 0.0
@@ -107,6 +111,7 @@ def main() -> None:
     parser.add_argument("cells", nargs="*", type=Path)
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--baseline", action="store_true")
+    parser.add_argument("--package", help="=DIR: the checkout whose offline_prog to time")
     args = parser.parse_args()
     cells = args.cells or [CELLS / name for name in DEMO_CELLS]
     print(f"== writing the plan folder (median of {args.runs}) ==")

@@ -30,25 +30,32 @@ def inner_samples(i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     counts = np.maximum(j - i - 1, 0)
     seg = np.repeat(np.arange(len(i)), counts)
     starts = np.cumsum(counts) - counts
-    return seg, np.arange(int(counts.sum())) - starts[seg] + i[seg] + 1
+    return seg, np.arange(len(seg)) - starts[seg] + i[seg] + 1
 
 
 def segment_max(values: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-    """(S,) the largest of ``values`` (K,) (one per inner sample, as ``inner_samples``
-    orders them) over each segment's inner samples; 0 for a segment without any."""
+    """(S, ...) the largest of ``values`` (K, ...) (one row per inner sample, as
+    ``inner_samples`` orders them) over each segment's inner samples; 0 for a segment
+    without any."""
     counts = np.maximum(j - i - 1, 0)
-    out = np.zeros(len(i))
+    out = np.zeros((len(i), *values.shape[1:]))
     has = counts > 0
     if has.any():
-        out[has] = np.maximum.reduceat(values, (np.cumsum(counts) - counts)[has])
+        out[has] = np.maximum.reduceat(values, (np.cumsum(counts) - counts)[has], axis=0)
     return out
+
+
+def _norms(x: np.ndarray) -> np.ndarray:
+    """(K,) Euclidean norms of the rows of (K, 3): np.linalg.norm(x, axis=1), bit for
+    bit, without its dispatch (the batched selection calls it in a loop)."""
+    return np.sqrt(np.add.reduce(x * x, axis=1))
 
 
 def rotation_vectors(R: np.ndarray) -> np.ndarray:
     """(S, 3) rotation vectors [rad] (axis · angle) of rotations (S, 3, 3). Near π the
     axis is ill-conditioned from the skew part, so scipy's careful branch takes over."""
     skew = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
-    sin2 = np.linalg.norm(skew, axis=1)  # 2 sin θ
+    sin2 = _norms(skew)  # 2 sin θ
     angle = np.arctan2(0.5 * sin2, 0.5 * (np.trace(R, axis1=1, axis2=2) - 1.0))
     tiny = sin2 <= 1e-15
     out = np.where(tiny[:, None], 0.5 * skew, skew * (angle / np.where(tiny, 1.0, sin2))[:, None])
@@ -97,19 +104,20 @@ def segment_deviations(
     a = p[i]
     chord = p[j] - a
     length2 = np.einsum("sc,sc->s", chord, chord)
-    moving = (length2 > 0)[seg]
-    inner = p[k]
-    lam = np.einsum("kc,kc->k", inner - a[seg], chord[seg]) / np.where(length2 > 0, length2, 1)[seg]
-    lam = np.where(moving, np.clip(lam, 0.0, 1.0), 0.0)
-    distance = np.linalg.norm(inner - (a[seg] + lam[:, None] * chord[seg]), axis=1)
+    moving = length2 > 0
+    inner, a_k, chord_k = p[k], a[seg], chord[seg]
+    lam = np.einsum("kc,kc->k", inner - a_k, chord_k) / np.where(moving, length2, 1)[seg]
+    lam = np.where(moving[seg], np.clip(lam, 0.0, 1.0), 0.0)
+    distance = _norms(inner - (a_k + lam[:, None] * chord_k))
     # A pure reorientation (no chord): interpolate by sample index instead.
-    lam = np.where(moving, lam, (k - i[seg]) / (j - i)[seg])
+    if not moving.all():
+        lam = np.where(moving[seg], lam, (k - i[seg]) / (j - i)[seg])
     # Slerp R(λ) = R_i·Exp(λ·θ·k) = R_i + sin(λθ)·R_i·K + (1 − cos(λθ))·R_i·K² (K = [k]×),
     # and each sample's angle from it by the trace: tr(R(λ)ᵀ R_k) = 1 + 2 cos(angle).
     R_i = R[i]
     omega = rotation_vectors(np.swapaxes(R_i, 1, 2) @ R[j])
-    theta = np.linalg.norm(omega, axis=1)
-    axis = np.where((theta > 0)[:, None], omega / np.where(theta > 0, theta, 1.0)[:, None], 0.0)
+    theta = _norms(omega)
+    axis = omega / np.where(theta > 0, theta, 1.0)[:, None]  # 0 where θ = 0
     K = np.zeros((len(i), 3, 3))
     K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
     K -= np.swapaxes(K, 1, 2)
@@ -119,4 +127,5 @@ def segment_deviations(
     turn = lam * theta[seg]
     trace = traces[:, 0] + np.sin(turn) * traces[:, 1] + (1.0 - np.cos(turn)) * traces[:, 2]
     angle = np.arccos(np.clip(0.5 * (trace - 1.0), -1.0, 1.0))  # ~1e-8 rad near 0
-    return segment_max(distance, i, j), segment_max(angle, i, j)
+    worst = segment_max(np.column_stack([distance, angle]), i, j)
+    return worst[:, 0], worst[:, 1]
