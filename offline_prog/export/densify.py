@@ -78,7 +78,10 @@ def _chord_deviation(p, R, a, b, x, R_x) -> tuple[np.ndarray, np.ndarray]:
     length2 = np.einsum("kc,kc->k", chord, chord)
     lam = np.clip(np.einsum("kc,kc->k", x - p[a], chord) / np.maximum(length2, 1e-30), 0, 1)
     distance = np.linalg.norm(x - p[a] - lam[:, None] * chord, axis=1)
-    rotvec = Rotation.from_matrix(np.swapaxes(R[a], 1, 2) @ R[b]).as_rotvec()
+    # Each segment's rotation once (many points share one: the grid in a sample interval).
+    _, first, which = np.unique(a * len(p) + b, return_index=True, return_inverse=True)
+    R_ab = np.swapaxes(R[a[first]], 1, 2) @ R[b[first]]
+    rotvec = Rotation.from_matrix(R_ab).as_rotvec()[which]
     R_lam = R[a] @ rotation_matrices(lam[:, None] * rotvec)
     return distance, rotation_angles(np.swapaxes(R_lam, 1, 2) @ R_x)
 
