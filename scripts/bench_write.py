@@ -6,8 +6,8 @@ Run: ``python scripts/bench_write.py [CELL.yaml ...] [--runs 5] [--package=DIR]
 its median wall time and CPU time (of this process: preview.html is drawn in a second
 one) are printed, with the median CPU time of each part measured alone in the same
 process (the report, the CSVs, the program data, the npz files, each program
-format, report.html, and preview.html, which the folder writes in a second process
-beside the rest). ``--package=/work/main`` times that checkout's writers instead of
+format, report.html, and preview.html, which a second process writes beside the rest,
+after trajectory.csv). ``--package=/work/main`` times that checkout's writers instead of
 this one's: a before/after on the same machine at about the same time.
 
 ``--baseline`` also times the KRL point selection as it was before it was batched
@@ -75,11 +75,12 @@ def parts(job, folder: Path, runs: int) -> dict[str, float]:
     if data.feasible:
         for fmt in job_formats(data.language):
             out[fmt] = median_time(runs, lambda fmt=fmt: export(data, fmt, folder / PROGRAMS_DIR))
-    job_folder._write_rest(job, folder, {}, folder_name=folder.name)  # report.html's inputs
+    plan_dir = folder / "plan"
+    job_folder.write_job_outputs(job, plan_dir)  # report.html's inputs
     out["report.html"] = median_time(
-        runs, lambda: write_job_report_html(folder, folder_name=folder.name)
+        runs, lambda: write_job_report_html(plan_dir, folder_name=plan_dir.name)
     )
-    out["preview.html (beside)"] = median_time(
+    out["preview.html (child)"] = median_time(
         runs, lambda: write_job_preview_html(job, folder / "preview.html")
     )
     return out
