@@ -66,13 +66,8 @@ def select_points(
 
         step = 1
         while i + 2 * step < n:
-            if i + 2 * step not in known:  # with the bisection a segment as long as the last needs
-                guess = 1 << (last.bit_length() - 1)  # the doubling then stops at 2·guess
-                ends = _doublings(i, step, n, reach=4 * last)
-                tree = _bisections(i + guess, min(i + 2 * guess, n - 1), levels=_levels(2 * guess))
-                ask(
-                    ends + ([n - 1] if i + 2 * guess >= n - 1 else []) + tree if step == 1 else ends
-                )
+            if i + 2 * step not in known:
+                ask(_likely(i, n, last) if step == 1 else _doublings(i, step, n, reach=4 * last))
             if not fits(i + 2 * step):
                 break
             step *= 2
@@ -94,6 +89,16 @@ def select_points(
 
 
 _BATCH_SAMPLES = 4096  # inner samples per batch of bisection candidates
+
+
+def _likely(i: int, n: int, last: int) -> list[int]:
+    """The ends a search from i asks for if its segment is about as long as the last
+    one (``last`` samples): the doublings up to 4·last, and the bisection between the
+    last doubling that would then fit and the first that would not (guess, 2·guess),
+    with the path's last sample when it lies there."""
+    guess = 1 << (last.bit_length() - 1)
+    ends = _doublings(i, 1, n, reach=4 * last) + ([n - 1] if i + 2 * guess >= n - 1 else [])
+    return ends + _bisections(i + guess, min(i + 2 * guess, n - 1), levels=_levels(2 * guess))
 
 
 def _doublings(i: int, step: int, n: int, *, reach: int) -> list[int]:
