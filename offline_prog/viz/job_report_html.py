@@ -11,7 +11,6 @@ time axis (the I/O timeline), and the joints against their limits.
 from __future__ import annotations
 
 import csv
-import io
 import json
 from pathlib import Path
 
@@ -30,27 +29,26 @@ QUALITY_SPAN = 3.0  # the quality plot's value axis: at most this many band widt
 def _columns(plan_dir: Path, report: dict) -> dict[str, np.ndarray]:
     """The columns of trajectory.csv that the plots draw (``_drawn``), every k-th row
     beyond MAX_PLOT_POINTS and the last: ``segment`` as text, the others as numbers
-    (empty cells NaN: the quality column off the dispensing rows). Read by numpy's C
-    reader, only those columns: the same numbers as converting every cell's text."""
-    text = (plan_dir / "trajectory.csv").read_text()
-    header = next(csv.reader([text.partition("\n")[0]]))
+    (empty cells NaN: the quality column off the dispensing rows). Only those rows and
+    columns are parsed, by numpy's C reader: the same numbers as converting every
+    cell's text."""
+    header, *body = (plan_dir / "trajectory.csv").read_text().removesuffix("\n").split("\n")
+    header = next(csv.reader([header]))
     drawn = [name for name in header if _drawn(name, report)]
-    n = text.count("\n") - 1
-    step = max(1, n // MAX_PLOT_POINTS)
-    rows = np.r_[np.arange(0, n, step), [n - 1] if (n - 1) % step else []].astype(int)
+    step = max(1, len(body) // MAX_PLOT_POINTS)
+    kept = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
     out = {}
     for names, as_text in _groups(drawn, report):
         if not names:
             continue
         cells = np.loadtxt(
-            io.StringIO(text),
+            kept,
             delimiter=",",
-            skiprows=1,
             usecols=[header.index(name) for name in names],
             dtype=str if as_text else float,
             ndmin=2,
             comments=None,
-        )[rows]
+        )
         for name, column in zip(names, cells.T, strict=True):
             if name == "segment":
                 out[name] = column.astype(object)
