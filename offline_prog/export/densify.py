@@ -25,7 +25,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, PchipInterpolator
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.density import rotation_angles, rotation_matrices
+from offline_prog.export.deviation import rotation_angles, rotation_matrices
 from offline_prog.export.program import ProgramData
 
 DENSE_SPACING_M = 1e-4  # grid step along s; its own chord error is ~h²/(8r) = 1.3 µm at r = 1 mm
@@ -78,7 +78,10 @@ def _chord_deviation(p, R, a, b, x, R_x) -> tuple[np.ndarray, np.ndarray]:
     length2 = np.einsum("kc,kc->k", chord, chord)
     lam = np.clip(np.einsum("kc,kc->k", x - p[a], chord) / np.maximum(length2, 1e-30), 0, 1)
     distance = np.linalg.norm(x - p[a] - lam[:, None] * chord, axis=1)
-    rotvec = Rotation.from_matrix(np.swapaxes(R[a], 1, 2) @ R[b]).as_rotvec()
+    # Each segment's rotation once (many points share one: the grid in a sample interval).
+    _, first, which = np.unique(a * len(p) + b, return_index=True, return_inverse=True)
+    R_ab = np.swapaxes(R[a[first]], 1, 2) @ R[b[first]]
+    rotvec = Rotation.from_matrix(R_ab).as_rotvec()[which]
     R_lam = R[a] @ rotation_matrices(lam[:, None] * rotvec)
     return distance, rotation_angles(np.swapaxes(R_lam, 1, 2) @ R_x)
 

@@ -13,7 +13,8 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.spatial.transform import Rotation
+
+from offline_prog.export.deviation import segment_deviations
 
 DEFAULT_CHORD_TOL_M = 0.05e-3
 DEFAULT_ANGLE_TOL_RAD = np.deg2rad(0.1)
@@ -28,68 +29,6 @@ class Selection:
     max_angle_rad: float
 
 
-def segment_deviation(p: np.ndarray, R: np.ndarray, i: int, j: int) -> tuple[float, float]:
-    """Largest position [m] and angle [rad] deviation of samples i..j from LIN i → j.
-
-    Args:
-        p: (N, 3) positions; R: (N, 3, 3) orientations (same frame).
-    """
-    if j - i < 2:
-        return 0.0, 0.0
-    a, b = p[i], p[j]
-    chord = b - a
-    length2 = float(chord @ chord)
-    inner = p[i + 1 : j]
-    lam = np.clip((inner - a) @ chord / length2, 0.0, 1.0) if length2 > 0 else np.zeros(len(inner))
-    distance = np.linalg.norm(inner - (a + lam[:, None] * chord), axis=1)
-    if length2 == 0.0:  # pure reorientation: interpolate by sample index instead
-        lam = np.arange(1, j - i) / (j - i)
-    # Slerp R(λ) = R_i·Exp(λ·θ·k) = R_i + sin(λθ)·R_i·K + (1 − cos(λθ))·R_i·K² (K = [k]×),
-    # and each sample's angle from it by the trace: tr(R(λ)ᵀ R_k) = 1 + 2 cos(angle).
-    omega = rotation_vector(R[i].T @ R[j])
-    theta = float(np.linalg.norm(omega))
-    k = omega / theta if theta > 0 else np.zeros(3)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    A, B, R_k = R[i] @ K, R[i] @ K @ K, R[i + 1 : j]
-    trace = (
-        np.einsum("nab,ab->n", R_k, R[i])
-        + np.sin(lam * theta) * np.einsum("nab,ab->n", R_k, A)
-        + (1.0 - np.cos(lam * theta)) * np.einsum("nab,ab->n", R_k, B)
-    )
-    angle = np.arccos(np.clip(0.5 * (trace - 1.0), -1.0, 1.0))  # ~1e-8 rad near 0
-    return float(distance.max()), float(angle.max())
-
-
-def rotation_vector(R: np.ndarray) -> np.ndarray:
-    """(3,) rotation vector [rad] of one rotation (3, 3): axis · angle. Near π the axis
-    is ill-conditioned from the skew part, so scipy's careful branch takes over."""
-    skew = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    sin2 = float(np.linalg.norm(skew))  # 2 sin θ
-    angle = float(np.arctan2(0.5 * sin2, 0.5 * (np.trace(R) - 1.0)))
-    if angle > np.pi - 1e-3:
-        return Rotation.from_matrix(R).as_rotvec()
-    return skew * (angle / sin2) if sin2 > 1e-15 else 0.5 * skew
-
-
-def rotation_matrices(rotvec: np.ndarray) -> np.ndarray:
-    """(K, 3, 3) rotations of (K, 3) rotation vectors [rad] (Rodrigues, vectorized)."""
-    angle = np.linalg.norm(rotvec, axis=1)
-    small = angle < 1e-12
-    axis = rotvec / np.where(small, 1.0, angle)[:, None]
-    K = np.zeros((len(rotvec), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
-    K -= np.swapaxes(K, 1, 2)
-    s, c = np.sin(angle)[:, None, None], (1.0 - np.cos(angle))[:, None, None]
-    return np.eye(3) + s * K + c * (K @ K)
-
-
-def rotation_angles(R: np.ndarray) -> np.ndarray:
-    """(K,) rotation angles [rad] of (K, 3, 3) rotations, accurate near 0 and π
-    (atan2 of the skew part's norm against the trace)."""
-    skew = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
-    return np.arctan2(0.5 * np.linalg.norm(skew, axis=1), 0.5 * (np.trace(R, axis1=1, axis2=2) - 1))
-
-
 def select_points(
     p: np.ndarray,
     R: np.ndarray,
@@ -99,33 +38,88 @@ def select_points(
 ) -> Selection:
     """Fewest samples of a dense pose path that LIN segments follow within tolerance.
 
+    From each chosen sample i: double the segment while it fits, then bisect for the
+    last end that fits. The deviations the search asks for are evaluated in batches
+    (``export.deviation``): the doublings up to a few times the last segment's length
+    at once, the next levels of the bisection at once; the search itself and so the
+    points chosen are those of asking one segment at a time.
+
     Args:
         p: (N, 3) positions [m]; R: (N, 3, 3) orientations, in one frame.
         chord_tol_m, angle_tol_rad: largest allowed deviation of any dense sample.
     """
     n = len(p)
-
-    def fits(i: int, j: int) -> bool:
-        d, a = segment_deviation(p, R, i, j)
-        return d <= chord_tol_m and a <= angle_tol_rad
-
-    chosen, i = [0], 0
+    chosen, i, last = [0], 0, 1
     worst_d = worst_a = 0.0
     while i < n - 1:
+        known = {i + 1: (0.0, 0.0)}  # (distance, angle) of segment (i, j) by j
+
+        def ask(ends: list[int], i=i, known=known) -> None:
+            ends = [j for j in dict.fromkeys(ends) if j not in known]
+            if ends:
+                d, a = segment_deviations(p, R, np.full(len(ends), i), np.asarray(ends))
+                known.update(zip(ends, zip(d.tolist(), a.tolist(), strict=True), strict=True))
+
+        def fits(j: int, known=known) -> bool:
+            d, a = known[j]
+            return d <= chord_tol_m and a <= angle_tol_rad
+
         step = 1
-        while i + 2 * step < n and fits(i, i + 2 * step):
+        while i + 2 * step < n:
+            if i + 2 * step not in known:
+                ask(_likely(i, n, last) if step == 1 else _doublings(i, step, n, reach=4 * last))
+            if not fits(i + 2 * step):
+                break
             step *= 2
         lo, hi = i + step, min(i + 2 * step, n - 1)  # lo fits; find the last that fits
-        if hi == n - 1 and fits(i, hi):
-            lo = hi
+        if hi == n - 1:
+            ask([hi])
+            if fits(hi):
+                lo = hi
         while hi - lo > 1:
             mid = (lo + hi) // 2
-            if fits(i, mid):
-                lo = mid
-            else:
-                hi = mid
-        d, a = segment_deviation(p, R, i, lo)
+            if mid not in known:
+                ask(_bisections(lo, hi, levels=_levels(hi - i)))
+            lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+        d, a = known[lo]
         worst_d, worst_a = max(worst_d, d), max(worst_a, a)
         chosen.append(lo)
-        i = lo
+        last, i = lo - i, lo
     return Selection(np.asarray(chosen), worst_d, worst_a)
+
+
+_BATCH_SAMPLES = 4096  # inner samples per batch of bisection candidates
+
+
+def _likely(i: int, n: int, last: int) -> list[int]:
+    """The ends a search from i asks for if its segment is about as long as the last
+    one (``last`` samples): the doublings up to 4·last, and the bisection between the
+    last doubling that would then fit and the first that would not (guess, 2·guess),
+    with the path's last sample when it lies there."""
+    guess = 1 << (last.bit_length() - 1)
+    ends = _doublings(i, 1, n, reach=4 * last) + ([n - 1] if i + 2 * guess >= n - 1 else [])
+    return ends + _bisections(i + guess, min(i + 2 * guess, n - 1), levels=_levels(2 * guess))
+
+
+def _doublings(i: int, step: int, n: int, *, reach: int) -> list[int]:
+    """The next doubled ends i + 2·step, i + 4·step, ... below n, as far as ``reach``
+    samples from i (at least the first)."""
+    ends, end = [], i + 2 * step
+    while end < n and (not ends or end - i <= reach):
+        ends.append(end)
+        end = i + 2 * (end - i)
+    return ends
+
+
+def _levels(length: int) -> int:
+    """How many levels of a bisection to evaluate at once for segments about
+    ``length`` samples long (2^levels − 1 of them within _BATCH_SAMPLES, at least 1)."""
+    return max(1, int(np.log2(_BATCH_SAMPLES / max(length, 1) + 1)))
+
+
+def _bisections(lo: int, hi: int, *, levels: int) -> list[int]:
+    """The midpoints a bisection of (lo, hi) may ask for in its next ``levels`` steps."""
+    if levels == 0 or hi - lo <= 1:
+        return []
+    mid = (lo + hi) // 2
+    return [mid, *_bisections(lo, mid, levels=levels - 1), *_bisections(mid, hi, levels=levels - 1)]

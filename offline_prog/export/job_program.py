@@ -126,7 +126,7 @@ class JobProgramData:
             arrays |= {f"seam{k}_{key}": value for key, value in seam_arrays.items()}
         target = Path(folder) / JOB_FILE
         with atomic_stream(target) as stream:
-            np.savez_compressed(stream, meta=json.dumps(meta), **arrays)
+            np.savez(stream, meta=json.dumps(meta), **arrays)  # uncompressed, as plan.npz
         return target
 
     @classmethod

@@ -236,27 +236,30 @@ def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dic
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
     with staged_folder(out_dir) as folder:
-        files = {"preview": folder / "preview.html"}
-        # preview.html needs nothing else written here: the second core draws it. An
-        # error or Ctrl-C in the block stops it before the staged folder goes.
-        with InParallel(lambda: write_job_preview_html(job, files["preview"])) as preview:
-            summary = _write_rest(job, folder, files, folder_name=out_dir.name)
-            preview.wait()
+        files = {"preview": folder / "preview.html", "trajectory": folder / "trajectory.csv"}
+
+        def beside() -> None:  # what needs nothing else written here
+            write_atomic(files["trajectory"], trajectory_csv(job))
+            write_job_preview_html(job, files["preview"])
+
+        # The second core writes trajectory.csv and draws preview.html. An error or
+        # Ctrl-C in the block stops it before the staged folder goes.
+        with InParallel(beside) as child:
+            summary = _write_rest(job, folder, files)
+            child.wait()
+        # After the programs and trajectory.csv, which it reads; it names the folder
+        # the user gets, not the staged one.
+        files["report_html"] = write_job_report_html(folder, folder_name=out_dir.name)
         names = sorted({path.relative_to(folder).parts[0] for path in files.values()})
         write_manifest(folder, {"plan": names})
     return {key: out_dir / path.relative_to(folder) for key, path in files.items()}, summary
 
 
-def _write_rest(job: JobPlan, folder: Path, files: dict[str, Path], *, folder_name: str) -> dict:
-    """Everything but preview.html into the staged ``folder``, adding to ``files``;
-    returns the report. ``folder_name`` is the folder the user gets."""
+def _write_rest(job: JobPlan, folder: Path, files: dict[str, Path]) -> dict:
+    """Everything but trajectory.csv, preview.html and report.html into the staged
+    ``folder``, adding to ``files``; returns the report."""
     summary = job_report(job)
-    files |= {
-        "trajectory": folder / "trajectory.csv",
-        "report": folder / "report.json",
-        "collisions": folder / "collisions.json",
-    }
-    write_atomic(files["trajectory"], trajectory_csv(job))
+    files |= {"report": folder / "report.json", "collisions": folder / "collisions.json"}
     write_atomic(files["report"], json.dumps(summary, indent=2) + "\n")
     write_collisions_json(job.collisions, files["collisions"])
     if job.clearance_profile is not None:
@@ -269,8 +272,6 @@ def _write_rest(job: JobPlan, folder: Path, files: dict[str, Path], *, folder_na
         for fmt in job_formats(data.language):
             for file in export(data, fmt, folder / PROGRAMS_DIR):
                 files[f"{fmt}:{file.name}"] = file
-    # After the programs; it names the folder the user gets, not the staged one.
-    files["report_html"] = write_job_report_html(folder, folder_name=folder_name)
     return summary
 
 

@@ -26,21 +26,54 @@ MAX_PLOT_POINTS = 6000  # rows kept for the page's plots (every k-th row beyond)
 QUALITY_SPAN = 3.0  # the quality plot's value axis: at most this many band widths beyond
 
 
-def _columns(plan_dir: Path) -> dict[str, np.ndarray]:
-    with open(plan_dir / "trajectory.csv", newline="") as stream:
-        rows = list(csv.reader(stream))
-    header, body = rows[0], rows[1:]
+def _columns(plan_dir: Path, report: dict) -> dict[str, np.ndarray]:
+    """The columns of trajectory.csv that the plots draw (``_drawn``), every k-th row
+    beyond MAX_PLOT_POINTS and the last: ``segment`` as text, the others as numbers
+    (empty cells NaN: the quality column off the dispensing rows). Only those rows and
+    columns are parsed, by numpy's C reader: the same numbers as converting every
+    cell's text."""
+    header, *body = (plan_dir / "trajectory.csv").read_text().removesuffix("\n").split("\n")
+    header = next(csv.reader([header]))
+    drawn = [name for name in header if _drawn(name, report)]
     step = max(1, len(body) // MAX_PLOT_POINTS)
-    body = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
+    kept = body[::step] + ([body[-1]] if (len(body) - 1) % step else [])
     out = {}
-    by_column = zip(*body, strict=True) if body else [()] * len(header)
-    for name, values in zip(header, by_column, strict=True):
-        if name == "segment":
-            out[name] = np.array(values, dtype=object)
-        else:  # empty cells (sigma on links) are NaN
-            text = np.array(values)
-            out[name] = np.where(text == "", "nan", text).astype(float)
-    return out
+    for names, as_text in _groups(drawn, report):
+        if not names:
+            continue
+        cells = np.loadtxt(
+            kept,
+            delimiter=",",
+            usecols=[header.index(name) for name in names],
+            dtype=str if as_text else float,
+            ndmin=2,
+            comments=None,
+        )
+        for name, column in zip(names, cells.T, strict=True):
+            if name == "segment":
+                out[name] = column.astype(object)
+            elif as_text:  # empty cells are NaN
+                out[name] = np.where(column == "", "nan", column).astype(float)
+            else:
+                out[name] = column
+    return {name: out[name] for name in drawn}
+
+
+def _drawn(name: str, report: dict) -> bool:
+    """Whether the plots draw trajectory.csv's column ``name``."""
+    quality = report.get("quality") or {}
+    return (
+        name in ("t", "segment", "tcp_speed", *(f"q{j + 1}" for j in range(6)))
+        or (name[:2] in ("do", "ao") and name[2:].isdigit())
+        or name == quality.get("column")
+    )
+
+
+def _groups(names: list[str], report: dict) -> list[tuple[list[str], bool]]:
+    """The drawn columns read as numbers and those read as text (the segment, and the
+    quality column, empty off the dispensing rows)."""
+    text = {"segment", (report.get("quality") or {}).get("column")}
+    return [([x for x in names if x not in text], False), ([x for x in names if x in text], True)]
 
 
 def _series(values: np.ndarray, scale: float = 1.0) -> list:
@@ -202,7 +235,7 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
     plan_dir = Path(plan_dir)
     folder_name = folder_name or plan_dir.name
     report = json.loads((plan_dir / "report.json").read_text())
-    col = _columns(plan_dir)
+    col = _columns(plan_dir, report)
     job = report["job"]
     ok = report["collision_free"]
     word = '<span class="pass">PASS</span>' if ok else '<span class="fail">FAIL</span>'

@@ -9,36 +9,58 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.density import (
+from offline_prog.export.density import select_points
+from offline_prog.export.deviation import (
+    inner_samples,
     rotation_angles,
     rotation_matrices,
-    segment_deviation,
-    select_points,
+    segment_deviations,
+    segment_max,
 )
 from offline_prog.export.program import ProgramData
 
 _GRID = 64  # flange style: nozzle curve samples per LIN segment
+_BATCH_SAMPLES = 4096  # inner samples per batch ((K, _GRID, 3) arrays of a few MB)
 
 
-def _nozzle_deviation(X_BP, X_BT, X_PF, i: int, j: int) -> tuple[float, float]:
-    """Flange style: largest distance [m] / angle [rad] of the plan's X_PF[i..j] from the
-    tool frame's curve on the part while the controller interpolates X_BP from i to j
-    (position linear, orientation slerp, one parameter)."""
-    if j - i < 2:
-        return 0.0, 0.0
+def _nozzle_deviations(X_BP, X_BT, X_PF, i: np.ndarray, j: np.ndarray):
+    """Flange style: for each segment (i, j) (S,), the largest distance [m] / angle [rad]
+    of the plan's X_PF[i..j] from the tool frame's curve on the part while the controller
+    interpolates X_BP from i to j (position linear, orientation slerp, one parameter);
+    0 for j − i < 2. Segments in batches of about _BATCH_SAMPLES inner samples.
+
+    Returns:
+        ((S,) distances [m], (S,) angles [rad]).
+    """
+    distance, angle = np.zeros(len(i)), np.zeros(len(i))
+    live = np.flatnonzero(j - i >= 2)
+    inner = np.cumsum(j[live] - i[live] - 1)
+    for batch in np.split(live, np.flatnonzero(np.diff(inner // _BATCH_SAMPLES)) + 1):
+        if len(batch):
+            distance[batch], angle[batch] = _nozzle_batch(X_BP, X_BT, X_PF, i[batch], j[batch])
+    return distance, angle
+
+
+def _nozzle_batch(X_BP, X_BT, X_PF, i: np.ndarray, j: np.ndarray):
+    """_nozzle_deviations of segments (S,) with j − i ≥ 2, in one pass."""
     lam = np.linspace(0.0, 1.0, _GRID + 1)
-    rotvec = Rotation.from_matrix(X_BP[i, :3, :3].T @ X_BP[j, :3, :3]).as_rotvec()
-    R_BP = X_BP[i, :3, :3] @ rotation_matrices(lam[:, None] * rotvec)
-    p_BP = X_BP[i, :3, 3] + lam[:, None] * (X_BP[j, :3, 3] - X_BP[i, :3, 3])
-    p_PT = np.einsum("nji,nj->ni", R_BP, X_BT[:3, 3] - p_BP)  # (G+1, 3) tool origin in P
-    a, d = p_PT[:-1], np.diff(p_PT, axis=0)
-    inner = X_PF[i + 1 : j, :3, 3]
-    u = np.clip(np.einsum("kgc,gc->kg", inner[:, None] - a, d) / (d * d).sum(1).clip(1e-30), 0, 1)
-    gap = np.linalg.norm(inner[:, None] - a - u[..., None] * d, axis=2)  # (K, G)
+    R_i, R_j = X_BP[i, :3, :3], X_BP[j, :3, :3]
+    rotvec = Rotation.from_matrix(np.swapaxes(R_i, 1, 2) @ R_j).as_rotvec()
+    turns = rotation_matrices((lam[None, :, None] * rotvec[:, None, :]).reshape(-1, 3))
+    R_BP = R_i[:, None] @ turns.reshape(len(i), _GRID + 1, 3, 3)  # (S, G+1, 3, 3)
+    p_i = X_BP[i, :3, 3]
+    p_BP = p_i[:, None] + lam[None, :, None] * (X_BP[j, :3, 3] - p_i)[:, None]
+    p_PT = np.einsum("sgji,sgj->sgi", R_BP, X_BT[:3, 3] - p_BP)  # (S, G+1, 3) tool origin in P
+    a, d = p_PT[:, :-1], np.diff(p_PT, axis=1)
+    seg, k = inner_samples(i, j)
+    inner = X_PF[k, :3, 3]
+    u = np.einsum("kgc,kgc->kg", inner[:, None] - a[seg], d[seg])
+    u = np.clip(u / (d * d).sum(2).clip(1e-30)[seg], 0, 1)
+    gap = np.linalg.norm(inner[:, None] - a[seg] - u[..., None] * d[seg], axis=2)  # (K, G)
     near = gap.argmin(axis=1)
-    R_PT = np.swapaxes(R_BP[near], 1, 2) @ X_BT[:3, :3]
-    angle = rotation_angles(np.swapaxes(R_PT, 1, 2) @ X_PF[i + 1 : j, :3, :3])
-    return float(gap.min(axis=1).max()), float(angle.max())
+    R_PT = np.swapaxes(R_BP[seg, near], 1, 2) @ X_BT[:3, :3]
+    angle = rotation_angles(np.swapaxes(R_PT, 1, 2) @ X_PF[k, :3, :3])
+    return segment_max(gap.min(axis=1), i, j), segment_max(angle, i, j)
 
 
 def process_points(
@@ -68,16 +90,17 @@ def process_points(
         X_BP, X_BT = data.X_BE @ data.X_EP, data.X_BT
     else:  # it interpolates P in T, the tool at T's origin
         X_BP, X_BT = np.linalg.inv(data.X_PF), np.eye(4)
-    indices, worst = [int(chosen.indices[0])], np.zeros(2)
-    stack = list(zip(chosen.indices[1:], chosen.indices[:-1], strict=True))[::-1]
-    while stack:  # split each LIN segment until the nozzle curve on P fits as well
-        j, i = (int(v) for v in stack.pop())
-        deviation = np.maximum(
-            segment_deviation(p, R, i, j), _nozzle_deviation(X_BP, X_BT, data.X_PF, i, j)
-        )
-        if j - i > 1 and (deviation[0] > chord_tol_m or deviation[1] > angle_tol_rad):
-            stack += [(j, (i + j) // 2), ((i + j) // 2, i)]
-            continue
-        indices.append(j)
-        worst = np.maximum(worst, deviation)
-    return np.asarray(indices), float(worst[0]), float(worst[1])
+    # Split each LIN segment until the nozzle curve on P fits as well, all the
+    # segments of a round at once; the ends kept are those of splitting one by one.
+    i, j = chosen.indices[:-1], chosen.indices[1:]
+    ends, worst = [chosen.indices[:1]], np.zeros(2)
+    while len(i):
+        d_line, a_line = segment_deviations(p, R, i, j)
+        d_tool, a_tool = _nozzle_deviations(X_BP, X_BT, data.X_PF, i, j)
+        d, a = np.maximum(d_line, d_tool), np.maximum(a_line, a_tool)
+        split = (j - i > 1) & ((d > chord_tol_m) | (a > angle_tol_rad))
+        ends.append(j[~split])
+        worst = np.maximum(worst, [d[~split].max(initial=0.0), a[~split].max(initial=0.0)])
+        mid = (i[split] + j[split]) // 2
+        i, j = np.concatenate([i[split], mid]), np.concatenate([mid, j[split]])
+    return np.sort(np.concatenate(ends)), float(worst[0]), float(worst[1])
