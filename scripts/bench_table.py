@@ -33,7 +33,7 @@ GOALS_S = {
     "plan seal_plate_kr16": 1.5,
     "plan seal_job_kr16 (4 seams)": 3.0,
     "plan 30-seam job": 15.0,
-    "place: one job candidate": 1.0,
+    "place: one feasible job candidate": 1.0,
     "session re-plan, tool pose (slowest cell)": 0.3,
 }
 
@@ -67,7 +67,8 @@ def many_seams_command(n: int, runs: int) -> float:
 
 
 def place_candidate() -> float:
-    """Median seconds of one job candidate through place's serial engine."""
+    """Median seconds of one feasible job candidate through place's serial engine (of
+    CANDIDATES seeded ones; those the robot cannot reach fail in a fraction of it)."""
     from offline_prog.config.cell import load_cell
     from offline_prog.placement.engine import SerialEngine
     from offline_prog.placement.payload import cell_payload
@@ -83,8 +84,9 @@ def place_candidate() -> float:
         seconds = []
         for candidate in batch:
             start = time.perf_counter()
-            engine.map("plan", [candidate])
-            seconds.append(time.perf_counter() - start)
+            (evaluation,) = engine.map("plan", [candidate])
+            if evaluation.feasible:  # an unreachable candidate stops early: not counted
+                seconds.append(time.perf_counter() - start)
     finally:
         engine.close()
     return statistics.median(seconds)
@@ -124,7 +126,7 @@ def bench_table(runs: int = 3, big_runs: int = 1) -> None:
     row("plan seal_plate_kr16", plan_command(CELLS / "seal_plate_kr16.yaml", runs))
     row("plan seal_job_kr16 (4 seams)", plan_command(CELLS / "seal_job_kr16.yaml", runs))
     row("plan 30-seam job", many_seams_command(30, big_runs))
-    row("place: one job candidate", place_candidate())
+    row("place: one feasible job candidate", place_candidate())
     slowest = 0.0
     for cell in sorted(CELLS.glob("*.yaml")):
         seconds = session_tool_pose(cell, runs)
