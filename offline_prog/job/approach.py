@@ -191,3 +191,16 @@ def seam_ends(
             )
         )
     return moves[0], moves[1]
+
+
+def plan_ends(inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
+    """:func:`seam_ends` of a timed seam plan (``job.records.Plan``)."""
+    q_ends = plan.joints.q[[0, -1]]
+    return seam_ends(inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
+
+
+def other_branches(results: list, chosen: int, most: int) -> list:
+    """Up to ``most`` feasible IK branch results other than ``chosen``, largest
+    joint-limit margin first: the branches a seam direction offers besides its best."""
+    others = (b for b in results if b.feasible and b.branch != chosen)
+    return sorted(others, key=lambda b: -b.margin_rad)[:most]

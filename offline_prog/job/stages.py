@@ -15,7 +15,7 @@ from offline_prog.collision.check import CollisionResult, check_trajectory
 from offline_prog.collision.motion import MotionChecker
 from offline_prog.collision.profile import distance_profile
 from offline_prog.errors import InputError, PlanFailedError
-from offline_prog.job.approach import CartesianMove, seam_ends
+from offline_prog.job.approach import other_branches, plan_ends
 from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
@@ -122,10 +122,7 @@ def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
     if plan.avoidance is not None or not plan.feasible:
         return []
     joints = plan.joints
-    others = sorted(
-        (b for b in joints.branches if b.feasible and b.branch != joints.branch),
-        key=lambda b: -b.margin_rad,
-    )[:MAX_OTHER_BRANCHES]
+    others = other_branches(joints.branches, joints.branch, MAX_OTHER_BRANCHES)
     variants = []
     for other in others:
         try:
@@ -145,12 +142,6 @@ def _other_branches(inputs: Inputs, scene: DrakeCell, plan) -> list:
                 )
             )
     return variants
-
-
-def plan_ends(inputs: Inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
-    """The approach to a timed plan's first sample and the retract from its last."""
-    q_ends = plan.joints.q[[0, -1]]
-    return seam_ends(inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
 
 
 def job_pieces(

@@ -24,7 +24,7 @@ import numpy as np
 
 from offline_prog.collision.check import check_trajectory
 from offline_prog.errors import PlanFailedError
-from offline_prog.job.approach import seam_ends
+from offline_prog.job.approach import other_branches, plan_ends, seam_ends
 from offline_prog.job.order import JobOrder, order_job
 from offline_prog.job.records import Plan, SeamOption, UntimedSeam
 from offline_prog.job.seams import errors_named_for, job_config, job_seams, seam_key
@@ -97,13 +97,10 @@ def untimed_options(
     options = [SeamOption(k, seam.name, reverse, None, *moves, untimed=first)]
     if not branches:
         return options
-    others = sorted(
-        (b for b in results if b.feasible and b.branch != first.branch),
-        key=lambda b: -b.margin_rad,
-    )[:MAX_OTHER_BRANCHES]
+    others = other_branches(results, first.branch, MAX_OTHER_BRANCHES)
+    # As the timed plan of another branch gets it: the first option's path as run.
+    again = motion_setup(inputs, run.flange) if others else None
     for other in others:
-        # As the timed plan of another branch gets it: the first option's path as run.
-        again = motion_setup(inputs, run.flange)
         variant, _ = _untimed(inputs, scene, fit, frames, rotation, run.flange, again, other.branch)
         if variant is None:
             continue
@@ -281,8 +278,7 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
     block = []
     try:
         plan = seam_planner(option.seam, reverse, u.inputs, scene, known=known)
-        q_ends = plan.joints.q[[0, -1]]
-        moves = seam_ends(u.inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
+        moves = plan_ends(u.inputs, plan, seam)
         block = [SeamOption(option.seam, option.name, reverse, plan, *moves)]
     except PlanFailedError as error:
         errors[reverse] = error
