@@ -33,6 +33,7 @@ from pathlib import Path
 from offline_prog.collision.profile import distance_profile
 from offline_prog.config.edits import CellValues
 from offline_prog.errors import PlanFailedError
+from offline_prog.forked import quiet
 from offline_prog.job.records import JobPlan, Plan
 from offline_prog.pipeline import (
     JOB_CLEARANCE,
@@ -154,7 +155,7 @@ def plan_job(
     """
     stage = StageTimer(progress)
     inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir)
-    return plan_loaded_job(inputs, stage)
+    return plan_loaded_job(inputs, stage, parallel=True)
 
 
 def plan_loaded_job(
@@ -163,6 +164,7 @@ def plan_loaded_job(
     *,
     clearance_profile: bool = True,
     fits: dict[tuple[int, bool], FittedPath] | None = None,
+    parallel: bool = False,
 ) -> JobPlan:
     """:func:`plan_job` on loaded inputs (a placement candidate's cell, in memory).
 
@@ -171,10 +173,12 @@ def plan_loaded_job(
         fits: (seam index, reversed) ↦ the seam's fitted path, kept by the caller: a
             fit found here is used, one computed here is added (a path on the part does
             not change with the placement).
+        parallel: plan the seams on a forked second process too (``forked``; not for
+            placement, whose workers already take every core).
     """
     fits = {} if fits is None else fits
     stages = JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ())
-    planner = SeamPlanner(stage.progress, fits)
+    planner = SeamPlanner(stage.progress, fits, parallel=parallel)
     results = {"inputs": inputs, "progress": stage.progress, "seam_planner": planner}
     run_stages(stages, results, stage)
     linked, timed = results["links"], results["order"]
@@ -201,10 +205,11 @@ class SeamPlanner:
     """One seam in one direction for the job's stages, by the one-seam pipeline: its
     fit and frames alone (:meth:`geometry`), or its whole plan (called), each seam
     direction's stage timings in one StageTimer. Keeps each fit in ``fits``
-    ((seam index, reversed) ↦ FittedPath)."""
+    ((seam index, reversed) ↦ FittedPath); with ``parallel`` the job's seams are planned
+    on two processes (``job.stages.seam_options``)."""
 
-    def __init__(self, progress: Callable[[str], None], fits: dict):
-        self.progress, self.fits = progress, fits
+    def __init__(self, progress: Callable[[str], None], fits: dict, *, parallel: bool = False):
+        self.progress, self.fits, self.parallel = progress, fits, parallel
         self.timers: dict[tuple[int, bool], StageTimer] = {}
 
     def geometry(self, k: int, reverse: bool, inputs: Inputs, scene: DrakeCell) -> dict:
@@ -215,6 +220,13 @@ class SeamPlanner:
         run_stages(SEAM_STAGES[:2], results, self.timer(k, reverse))
         self.fits[k, reverse] = results["fit"]
         return {name: results[name] for name in ("fit", "frames")}
+
+    def silence(self) -> None:
+        """Tell no more progress (a forked process's: the terminal's line is the
+        parent's)."""
+        self.progress = quiet
+        for timer in self.timers.values():
+            timer.progress = quiet
 
     def timer(self, k: int, reverse: bool) -> StageTimer:
         """The StageTimer of seam k in one direction (its plan's ``timings_s``)."""

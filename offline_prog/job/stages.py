@@ -15,6 +15,7 @@ from offline_prog.collision.check import CollisionResult, check_trajectory
 from offline_prog.collision.motion import MotionChecker
 from offline_prog.collision.profile import distance_profile
 from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.forked import forked_map, in_child, quiet
 from offline_prog.job.approach import other_branches, plan_ends
 from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
@@ -56,13 +57,20 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamC
         PlanFailedError: a seam cannot be done in any direction (its reason, named).
     """
     check_speed_bands(inputs)
-    options, errors, seams = [], [], job_seams(inputs.cell)
-    for k, seam in enumerate(seams):
+    seams = job_seams(inputs.cell)
+
+    def one_seam(k: int):
+        """(seam k's options, why a direction was dropped, its fits and stage timers)."""
+        tell = progress
+        if in_child():  # the terminal's progress line is the parent's
+            tell = quiet
+            plan_seam.silence()
+        seam = seams[k]
         directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]
         found, failed = [], {}
         for reverse in directions:
             text = f"seam {k + 1}/{len(seams)}: {seam.name} ({'reverse' if reverse else 'forward'})"
-            progress(Step(text, stage="seams", done=k, total=len(seams)))
+            tell(Step(text, stage="seams", done=k, total=len(seams)))
             try:
                 with errors_named_for(seam_key(inputs.cell, k)):
                     seam_in = seam_inputs(inputs, k, reverse=reverse)
@@ -74,6 +82,23 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamC
             if inputs.cell.seams:  # name the seam (a path: cell has only the one)
                 failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
             raise PlanFailedError(failure)
+        keys = [(k, reverse) for reverse in directions]
+        fits = {key: plan_seam.fits[key] for key in keys if key in plan_seam.fits}
+        timers = {key: plan_seam.timers[key] for key in keys if key in plan_seam.timers}
+        return found, failed, fits, timers
+
+    items = range(len(seams))
+    if plan_seam.parallel:  # on the second core too (the seams are independent)
+        outcomes = forked_map(one_seam, list(items), shared=(inputs, scene, plan_seam))
+        results = (outcome.result() for outcome in outcomes)  # raised in the seams' order
+    else:
+        results = (one_seam(k) for k in items)  # the first seam that fails ends it
+    options, errors = [], []
+    for found, failed, fits, timers in results:
+        plan_seam.fits.update(fits)
+        for key, timer in timers.items():
+            timer.progress = plan_seam.progress
+            plan_seam.timers[key] = timer
         options.append(found)
         errors.append(failed)
     progress(Step(f"{len(seams)} seams planned", stage="seams", done=len(seams), total=len(seams)))

@@ -19,11 +19,13 @@ the whole direction with its first).
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
 from offline_prog.collision.check import check_trajectory
 from offline_prog.errors import PlanFailedError
+from offline_prog.forked import forked_map, in_child
 from offline_prog.job.approach import other_branches, plan_ends, seam_ends
 from offline_prog.job.order import JobOrder, order_job
 from offline_prog.job.records import Plan, SeamOption, UntimedSeam
@@ -198,14 +200,25 @@ def timed_order(
         flat = [(k, j) for k, seam in enumerate(options) for j in range(len(seam))]
         chosen = [flat[i] for i in order.sequence]
         pending = [(k, j) for k, j in chosen if options[k][j].plan is None]
+
+        time_one = functools.partial(
+            _time_pending, inputs, scene, seam_planner, options, errors, pending, progress
+        )
+        items = list(range(len(pending)))
+        if seam_planner.parallel:  # the chosen seams are timed on the second core too
+            shared = (inputs, scene, seam_planner, options, errors)
+            outcomes = forked_map(time_one, items, shared=shared)
+            results = (outcome.result() for outcome in outcomes)  # raised in order
+        else:
+            results = (time_one(n) for n in items)
         changed = False
-        for done, (k, j) in enumerate(pending):
-            text = f"timing seam {options[k][j].label}"
-            progress(Step(text, stage="timing", done=done, total=len(pending)))
+        for (k, j), (timed, same, seam_errors, timings) in zip(pending, results, strict=True):
             name = options[k][j].name
-            with errors_named_for(seam_key(inputs.cell, k)):
-                seam = job_seams(inputs.cell)[k]
-                options[k], same = _time(options[k], j, scene, seam_planner, errors[k], seam)
+            options[k] = timed
+            errors[k].clear()
+            errors[k].update(seam_errors)
+            for key, timings_s in timings.items():  # in place: a plan holds its timer's
+                seam_planner.timer(*key).timings_s.update(timings_s)
             changed |= not same
             if not options[k]:
                 failure = errors[k][min(errors[k])].failure  # forward's reason first
@@ -214,6 +227,25 @@ def timed_order(
                 raise PlanFailedError(failure)
         if not changed:
             return TimedOrder(options, order)
+
+
+def _time_pending(inputs, scene, seam_planner, options, errors, pending, progress, n: int):
+    """(seam k's options with option j timed (:func:`_time`), whether they are the same
+    ones, its errors, its timers' timings) for ``pending[n]`` = (k, j): new containers, so
+    that what changed travels back from a forked process (``offline_prog.forked``)."""
+    k, j = pending[n]
+    if in_child():  # the terminal's progress line is the parent's
+        seam_planner.silence()
+    else:
+        text = f"timing seam {options[k][j].label}"
+        progress(Step(text, stage="timing", done=n, total=len(pending)))
+    seam_errors = dict(errors[k])
+    with errors_named_for(seam_key(inputs.cell, k)):
+        seam = job_seams(inputs.cell)[k]
+        timed, same = _time(options[k], j, scene, seam_planner, seam_errors, seam)
+    keys = [key for key in seam_planner.timers if key[0] == k]
+    timings = {key: dict(seam_planner.timers[key].timings_s) for key in keys}
+    return timed, same, seam_errors, timings
 
 
 def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):

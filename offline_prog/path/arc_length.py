@@ -10,6 +10,7 @@ u-derivatives (so no finite differences anywhere downstream).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
@@ -144,21 +145,28 @@ def compose_derivatives(c: list[np.ndarray], u: list[np.ndarray]) -> list[np.nda
 
 def curve_speed(derivatives: Callable[[np.ndarray, int], np.ndarray]) -> SpeedFunction:
     """SpeedFunction g = |c'|, g' = c'·c''/g, g'' = (|c''|² + c'·c''' − g'²)/g."""
+    return CurveSpeed(derivatives)
 
-    def speed(u: np.ndarray, order: int = 2):
-        c1 = derivatives(u, 1)
+
+@dataclasses.dataclass(frozen=True)
+class CurveSpeed:
+    """:func:`curve_speed`'s SpeedFunction, an object rather than a closure so that a
+    path can be pickled (``offline_prog.forked``)."""
+
+    derivatives: Callable[[np.ndarray, int], np.ndarray]  # (u (N,), k) ↦ c⁽ᵏ⁾(u) (N, 3)
+
+    def __call__(self, u: np.ndarray, order: int = 2):
+        c1 = self.derivatives(u, 1)
         g = np.linalg.norm(c1, axis=1)
         if order == 0:
             return (g,)
-        c2 = derivatives(u, 2)
+        c2 = self.derivatives(u, 2)
         g1 = np.einsum("ij,ij->i", c1, c2) / g
         if order == 1:
             return g, g1
-        c3 = derivatives(u, 3)
+        c3 = self.derivatives(u, 3)
         g2 = (np.einsum("ij,ij->i", c2, c2) + np.einsum("ij,ij->i", c1, c3) - g1**2) / g
         return g, g1, g2
-
-    return speed
 
 
 class ArcLengthPath:
