@@ -2,6 +2,6 @@
 
 import sys
 
-from offline_prog.cli import main
+from offline_prog.cli import command
 
-sys.exit(main())
+sys.exit(command())
