@@ -42,6 +42,8 @@ from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs, attempt_motion
 
 LINK_SEED = 0  # links are seeded with this plus their index: same job, same links
+# The directions a seam's ``direction`` runs it in (reversed?), forward first.
+DIRECTIONS = {"forward": (False,), "reverse": (True,), "auto": (False, True)}
 
 
 def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamChoices:
@@ -58,49 +60,49 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamC
     """
     check_speed_bands(inputs)
     seams = job_seams(inputs.cell)
+    items = [(k, reverse) for k, seam in enumerate(seams) for reverse in DIRECTIONS[seam.direction]]
 
-    def one_seam(k: int):
-        """(seam k's options, why a direction was dropped, its fits and stage timers)."""
+    def one_direction(item: tuple[int, bool]):
+        """(seam k's options in one direction, or why it cannot run that way; its fit
+        and stage timer)."""
+        k, reverse = item
         tell = progress
         if in_child():  # the terminal's progress line is the parent's
             tell = quiet
             plan_seam.silence()
-        seam = seams[k]
-        directions = {"forward": [False], "reverse": [True], "auto": [False, True]}[seam.direction]
-        found, failed = [], {}
-        for reverse in directions:
-            text = f"seam {k + 1}/{len(seams)}: {seam.name} ({'reverse' if reverse else 'forward'})"
-            tell(Step(text, stage="seams", done=k, total=len(seams)))
-            try:
-                with errors_named_for(seam_key(inputs.cell, k)):
-                    seam_in = seam_inputs(inputs, k, reverse=reverse)
-                    found += _direction_options(inputs, seam_in, scene, plan_seam, k, reverse, seam)
-            except PlanFailedError as error:
-                failed[reverse] = error
-        if not found:
-            failure = failed[directions[0]].failure
-            if inputs.cell.seams:  # name the seam (a path: cell has only the one)
-                failure = dataclasses.replace(failure, reason=f"seam {seam.name}: {failure.reason}")
-            raise PlanFailedError(failure)
-        keys = [(k, reverse) for reverse in directions]
-        fits = {key: plan_seam.fits[key] for key in keys if key in plan_seam.fits}
-        timers = {key: plan_seam.timers[key] for key in keys if key in plan_seam.timers}
-        return found, failed, fits, timers
+        seam, found, error = seams[k], [], None
+        text = f"seam {k + 1}/{len(seams)}: {seam.name} ({'reverse' if reverse else 'forward'})"
+        tell(Step(text, stage="seams", done=k, total=len(seams)))
+        try:
+            with errors_named_for(seam_key(inputs.cell, k)):
+                seam_in = seam_inputs(inputs, k, reverse=reverse)
+                found = _direction_options(inputs, seam_in, scene, plan_seam, k, reverse, seam)
+        except PlanFailedError as failed:
+            error = failed
+        return found, error, plan_seam.fits.get(item), plan_seam.timers.get(item)
 
-    items = range(len(seams))
-    if plan_seam.parallel:  # on the second core too (the seams are independent)
-        outcomes = forked_map(one_seam, list(items), shared=(inputs, scene, plan_seam))
-        results = (outcome.result() for outcome in outcomes)  # raised in the seams' order
+    if plan_seam.parallel:  # on the second core too (seams and directions are independent)
+        outcomes = forked_map(one_direction, items, shared=(inputs, scene, plan_seam))
+        results = (outcome.result() for outcome in outcomes)  # raised in their order
     else:
-        results = (one_seam(k) for k in items)  # the first seam that fails ends it
-    options, errors = [], []
-    for found, failed, fits, timers in results:
-        plan_seam.fits.update(fits)
-        for key, timer in timers.items():
+        results = (one_direction(item) for item in items)  # the first failure ends it
+    options, errors = [[] for _ in seams], [{} for _ in seams]
+    for (k, reverse), (found, error, fit, timer) in zip(items, results, strict=True):
+        if fit is not None:
+            plan_seam.fits[k, reverse] = fit
+        if timer is not None:
             timer.progress = plan_seam.progress
-            plan_seam.timers[key] = timer
-        options.append(found)
-        errors.append(failed)
+            plan_seam.timers[k, reverse] = timer
+        options[k] += found
+        if error is not None:
+            errors[k][reverse] = error
+        if reverse == DIRECTIONS[seams[k].direction][-1] and not options[k]:
+            failure = errors[k][DIRECTIONS[seams[k].direction][0]].failure
+            if inputs.cell.seams:  # name the seam (a path: cell has only the one)
+                failure = dataclasses.replace(
+                    failure, reason=f"seam {seams[k].name}: {failure.reason}"
+                )
+            raise PlanFailedError(failure)
     progress(Step(f"{len(seams)} seams planned", stage="seams", done=len(seams), total=len(seams)))
     return SeamChoices(options, errors)
 
