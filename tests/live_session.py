@@ -18,6 +18,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 from pathlib import Path
 from urllib.parse import parse_qs, urlsplit
 
@@ -55,6 +56,25 @@ class Live:
     port: int
     url: str  # as printed
     token: str  # "" when the URL has none
+    # What it wrote after the URL line, read as it comes (a terminal never blocks the
+    # session; a pipe nobody reads would once 64 KiB were written): see ``stderr()``.
+    printed: dict = dataclasses.field(default_factory=lambda: {"stdout": [], "stderr": []})
+    readers: list = dataclasses.field(default_factory=list)
+
+    def __post_init__(self):
+        for name in ("stdout", "stderr"):
+            reader = threading.Thread(
+                target=_collect, args=(getattr(self.process, name), self.printed[name]), daemon=True
+            )
+            reader.start()
+            self.readers.append(reader)
+
+    def stderr(self) -> str:
+        """What the session wrote on stderr so far (all of it once it ended)."""
+        if self.process.poll() is not None:
+            for reader in self.readers:
+                reader.join(timeout=5)
+        return "".join(self.printed["stderr"])
 
     def send(self, method: str, path: str, body=None, *, headers=None, host=None):
         """(status, JSON reply or text) of one request; ``body`` a dict or list (sent as JSON)
@@ -87,14 +107,24 @@ class Live:
         return snapshot
 
     def stop(self) -> int:
-        """Ctrl-C; the exit code."""
+        """Ctrl-C; the exit code (fails the test, with what the session wrote, if it
+        does not stop)."""
         if self.process.poll() is None:
             self.process.send_signal(signal.SIGINT)
         try:
             return self.process.wait(timeout=30)
         except subprocess.TimeoutExpired:
             self.process.kill()
-            return self.process.wait()
+            code = self.process.wait()
+            pytest.fail(
+                f"the session did not stop on Ctrl-C within 30 s: {self.stderr()[-2000:]!r}"
+            )
+            return code
+
+
+def _collect(stream, lines: list[str]) -> None:
+    for line in stream:
+        lines.append(line)
 
 
 def copy_cell(name: str, folder: Path) -> Path:

@@ -130,10 +130,10 @@ def test_bad_values_are_400_and_the_session_keeps_running_with_its_values(own):
         assert code == 400 and reply["ok"] is False, (body, reply)
         assert reason in reply["message"] and "\n" not in reply["message"], (body, reply)
     time.sleep(0.5)  # a few main-loop rounds: a NaN σ would have reached Drake
-    assert own.process.poll() is None, own.process.stderr.read()
+    assert own.process.poll() is None, own.stderr()
     after = own.status()
     assert after["values"]["X_IT.x"] == 1010.0 and after["auto"] is False
     assert after["values"] == before["values"]
     assert own.stop() == 130
-    stderr = own.process.stderr.read()
+    stderr = own.stderr()
     assert "Traceback" not in stderr and "RecursionError" not in stderr, stderr
