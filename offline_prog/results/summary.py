@@ -101,8 +101,7 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         f"tool {report['tool']}, part {report['part']}: {len(report['seams'])} "
         + ("seam" if len(report["seams"]) == 1 else "seams")
     )
-    if not report["payload"]["set"]:
-        console.print(f"  [bold yellow]payload   {report['payload']['warning']}[/bold yellow]")
+    print_payload_warning(console, report)
     order = ", ".join(f"{o['seam']} ({o['direction']})" for o in job["order"])
     console.print(
         f"  order     {order} ({job['order_mode']}, {job['order_method']}; estimated "
@@ -122,7 +121,6 @@ def print_job_summary(console: Console, report: dict, files: dict, seconds: floa
         f"air {job['air_time_s']:.2f} s (links {job['link_time_s']:.2f} s, approach and "
         f"retract {job['approach_retract_time_s']:.2f} s)"
     )
-    print_payload_warning(console, report)
     for seam in report["seams"]:
         console.print(
             f"  seam      {seam['seam']}: {seam['path']['length_m'] * 1e3:.1f} mm, "

@@ -127,4 +127,4 @@ def test_a_job_reports_and_prints_the_payload_warning(planned_job):
     assert list(report).index("payload") < 10  # near the top: prominent
     out = io.StringIO()
     print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
-    assert f"payload   {report['payload']['warning']}" in out.getvalue()
+    assert out.getvalue().count(f"payload   {report['payload']['warning']}") == 1  # once
