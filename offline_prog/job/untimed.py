@@ -206,9 +206,11 @@ def timed_order(
         )
         items = list(range(len(pending)))
         if seam_planner.parallel:  # the chosen seams are timed on the second core too
+            # Longest path first: the two processes end nearer together.
+            longest = sorted(items, key=lambda n: -_length(options[pending[n][0]][pending[n][1]]))
             shared = (inputs, scene, seam_planner, options, errors)
-            outcomes = forked_map(time_one, items, shared=shared)
-            results = (outcome.result() for outcome in outcomes)  # raised in order
+            outcomes = dict(zip(longest, forked_map(time_one, longest, shared=shared), strict=True))
+            results = (outcomes[n].result() for n in items)  # raised in order
         else:
             results = (time_one(n) for n in items)
         changed = False
@@ -227,6 +229,11 @@ def timed_order(
                 raise PlanFailedError(failure)
         if not changed:
             return TimedOrder(options, order)
+
+
+def _length(option: SeamOption) -> float:
+    """The option's path length [m]: the size of its time law's work."""
+    return option.untimed.fit.path.length if option.untimed else option.plan.path.length
 
 
 def _time_pending(inputs, scene, seam_planner, options, errors, pending, progress, n: int):
