@@ -24,6 +24,7 @@ from pydrake.math import RigidTransform
 from offline_prog.atomic import write_atomic
 from offline_prog.config.cell import transform
 from offline_prog.scene.drake_cell import build_cell_model
+from offline_prog.scene.mesh_cache import drawn_arrays
 from offline_prog.viz.static_scene import StaticScene
 
 PREVIEW_FPS = 30.0
@@ -110,26 +111,40 @@ def _joints_at(plan, times: np.ndarray) -> np.ndarray:
 def _mesh_file(shape) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """(vertices (V, 3) [m], faces (F, 3), vertex colours (V, 3) or None) of a Drake
     Mesh (its file; each part coloured by its material, e.g. an OBJ's .mtl) or Convex
-    (its hull)."""
-    import trimesh  # only for mesh files: half a second of import time otherwise saved
-
-    scale = np.asarray(shape.scale3())
+    (its hull); the file's arrays are kept in the mesh cache (``drawn_arrays``)."""
+    file = shape.source().path()
     if isinstance(shape, Convex):
-        hull = trimesh.load(shape.source().path(), force="mesh").convex_hull
-        return np.asarray(hull.vertices) * scale, np.asarray(hull.faces), None
-    parts = trimesh.load(shape.source().path(), force="scene").dump(concatenate=False)
+        arrays = drawn_arrays(file, "preview hull v1", lambda: _hull_arrays(file))
+    else:
+        arrays = drawn_arrays(file, "preview parts v1", lambda: _part_arrays(file))
+    scale = np.asarray(shape.scale3())
+    return arrays["vertices"] * scale, arrays["faces"], arrays.get("colors")
+
+
+def _hull_arrays(file: str) -> dict[str, np.ndarray]:
+    """{vertices (V, 3), faces (F, 3)} of a mesh file's convex hull, in file units."""
+    import trimesh  # only for a mesh file not drawn before: ~0.2 s of import
+
+    hull = trimesh.load(file, force="mesh").convex_hull
+    return {"vertices": np.asarray(hull.vertices), "faces": np.asarray(hull.faces)}
+
+
+def _part_arrays(file: str) -> dict[str, np.ndarray]:
+    """{vertices (V, 3), faces (F, 3), colors (V, 3) if every part has a material} of a
+    mesh file's parts joined, in file units."""
+    import trimesh  # only for a mesh file not drawn before: ~0.2 s of import
+
+    parts = trimesh.load(file, force="scene").dump(concatenate=False)
     vertices, faces, colors, offset = [], [], [], 0
     for part in parts:
-        vertices.append(np.asarray(part.vertices) * scale)
+        vertices.append(np.asarray(part.vertices))
         faces.append(np.asarray(part.faces) + offset)
         offset += len(part.vertices)
         colors.append(np.tile(_part_color(part), (len(part.vertices), 1)))
-    colored = any(c is not None for c in colors)
-    return (
-        np.vstack(vertices),
-        np.vstack(faces),
-        np.vstack(colors) if colored and all(c is not None for c in colors) else None,
-    )
+    arrays = {"vertices": np.vstack(vertices), "faces": np.vstack(faces)}
+    if all(c is not None for c in colors):
+        arrays["colors"] = np.vstack(colors)
+    return arrays
 
 
 def _part_color(part) -> np.ndarray | None:
