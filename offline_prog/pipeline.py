@@ -29,10 +29,12 @@ collision  inputs, fit, frames, scene,     (all of those)
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections.abc import Callable
 
 from offline_prog.config.edits import CellValues
 from offline_prog.errors import InputError, PlanFailedError
+from offline_prog.forked import forked_map
 from offline_prog.job.home import home_pose
 from offline_prog.job.stages import (
     check_job,
@@ -116,6 +118,8 @@ JOB_STAGES = (
     Stage("quality", "process quality", job_quality, ("inputs", "links", "io")),
     Stage("check", "collision check of the whole job", check_job, ("inputs", "scene", "links")),
 )
+# The check (last) and the clearance profile read the linked job, not each other.
+JOB_CHECK = JOB_STAGES[-1]
 JOB_CLEARANCE = Stage("clearance", "clearance profile", job_clearance, ("scene", "links"))
 
 
@@ -163,6 +167,28 @@ def run_stages(
             raise kept[1]
         results[stage.name] = kept[1]
     return results
+
+
+def run_side_by_side(stages: tuple[Stage, ...], results: dict[str, object], timer) -> None:
+    """Run ``stages``, none of which reads another's result, on this process and a
+    forked child (``forked.forked_map``); ``results`` gets each one's result and
+    ``timer`` each one's own wall time, as :func:`run_stages` would give them.
+
+    Raises:
+        The first stage's error, in ``stages``' order, as a serial run would.
+    """
+
+    def timed(stage: Stage) -> tuple[object, float]:
+        start = time.perf_counter()
+        value = stage.function(*(results[r] for r in stage.reads))
+        return value, time.perf_counter() - start
+
+    timer.progress(" and ".join(stage.description for stage in stages))
+    outcomes = forked_map(timed, list(stages), shared=[results])
+    for stage, outcome in zip(stages, outcomes, strict=True):
+        results[stage.name], seconds = outcome.result()
+        key = timer.prefix + stage.name
+        timer.timings_s[key] = timer.timings_s.get(key, 0.0) + seconds
 
 
 def with_normal_hint(error: PlanFailedError, inputs: Inputs, fit: FittedPath, scene):

@@ -36,10 +36,12 @@ from offline_prog.errors import PlanFailedError
 from offline_prog.forked import quiet
 from offline_prog.job.records import JobPlan, Plan
 from offline_prog.pipeline import (
+    JOB_CHECK,
     JOB_CLEARANCE,
     JOB_STAGES,
     SEAM_STAGES,
     StageCache,
+    run_side_by_side,
     run_stages,
     with_normal_hint,
 )
@@ -177,10 +179,13 @@ def plan_loaded_job(
             placement, whose workers already take every core).
     """
     fits = {} if fits is None else fits
-    stages = JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ())
     planner = SeamPlanner(stage.progress, fits, parallel=parallel)
     results = {"inputs": inputs, "progress": stage.progress, "seam_planner": planner}
-    run_stages(stages, results, stage)
+    if clearance_profile and parallel:  # the check and the profile: one on each core
+        run_stages(JOB_STAGES[: JOB_STAGES.index(JOB_CHECK)], results, stage)
+        run_side_by_side((JOB_CHECK, JOB_CLEARANCE), results, stage)
+    else:
+        run_stages(JOB_STAGES + ((JOB_CLEARANCE,) if clearance_profile else ()), results, stage)
     linked, timed = results["links"], results["order"]
     return JobPlan(
         inputs.file,

@@ -2,7 +2,9 @@
 serial loop, the objects both hold coming back as themselves, and a job planned on two
 processes equal to the job planned on one."""
 
+import dataclasses
 import os
+import pickle
 import threading
 import time
 
@@ -83,3 +85,10 @@ def test_a_job_planned_on_two_processes_is_the_job_planned_on_one():
         np.testing.assert_array_equal(mine.plan.joints.qd, theirs.plan.joints.qd)
         assert mine.plan.timings_s.keys() == theirs.plan.timings_s.keys()
     assert two.collisions.min_distance_m == one.collisions.min_distance_m
+    # The check and the clearance profile ran side by side: the same results (bit for
+    # bit: pickled alike) and stages.
+    mine, theirs = (dataclasses.asdict(job.collisions) for job in (two, one))
+    assert mine.pop("stats").keys() == theirs.pop("stats").keys()  # with run times
+    assert pickle.dumps(mine) == pickle.dumps(theirs)
+    assert pickle.dumps(two.clearance_profile) == pickle.dumps(one.clearance_profile)
+    assert two.timings_s.keys() == one.timings_s.keys()
