@@ -147,16 +147,17 @@ def point_curve_distances(curve, points: np.ndarray, u0: np.ndarray, lo: float, 
     Returns:
         (N,) distances [m]; never larger than the residual |r(u0) − point|.
     """
-    best = np.linalg.norm(curve(u0, 0) - points, axis=1)
+    diff = curve(u0, 0) - points
+    best = np.linalg.norm(diff, axis=1)
     u = u0.copy()
     for _ in range(6):
-        diff = curve(u, 0) - points
         d1, d2 = curve(u, 1), curve(u, 2)
         grad = np.einsum("ij,ij->i", diff, d1)
         hess = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", diff, d2)
         step = np.where(hess > 0, grad / np.where(hess > 0, hess, 1.0), 0.0)
         u = np.clip(u - step, lo, hi)
-        best = np.minimum(best, np.linalg.norm(curve(u, 0) - points, axis=1))
+        diff = curve(u, 0) - points  # the residual at the new u: the next step's too
+        best = np.minimum(best, np.linalg.norm(diff, axis=1))
     return best
 
 
