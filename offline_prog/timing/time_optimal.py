@@ -146,7 +146,11 @@ def _toppra_algorithm():
     """toppra.algorithm, imported here only (a plan without the time-optimal law does
     without it) and without matplotlib: toppra imports matplotlib.pyplot at load for its
     plot helpers only, 0.35 s of a plan's start. While toppra loads, matplotlib and
-    matplotlib.pyplot are stand-ins that import the real module if toppra ever plots."""
+    matplotlib.pyplot are stand-ins that import the real module if toppra ever plots.
+
+    Every solve's algorithm asks ``toppra.solverwrapper.available_solvers`` which
+    optional solvers are installed, a search of the whole import path (~0.1 ms, 340
+    times in a placement candidate): the answer is kept after the first."""
     if "toppra.algorithm" not in sys.modules:
         deferred = {
             name: _Deferred(name)
@@ -161,6 +165,8 @@ def _toppra_algorithm():
         finally:
             for name in deferred:
                 del sys.modules[name]
+        solvers = sys.modules["toppra.solverwrapper"]
+        solvers.available_solvers = functools.cache(solvers.available_solvers)
     return sys.modules["toppra.algorithm"]
 
 
