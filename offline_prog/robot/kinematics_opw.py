@@ -71,6 +71,18 @@ def _rot_y(theta: np.ndarray) -> np.ndarray:
     return np.stack([c, z, s, z, o, z, -s, z, c], axis=-1).reshape(theta.shape + (3, 3))
 
 
+def _rot_z_rot_y(theta_z: np.ndarray, theta_y: np.ndarray) -> np.ndarray:
+    """Rz(theta_z) Ry(theta_y) for theta_z, theta_y (...,) [rad] -> (..., 3, 3), written
+    out: the numbers of ``_rot_z(theta_z) @ _rot_y(theta_y)`` (each entry one product
+    or one factor; the product's other terms are zeros) at a third of its cost."""
+    cz, sz, cy, sy = np.cos(theta_z), np.sin(theta_z), np.cos(theta_y), np.sin(theta_y)
+    R = np.empty(theta_z.shape + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 0, 2] = cz * cy, -sz, cz * sy
+    R[..., 1, 0], R[..., 1, 1], R[..., 1, 2] = sz * cy, cz, sz * sy
+    R[..., 2, 0], R[..., 2, 1], R[..., 2, 2] = -sy, 0.0, cy
+    return R
+
+
 def acos_clipped(x: np.ndarray) -> np.ndarray:
     """arccos that forgives rounding just outside [-1, 1] and is NaN beyond it."""
     x = np.where(np.abs(x) <= 1.0 + DOMAIN_SLACK, np.clip(x, -1.0, 1.0), np.nan)
@@ -218,7 +230,7 @@ def _solutions(params: OpwParameters, X_BE: np.ndarray, arms: slice, flips: tupl
     p_BC = X_BE[:, :3, 3] - params.c4 * R_BE[:, :, 2]
     theta1, theta2, theta3 = (t[:, arms] for t in _arm_solutions(params, p_BC))
     # Wrist: R_CE = R_BC^T R_BE = Rz(theta4) Ry(theta5) Rz(theta6) (paper eq. 11-13).
-    R_BC = _rot_z(theta1) @ _rot_y(theta2 + theta3)
+    R_BC = _rot_z_rot_y(theta1, theta2 + theta3)
     R_CE = np.swapaxes(R_BC, -1, -2) @ R_BE[:, None]
     sin5 = np.hypot(R_CE[..., 0, 2], R_CE[..., 1, 2])
     theta5 = np.arctan2(sin5, R_CE[..., 2, 2])
