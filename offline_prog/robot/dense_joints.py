@@ -49,7 +49,10 @@ def dense_joints(
         return q_dense
     left = np.clip(np.searchsorted(sigma, sigma_dense, side="right") - 1, 0, len(sigma) - 1)
     branch = _nearest(robot.inverse(X_BE), q)[1][left]  # (M,) each sample's branch
-    solutions = robot.inverse(X_BE_dense)[np.arange(len(sigma_dense)), branch]  # (M, 6)
+    solutions = np.empty((len(sigma_dense), 6))  # (M, 6): each point's branch alone
+    for b in np.unique(branch):
+        rows = branch == b
+        solutions[rows] = robot.inverse_branch(X_BE_dense[rows], int(b))
     wrapped = q_dense + (solutions - q_dense + np.pi) % (2 * np.pi) - np.pi
     ok = np.isfinite(wrapped).all(axis=1)
     q_dense[ok] = wrapped[ok]
