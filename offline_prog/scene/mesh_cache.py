@@ -11,6 +11,7 @@ content hash (and scale and CoACD's settings) in ``$OFFLINE_PROG_CACHE`` or
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import re
@@ -95,25 +96,44 @@ def drawn_arrays(
     """``convert()``'s arrays for a mesh file, kept in the cache as an npz keyed by the
     file's bytes, the bytes of the material libraries an OBJ names, and ``how`` (what
     ``convert`` makes of them, with its version). Where the cache cannot be written,
-    the arrays are returned all the same."""
-    data = Path(mesh_file).read_bytes()
-    for name in MTLLIB.findall(data) if str(mesh_file).lower().endswith(".obj") else ():
-        library = Path(mesh_file).parent / name.decode(errors="replace")
-        data += library.read_bytes() if library.is_file() else b""
+    the arrays are returned all the same; a kept file that cannot be read is made
+    again."""
+    mesh_file = Path(mesh_file)
+    data = mesh_file.read_bytes()
+    if mesh_file.suffix.lower() == ".obj":
+        for library in _material_libraries(mesh_file, data):
+            data += library.read_bytes()
     key = hashlib.sha256(data + how.encode()).hexdigest()[:20]
     target = mesh_cache_dir() / f"{key}.drawn.npz"
     try:
         with np.load(target) as kept:
             return {name: kept[name] for name in kept.files}
-    except (OSError, ValueError):  # not kept yet (or a broken file: made again)
+    except Exception:  # not kept yet, or not readable (np.load's errors vary): made again
         pass
     arrays = convert()
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        temp = target.with_suffix(f".{os.getpid()}.tmp")
-        with open(temp, "wb") as file:
+        handle, temp = tempfile.mkstemp(dir=target.parent, prefix=f".{key}.", suffix=".tmp")
+    except OSError:  # a read-only cache: drawn from the file every time
+        return arrays
+    try:
+        with os.fdopen(handle, "wb") as file:
             np.savez(file, **arrays)
         os.replace(temp, target)
-    except OSError:  # a read-only cache: drawn from the file every time
-        pass
+    except OSError:  # a full disk: not kept
+        with contextlib.suppress(OSError):
+            os.unlink(temp)
     return arrays
+
+
+def _material_libraries(obj_file: Path, data: bytes) -> list[Path]:
+    """The material library files an OBJ's ``mtllib`` statements name that exist (a
+    statement may name several, separated by spaces, or one name with spaces)."""
+    found: list[Path] = []
+    for statement in MTLLIB.findall(data):
+        text = statement.decode(errors="replace")
+        for name in (text, *text.split()):
+            library = obj_file.parent / name
+            if library.is_file() and library not in found:
+                found.append(library)
+    return found

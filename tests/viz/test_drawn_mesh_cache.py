@@ -70,3 +70,14 @@ def test_a_cache_that_cannot_be_written_still_draws(tmp_path, monkeypatch, link)
     monkeypatch.setenv("OFFLINE_PROG_CACHE", str(blocked))
     vertices, faces, colors = _mesh_file(Mesh(str(link), 1.0))
     assert len(vertices) > 100 and colors is not None
+
+
+def test_a_kept_file_that_cannot_be_read_is_made_again(cache, link):
+    drawn = _mesh_file(Mesh(str(link), 1.0))
+    (kept,) = cache.glob("*.drawn.npz")
+    kept.write_bytes(kept.read_bytes()[:100])  # cut short
+    again = _mesh_file(Mesh(str(link), 1.0))
+    for a, b in zip(drawn, again, strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(np.load(kept)["vertices"], drawn[0])  # kept anew
+    assert [f.name for f in cache.iterdir()] == [kept.name]  # no temporary file left
