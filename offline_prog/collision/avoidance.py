@@ -32,7 +32,12 @@ CLEARANCE_MARGIN_M = 2e-3  # asked of the IK beyond the clearance
 INFLUENCE_M = 0.05  # distance at which pairs start to count in the constraint
 NORMAL_TOL_RAD = 1e-6
 POSITION_TOL_M = 1e-7
-SPLINE_CONTROL_POINTS = 10
+SPLINE_CONTROL_POINTS = (10, 20, 40)  # tried in turn: the smoothest turn that fits
+# The most the tool may turn between neighbouring IK samples (a continuous turn: SNOPT
+# may otherwise land on another side of the bound from one sample to the next), and how
+# far the fitted turn may leave its samples and the bound.
+MAX_TURN_STEP_RAD = np.deg2rad(10.0)
+TURN_FIT_TOL_RAD = np.deg2rad(1.0)
 N_NUDGES, NUDGE_RAD = 4, 0.1  # more IK starts at a sample where the first two fail
 
 
@@ -65,7 +70,10 @@ def turn_profile(
 
     Returns:
         φ(s) ↦ (φ, φ′, φ″) for ``FlangePath(tool_turn=...)``, or None when some
-        sample has no solution.
+        sample has no solution within MAX_TURN_STEP_RAD of the one before, or the
+        smooth turn through them leaves them or the bound by more than
+        TURN_FIT_TOL_RAD, swept from the start and then, if that fails, back from
+        the end (a turn the first sweep met too late).
     """
     plant = drake.plant
     context = drake.diagram.CreateDefaultContext()
@@ -80,33 +88,69 @@ def turn_profile(
     n_P = n_P - np.einsum("ij,ij->i", n_P, t_P)[:, None] * t_P
     n_P /= np.linalg.norm(n_P, axis=1, keepdims=True)
     q_seed_plan = np.column_stack([np.interp(s_grid, s_plan, q_plan[:, j]) for j in range(6)])
-    q_prev, angles = q_seed_plan[0], []
-    for k in range(len(s_grid)):
-        ik = InverseKinematics(plant, plant_context)
-        ik.AddPositionConstraint(part, p_PF[k], world, p_IT - POSITION_TOL_M, p_IT + POSITION_TOL_M)
-        ik.AddAngleBetweenVectorsConstraint(world, axis_I, part, n_P[k], 0.0, NORMAL_TOL_RAD)
-        ik.AddAngleBetweenVectorsConstraint(world, x_T, part, t_P[k], 0.0, bound_rad)
-        ik.AddMinimumDistanceLowerBoundConstraint(clearance + CLEARANCE_MARGIN_M, INFLUENCE_M)
-        q = ik.q()
-        ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(q_prev)), q_prev, q)
-        # The previous solution, the plan's, then a few seeded nudges of the previous one
-        # (SNOPT can stall on a distance constraint's kinks from one start).
-        rng = np.random.default_rng(k)
-        nudges = [q_prev + rng.uniform(-NUDGE_RAD, NUDGE_RAD, len(q_prev)) for _ in range(N_NUDGES)]
-        for seed in (q_prev, q_seed_plan[k], *nudges):
-            result = Solve(ik.prog(), seed)
-            if result.is_success():
-                break
-        else:
-            return None
-        q_prev = result.GetSolution(q)
-        plant.SetPositions(plant_context, q_prev)
-        R_IP = part.CalcPoseInWorld(plant_context).rotation().matrix()
-        angles.append(_turn_angle(x_T, axis_I, R_IP @ t_P[k]))
-    angles = np.unwrap(np.asarray(angles))
-    spline = fit_on_knots(
-        s_grid, angles[:, None], open_knots(s_grid, SPLINE_CONTROL_POINTS, 5), 5, closed=False
-    )
+
+    def sweep(order, seeds: np.ndarray):
+        """(turn angles (K,) [rad], joints (K, 6)) solved sample after sample in
+        ``order``, each within MAX_TURN_STEP_RAD of the one before and seeded by it,
+        then by seeds[k]; None where a sample has no solution."""
+        q_prev, angles, solved = seeds[order[0]], np.zeros(len(s_grid)), seeds.copy()
+        for n, k in enumerate(order):
+            ik = InverseKinematics(plant, plant_context)
+            ik.AddPositionConstraint(
+                part, p_PF[k], world, p_IT - POSITION_TOL_M, p_IT + POSITION_TOL_M
+            )
+            ik.AddAngleBetweenVectorsConstraint(world, axis_I, part, n_P[k], 0.0, NORMAL_TOL_RAD)
+            ik.AddAngleBetweenVectorsConstraint(world, x_T, part, t_P[k], 0.0, bound_rad)
+            ik.AddMinimumDistanceLowerBoundConstraint(clearance + CLEARANCE_MARGIN_M, INFLUENCE_M)
+            if n:  # near the last sample's turn: x_T turned by it about the axis
+                last = angles[order[n - 1]]
+                x_last = np.cos(last) * x_T + np.sin(last) * np.cross(axis_I, x_T)
+                ik.AddAngleBetweenVectorsConstraint(
+                    world, x_last, part, t_P[k], 0.0, MAX_TURN_STEP_RAD
+                )
+            q = ik.q()
+            ik.get_mutable_prog().AddQuadraticErrorCost(np.eye(len(q_prev)), q_prev, q)
+            # The previous solution, the seed's, then a few seeded nudges of the previous
+            # one (SNOPT can stall on a distance constraint's kinks from one start).
+            rng = np.random.default_rng(k)
+            nudges = [
+                q_prev + rng.uniform(-NUDGE_RAD, NUDGE_RAD, len(q_prev)) for _ in range(N_NUDGES)
+            ]
+            for seed in (q_prev, seeds[k], *nudges):
+                result = Solve(ik.prog(), seed)
+                if result.is_success():
+                    break
+            else:
+                return None
+            q_prev = solved[k] = result.GetSolution(q)
+            plant.SetPositions(plant_context, q_prev)
+            R_IP = part.CalcPoseInWorld(plant_context).rotation().matrix()
+            angles[k] = _turn_angle(x_T, axis_I, R_IP @ t_P[k])
+        return np.unwrap(angles), solved
+
+    def smooth(angles: np.ndarray):
+        """The spline of the turn angles with the fewest control points (of
+        SPLINE_CONTROL_POINTS) that stays within TURN_FIT_TOL_RAD of them and of the
+        bound, or None."""
+        fine_s = np.linspace(0.0, path.length, 10 * GRID_POINTS)
+        for count in SPLINE_CONTROL_POINTS:
+            knots = open_knots(s_grid, count, 5)
+            spline = fit_on_knots(s_grid, angles[:, None], knots, 5, closed=False)
+            off = np.abs(spline(s_grid)[:, 0] - angles).max()
+            over = np.abs(spline(fine_s)[:, 0]).max() - bound_rad
+            if max(off, over) <= TURN_FIT_TOL_RAD:
+                return spline
+        return None
+
+    forward = sweep(range(len(s_grid)), q_seed_plan)
+    if forward is None:
+        return None
+    spline = smooth(forward[0])
+    if spline is None:  # a turn the sweep met too late: back from the end, near its joints
+        backward = sweep(range(len(s_grid) - 1, -1, -1), forward[1])
+        spline = None if backward is None else smooth(backward[0])
+    if spline is None:
+        return None
 
     def tool_turn(s: np.ndarray):
         s = np.clip(s, 0.0, path.length)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from offline_prog.collision.avoidance import turn_profile
+from offline_prog.collision.avoidance import TURN_FIT_TOL_RAD, turn_profile
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.cell import transform
 from offline_prog.joints.joint_plan import plan_joint_trajectory
@@ -21,7 +21,7 @@ def test_turn_profile_holds_the_process_and_the_clearance():
     plan = plan_cell(CELLS / "weld_seam_irb2400.yaml")
     cell = plan.cell
     drake = build_cell_model(cell, plan.cell_file, plan.robot)
-    clearance = 0.012  # the demo keeps 15 mm; the IK asks for this plus its margin
+    clearance = 0.010  # the demo keeps 15 mm; the IK asks for this plus its margin
     X_IT, X_PE = transform(cell.tool.X_IT), transform(cell.part.X_PE)
     bound = np.deg2rad(cell.tool.free_rotation_deg)
     turn = turn_profile(
@@ -38,7 +38,7 @@ def test_turn_profile_holds_the_process_and_the_clearance():
     assert turn is not None
     s = np.linspace(0.0, plan.path.length, 400)
     phi, dphi, ddphi = turn(s)
-    assert np.abs(phi).max() <= bound + np.deg2rad(2.0)  # spline of in-bound solutions
+    assert np.abs(phi).max() <= bound + TURN_FIT_TOL_RAD  # spline of in-bound solutions
     assert np.all(np.isfinite(ddphi))
     flange = FlangePath(plan.path, plan.flange.normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn)
     parameter = TimeLawParameter(flange, "tcp")
@@ -64,6 +64,34 @@ def test_turn_profile_holds_the_process_and_the_clearance():
         drake.plant.SetPositions(context, drake.robot, joints.q[i])
         X_IP = drake.plant.EvalBodyPoseInWorld(context, part)
         assert np.linalg.norm(X_IP @ traj.flange.p_PF[i] - X_IT.translation()) <= 1e-8
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("clearance", [0.008, 0.012])
+def test_a_turn_profile_stays_within_the_bound_or_is_refused(clearance):
+    """Where the sample-by-sample IK cannot turn the tool smoothly (SNOPT lands on
+    another side of the bound from one sample to the next, or meets a turn too late),
+    no turn comes back: a tool allowed ±45° is never turned beyond, and the turn
+    follows the IK samples that keep the clearance. (Before this check, 12 mm gave a
+    turn reaching 50.7° on one machine.)"""
+    plan = plan_cell(CELLS / "weld_seam_irb2400.yaml")
+    cell = plan.cell
+    drake = build_cell_model(cell, plan.cell_file, plan.robot)
+    bound = np.deg2rad(cell.tool.free_rotation_deg)
+    turn = turn_profile(
+        drake,
+        plan.path,
+        plan.flange.normal,
+        X_IT=transform(cell.tool.X_IT),
+        s_plan=plan.trajectory.s,
+        q_plan=plan.joints.q,
+        axis=np.array([0.0, 1.0, 0.0]),
+        bound_rad=bound,
+        clearance=clearance,
+    )
+    if turn is not None:
+        phi = turn(np.linspace(0.0, plan.path.length, 2000))[0]
+        assert np.abs(phi).max() <= bound + TURN_FIT_TOL_RAD
 
 
 @pytest.mark.slow
