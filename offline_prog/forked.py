@@ -1,14 +1,14 @@
 """A map over items on this process and a forked child: the second core for the plan.
 
 :func:`forked_map` computes ``function(item)`` for each item. This process and one
-forked child take the items in turn from a shared counter, so a slow item does not hold
-up the rest. The child sends each outcome back pickled, with the objects both
-processes already hold (``shared``: the cell's inputs, the Drake scene, and everything
-reachable from them at the fork) sent as references, not copies. So the caller gets
-the same objects, and nothing the child cannot pickle (a Drake context) has to travel.
-An outcome the child cannot send is computed here again. Each outcome is the value or
-the exception the item raised (:class:`Outcome`), so the caller raises them in the
-items' order, as a serial loop would have.
+forked child take the items in turn from a shared counter (this process the first), so
+a slow item does not hold up the rest. The child sends each outcome back pickled, with
+the objects both processes already hold (``shared``: the cell's inputs, the Drake
+scene, and everything reachable from them at the fork) sent as references, not copies.
+So the caller gets the same objects, and nothing the child cannot pickle (a Drake
+context) has to travel. An outcome the child cannot send is computed here again. Each
+outcome is the value or the exception the item raised (:class:`Outcome`), so the
+caller raises them in the items' order, as a serial loop would have.
 
 Where fork is not available, or only one core is, the items run here, one after the
 other.
@@ -132,7 +132,9 @@ def forked_map(
     context = multiprocessing.get_context("fork")
     objects = reachable(shared)
     index = {id(obj): k for k, obj in enumerate(objects)}
-    counter = context.Value("i", 0)  # the next item to take, under its lock
+    # The next item to take, under its lock. The first is this process's, whichever
+    # process starts first: its progress is the terminal's (the child tells none).
+    counter = context.Value("i", 1)
     receive, send = context.Pipe(duplex=False)
 
     def take() -> int:
@@ -163,8 +165,10 @@ def forked_map(
     reader.start()
     outcomes: list[Outcome | None] = [None] * len(items)
     try:
-        while (i := take()) < len(items):
+        i = 0
+        while i < len(items):
             outcomes[i] = _run(function, items[i])
+            i = take()
         reader.join()
         process.join()
     finally:

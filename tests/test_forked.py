@@ -50,6 +50,7 @@ def test_outcomes_are_the_serial_loops_with_the_shared_objects_as_themselves():
     if TWO:
         pids = {o.value["pid"] for o in outcomes if o.error is None}
         assert len(pids) == 2 and os.getpid() in pids  # the child computed some
+        assert outcomes[0].value["pid"] == os.getpid()  # the first item: the progress's
 
 
 @needs_two
