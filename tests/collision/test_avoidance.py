@@ -16,30 +16,40 @@ from offline_prog.timing.trajectory import TimeLawParameter
 from conftest import CELLS
 
 
-@pytest.mark.slow
-def test_turn_profile_holds_the_process_and_the_clearance():
+@pytest.fixture(scope="module")
+def weld():
+    """The weld demo's plan, cell, Drake cell and the torch's free-rotation bound [rad]."""
     plan = plan_cell(CELLS / "weld_seam_irb2400.yaml")
-    cell = plan.cell
-    drake = build_cell_model(cell, plan.cell_file, plan.robot)
+    drake = build_cell_model(plan.cell, plan.cell_file, plan.robot)
+    return plan, plan.cell, drake, np.deg2rad(plan.cell.tool.free_rotation_deg)
+
+
+def weld_turn(weld, clearance: float):
+    """turn_profile of the weld demo's torch about y of T at ``clearance`` [m]."""
+    plan, cell, drake, bound = weld
+    return turn_profile(
+        drake,
+        plan.path,
+        plan.flange.normal,
+        X_IT=transform(cell.tool.X_IT),
+        s_plan=plan.trajectory.s,
+        q_plan=plan.joints.q,
+        axis=np.array([0.0, 1.0, 0.0]),
+        bound_rad=bound,
+        clearance=clearance,
+    )
+
+
+@pytest.mark.slow
+def test_turn_profile_holds_the_process_and_the_clearance(weld):
+    plan, cell, drake, bound = weld
     X_IT, X_PE = transform(cell.tool.X_IT), transform(cell.part.X_PE)
-    bound = np.deg2rad(cell.tool.free_rotation_deg)
     # The demo keeps 15 mm; the IK asks for the clearance plus its margin. The
     # sample-by-sample IK (SNOPT) may find no smooth turn at one clearance on one
     # machine and find one on another (12 mm: none on an AMD EPYC, one on the machine
     # before): the first clearance that gets a turn is held to it.
     for clearance in (0.010, 0.012, 0.008):
-        turn = turn_profile(
-            drake,
-            plan.path,
-            plan.flange.normal,
-            X_IT=X_IT,
-            s_plan=plan.trajectory.s,
-            q_plan=plan.joints.q,
-            axis=np.array([0.0, 1.0, 0.0]),
-            bound_rad=bound,
-            clearance=clearance,
-        )
-        if turn is not None:
+        if (turn := weld_turn(weld, clearance)) is not None:
             break
     assert turn is not None, "no smooth turn at 10, 12 or 8 mm"
     s = np.linspace(0.0, plan.path.length, 400)
@@ -74,27 +84,14 @@ def test_turn_profile_holds_the_process_and_the_clearance():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("clearance", [0.008, 0.012])
-def test_a_turn_profile_stays_within_the_bound_or_is_refused(clearance):
+def test_a_turn_profile_stays_within_the_bound_or_is_refused(weld, clearance):
     """Where the sample-by-sample IK cannot turn the tool smoothly (SNOPT lands on
     another side of the bound from one sample to the next, or meets a turn too late),
     no turn comes back: a tool allowed ±45° is never turned beyond, and the turn
     follows the IK samples that keep the clearance. (Before this check, 12 mm gave a
     turn reaching 50.7° on one machine.)"""
-    plan = plan_cell(CELLS / "weld_seam_irb2400.yaml")
-    cell = plan.cell
-    drake = build_cell_model(cell, plan.cell_file, plan.robot)
-    bound = np.deg2rad(cell.tool.free_rotation_deg)
-    turn = turn_profile(
-        drake,
-        plan.path,
-        plan.flange.normal,
-        X_IT=transform(cell.tool.X_IT),
-        s_plan=plan.trajectory.s,
-        q_plan=plan.joints.q,
-        axis=np.array([0.0, 1.0, 0.0]),
-        bound_rad=bound,
-        clearance=clearance,
-    )
+    plan, _, _, bound = weld
+    turn = weld_turn(weld, clearance)
     if turn is not None:
         phi = turn(np.linspace(0.0, plan.path.length, 2000))[0]
         assert np.abs(phi).max() <= bound + TURN_FIT_TOL_RAD
