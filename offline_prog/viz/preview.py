@@ -135,15 +135,20 @@ def _part_arrays(file: str) -> dict[str, np.ndarray]:
     import trimesh  # only for a mesh file not drawn before: ~0.2 s of import
 
     parts = trimesh.load(file, force="scene").dump(concatenate=False)
-    vertices, faces, colors, offset = [], [], [], 0
+    vertices, faces, offset = [], [], 0
     for part in parts:
         vertices.append(np.asarray(part.vertices))
         faces.append(np.asarray(part.faces) + offset)
         offset += len(part.vertices)
-        colors.append(np.tile(_part_color(part), (len(part.vertices), 1)))
     arrays = {"vertices": np.vstack(vertices), "faces": np.vstack(faces)}
-    if all(c is not None for c in colors):
-        arrays["colors"] = np.vstack(colors)
+    colors = [_part_color(part) for part in parts]
+    if all(color is not None for color in colors):
+        arrays["colors"] = np.vstack(
+            [
+                np.tile(color, (len(part.vertices), 1))
+                for color, part in zip(colors, parts, strict=True)
+            ]
+        )
     return arrays
 
 

@@ -81,3 +81,15 @@ def test_a_kept_file_that_cannot_be_read_is_made_again(cache, link):
         np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(np.load(kept)["vertices"], drawn[0])  # kept anew
     assert [f.name for f in cache.iterdir()] == [kept.name]  # no temporary file left
+
+
+def test_a_mesh_without_materials_is_drawn_without_vertex_colours(cache, tmp_path):
+    import trimesh
+
+    stl = tmp_path / "block.stl"
+    trimesh.creation.box(extents=(0.1, 0.2, 0.3)).export(stl)
+    for _ in range(2):  # from the file, then from the cache
+        vertices, faces, colors = _mesh_file(Mesh(str(stl), 1.0))
+        assert colors is None  # the shape's own colour, not a column of None
+        np.testing.assert_allclose(np.ptp(vertices, axis=0), [0.1, 0.2, 0.3])
+    assert len(list(cache.glob("*.drawn.npz"))) == 1
