@@ -187,8 +187,7 @@ def run_side_by_side(stages: tuple[Stage, ...], results: dict[str, object], time
     outcomes = forked_map(timed, list(stages), shared=[results])
     for stage, outcome in zip(stages, outcomes, strict=True):
         results[stage.name], seconds = outcome.result()
-        key = timer.prefix + stage.name
-        timer.timings_s[key] = timer.timings_s.get(key, 0.0) + seconds
+        timer.add(stage.name, seconds)
 
 
 def with_normal_hint(error: PlanFailedError, inputs: Inputs, fit: FittedPath, scene):

@@ -82,9 +82,13 @@ class StageTimer:
         self.progress(description)
         start = time.perf_counter()
         result = function(*args)
-        key = self.prefix + name
-        self.timings_s[key] = self.timings_s.get(key, 0.0) + time.perf_counter() - start
+        self.add(name, time.perf_counter() - start)
         return result
+
+    def add(self, name: str, seconds: float) -> None:
+        """Count ``seconds`` [s] of wall time to stage ``name`` (one run elsewhere)."""
+        key = self.prefix + name
+        self.timings_s[key] = self.timings_s.get(key, 0.0) + seconds
 
 
 def plan_seam(
