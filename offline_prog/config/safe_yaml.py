@@ -145,21 +145,32 @@ def _check_nodes(file: Path, root: yaml.Node) -> None:
 def _check_depth(file: Path, text: str) -> None:
     """Nesting depth from the parser's events (an iterative pass, no node built).
 
-    PyYAML's pure-Python parser is used: it yields events as it scans, so our limit
-    fires first, with our message and line, whatever PyYAML is installed (the C parser
-    bundled with PyYAML 6.0.4 stops at 1,000 flow levels with a message of its own).
+    libyaml's parser (where installed) and PyYAML's are both iterative, and both yield
+    events as they scan, so our limit fires first, with our message and line. libyaml's
+    scanner looks up to 1,024 characters ahead for a key, and the libyaml bundled with
+    PyYAML 6.0.4 stops at 1,000 levels with a message of its own: that one is
+    ours too (the line it names).
     """
     depth = 0
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
-        if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
-            depth += 1
-            if depth > MAX_YAML_DEPTH:
-                line = event.start_mark.line + 1
-                raise InputError(
-                    file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
-                )
-        elif isinstance(event, yaml.SequenceEndEvent | yaml.MappingEndEvent):
-            depth -= 1
+    try:
+        for event in yaml.parse(text, Loader=_BaseLoader):
+            if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
+                depth += 1
+                if depth > MAX_YAML_DEPTH:
+                    line = event.start_mark.line + 1
+                    raise InputError(
+                        file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
+                    )
+            elif isinstance(event, yaml.SequenceEndEvent | yaml.MappingEndEvent):
+                depth -= 1
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        if mark is None or "maximum nesting depth" not in str(error):
+            raise
+        line = mark.line + 1
+        raise InputError(
+            file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
+        ) from None
 
 
 def load(file: Path, text: str):

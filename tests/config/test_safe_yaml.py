@@ -58,6 +58,16 @@ def test_unterminated_deep_nesting(tmp_path):
     refused(write_cell(tmp_path, BASE + "deep: " + "[" * 100_000 + "\n"), "nested deeper")
 
 
+@pytest.mark.parametrize("depth", [MAX_YAML_DEPTH, 2_000, 100_000])
+def test_deep_block_nesting_names_its_line(tmp_path, depth):
+    """Block sequences nested on one line ("- - - x", under the top mapping: one level
+    beyond the limit), and beyond libyaml's own 1,000 levels: our message, its line."""
+    lines = BASE.count("\n")
+    cell = write_cell(tmp_path, BASE + "deep:\n" + "- " * depth + "x\n")
+    message = refused(cell, f"nested deeper than {MAX_YAML_DEPTH} levels")
+    assert f"line {lines + 2}:" in message
+
+
 def test_duplicate_keys(tmp_path):
     cell = write_cell(tmp_path, BASE.replace("  speed: 0.1", "  speed: 0.1\n  speed: 1.0"))
     assert "line 16: key 'speed' given twice" in refused(cell, "given twice")
