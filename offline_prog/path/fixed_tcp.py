@@ -57,28 +57,34 @@ class FlangeSamples:
     dw_s: np.ndarray
 
 
-PART_SAMPLES_KEPT = 16  # evaluations kept by part_samples and part_in_tool each,
-PART_SAMPLES_MOST = 5000  # of at most this many samples each (≤ 2 MB)
+# Evaluations kept by part_samples and part_in_tool, each: of at most PART_SAMPLES_MOST
+# samples (≤ 2 MB each), the last ones used up to PART_CACHE_BYTES in all. A placement
+# candidate of the seal job evaluates about 20 grids that every candidate shares (the
+# tool rotations' trial grid and each seam direction's σ grid) and as many of its own
+# (its time laws' samples): a count of 16 evicted the shared ones.
+PART_SAMPLES_MOST = 5000
+PART_CACHE_BYTES = 32 * 2**20
 _part_samples: collections.OrderedDict = collections.OrderedDict()
 _part_in_tool: collections.OrderedDict = collections.OrderedDict()
 _lock = threading.Lock()
 
 
 def _kept(cache: collections.OrderedDict, key: tuple, owners: tuple, compute) -> tuple:
-    """compute()'s arrays, made read-only and kept under key (the last
-    PART_SAMPLES_KEPT); ``owners`` are the objects whose ids the key holds (kept with
-    the entry, so an id is theirs while it lives)."""
+    """compute()'s arrays, made read-only and kept under key (the last used, up to
+    PART_CACHE_BYTES); ``owners`` are the objects whose ids the key holds (kept with the
+    entry, so an id is theirs while it lives)."""
     with _lock:
         entry = cache.get(key)
         if entry is not None and all(a is b for a, b in zip(entry[0], owners, strict=True)):
             cache.move_to_end(key)
-            return entry[1]
+            return entry[2]
     values = compute()
     for value in values:
         value.setflags(write=False)
+    size = sum(value.nbytes for value in values)
     with _lock:  # threads may plan at once (a Dask worker's threads)
-        cache[key] = (owners, values)
-        while len(cache) > PART_SAMPLES_KEPT:
+        cache[key] = (owners, size, values)
+        while sum(entry[1] for entry in cache.values()) > PART_CACHE_BYTES:
             cache.popitem(last=False)
     return values
 
@@ -89,9 +95,10 @@ def part_samples(path: ArcLengthPath, normal: NormalField, s: np.ndarray) -> tup
 
     They depend on neither X_IT nor X_PE (nor the tool turn): the tool rotations tried
     for one seam, placement candidates and session edits evaluate the same path at the
-    same σ grid again and again, so the last PART_SAMPLES_KEPT evaluations (of grids up
-    to PART_SAMPLES_MOST) are kept: the same path and normal objects, the same s bit
-    for bit, the same arrays (read-only, so no caller changes what another gets).
+    same σ grid again and again, so the last evaluations (of grids up to
+    PART_SAMPLES_MOST, PART_CACHE_BYTES in all) are kept: the same path and normal
+    objects, the same s bit for bit, the same arrays (read-only, so no caller changes
+    what another gets).
 
     Raises:
         NormalTangentError: from :func:`process_frames`.

@@ -144,3 +144,25 @@ def test_kept_part_values_give_the_same_flange_poses(rng, closed):
                     np.testing.assert_array_equal(getattr(got, name), getattr(want, name))
     with pytest.raises(ValueError, match="read-only"):
         variants[0](s).p_PF[0, 0] = 1.0
+
+
+def test_kept_part_values_stay_within_their_bytes(rng, monkeypatch):
+    """The kept evaluations are the last used ones, PART_CACHE_BYTES in all: a grid used
+    again is kept (the same arrays), the oldest goes first."""
+    from offline_prog.path import fixed_tcp
+
+    base = random_flange_path(rng, closed=False)
+    grids = [np.linspace(0.0, base.length, n) for n in (300, 301, 302, 303)]
+    one = sum(v.nbytes for v in fixed_tcp.part_samples(base.path, base.normal, grids[3]))
+    monkeypatch.setattr(fixed_tcp, "PART_CACHE_BYTES", 3 * one)  # three entries fit
+    fixed_tcp._part_samples.clear()
+    first = fixed_tcp.part_samples(base.path, base.normal, grids[0])
+    for grid in grids[1:3]:
+        fixed_tcp.part_samples(base.path, base.normal, grid)
+    assert fixed_tcp.part_samples(base.path, base.normal, grids[0])[0] is first[0]  # kept
+    fixed_tcp.part_samples(base.path, base.normal, grids[3])  # grids[1] is the oldest now
+    assert sum(entry[1] for entry in fixed_tcp._part_samples.values()) <= 3 * one
+    assert fixed_tcp.part_samples(base.path, base.normal, grids[0])[0] is first[0]
+    again = fixed_tcp.part_samples(base.path, base.normal, grids[1])
+    np.testing.assert_array_equal(again[0], base.path(grids[1], order=2)[0])
+    assert len(fixed_tcp._part_samples) == 3
