@@ -20,6 +20,7 @@ from offline_prog.constants import (
     DEFAULT_SPLINE_DEGREE,
     MIN_SPLINE_DEGREE,
 )
+from offline_prog.path.fit_hint import hint_key, keep_hint, read_hint
 
 
 @dataclasses.dataclass(frozen=True)
@@ -220,6 +221,22 @@ def fit_bspline(
             )
         return fit(n_control_points)
 
+    # The count this search found on an earlier run (path.fit_hint): one fit, the same
+    # numbers as the search's, if it holds the tolerance.
+    key = hint_key(
+        points,
+        weights,
+        closed=closed,
+        degree=degree,
+        tolerance_m=tolerance_m,
+        source_file=__file__,
+    )
+    kept = read_hint(key)
+    if kept is not None and m_min <= kept <= m_max:
+        trial = fit(kept)
+        if trial.max_error_m <= tolerance_m:
+            return trial
+
     # Smallest m meeting the tolerance: double until it passes, then bisect.
     lo_m, hi_m, best = m_min - 1, None, None
     m = m_min
@@ -251,4 +268,5 @@ def fit_bspline(
             hi_m, best = mid, trial
         else:
             lo_m = mid
+    keep_hint(key, hi_m)
     return best

@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from offline_prog.disk_cache import cache_dir
+
 if TYPE_CHECKING:  # trimesh costs ~0.5 s to import; loaded where a mesh is used
     import trimesh
 
@@ -34,8 +36,7 @@ COACD_SEED = 0
 
 def mesh_cache_dir() -> Path:
     """Where converted meshes live (``$OFFLINE_PROG_CACHE`` or ~/.cache/offline_prog)."""
-    root = os.environ.get("OFFLINE_PROG_CACHE") or Path.home() / ".cache" / "offline_prog"
-    return Path(root) / "meshes"
+    return cache_dir("meshes")
 
 
 def as_obj(mesh_file: Path, scale: float) -> Path:
