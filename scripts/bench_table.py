@@ -8,8 +8,10 @@ median of ``--big-runs``. The import floor is the median wall time of
 ``python -c "import pydrake.all"`` measured between the other figures, so each ratio
 holds on a noisy machine. The placement candidate is the seal job's placement demo
 (cells/placement/seal_job_far_kr16.yaml) through ``place``'s own serial engine, after
-the cell is loaded (as a worker runs it), median over candidates; the session re-plan
-is a tool-pose change (X_IT x ± 5 mm, a fresh value each time) on every demo cell.
+the cell is loaded (as a worker runs it), median over candidates, and the feasible
+ones' rate on ``place``'s default engine (two Dask workers on this machine); the
+session re-plan is a tool-pose change (X_IT x ± 5 mm, a fresh value each time) on every
+demo cell.
 """
 
 from __future__ import annotations
@@ -92,6 +94,29 @@ def place_candidate() -> float:
     return statistics.median(seconds)
 
 
+def place_throughput(workers: int = 2, rounds: int = 5) -> float:
+    """Seconds per feasible job candidate through ``place``'s default engine (a
+    LocalCluster of one worker per core), after each worker has loaded the cell: the
+    feasible ones of place_candidate's seeded candidates, ``rounds`` times over."""
+    from offline_prog.config.cell import load_cell
+    from offline_prog.placement.engine import DaskEngine
+    from offline_prog.placement.payload import cell_payload
+    from offline_prog.placement.space import check_place
+
+    cell = load_cell(PLACE_JOB)
+    _, space = check_place(PLACE_JOB, cell)
+    rng = np.random.default_rng(0)
+    batch = [space.candidate(x, 0) for x in rng.uniform(0.1, 0.9, (CANDIDATES, 4))]
+    engine = DaskEngine(cell_payload(PLACE_JOB, cell), workers=workers)
+    try:
+        feasible = [e.candidate for e in engine.map("plan", batch) if e.feasible]
+        start = time.perf_counter()
+        engine.map("plan", feasible * rounds)
+        return (time.perf_counter() - start) / (len(feasible) * rounds)
+    finally:
+        engine.close()
+
+
 def session_tool_pose(cell: Path, repeats: int) -> float:
     """Median seconds of a session re-plan after a tool-pose change."""
     from offline_prog.session.replan import Replanner
@@ -127,6 +152,7 @@ def bench_table(runs: int = 3, big_runs: int = 1) -> None:
     row("plan seal_job_kr16 (4 seams)", plan_command(CELLS / "seal_job_kr16.yaml", runs))
     row("plan 30-seam job", many_seams_command(30, big_runs))
     row("place: one feasible job candidate", place_candidate())
+    row("place: each feasible candidate, 2 workers", place_throughput())
     slowest = 0.0
     for cell in sorted(CELLS.glob("*.yaml")):
         seconds = session_tool_pose(cell, runs)
