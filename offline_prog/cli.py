@@ -196,6 +196,7 @@ def exit_code(error: BaseException, args) -> tuple[int, str]:
 
 def command() -> int:
     """The ``offline-prog`` command in its own process (``python -m offline_prog``)."""
+    gc.disable()  # while the command imports: main freezes their objects, then enables it
     return main(own_process=True)
 
 
@@ -204,7 +205,8 @@ def main(argv: list[str] | None = None, *, own_process: bool = False) -> int:
 
     Args:
         own_process: the process is this command's (not a test's that runs many):
-            what the imports made is frozen out of the garbage collector's walks.
+            what the imports made is frozen out of the garbage collector's walks, and
+            the collector (disabled by :func:`command` while it imports) is enabled.
     """
     args = parser().parse_args(argv)
     console, errors = Console(soft_wrap=True), Console(stderr=True, soft_wrap=True)
@@ -224,8 +226,10 @@ def main(argv: list[str] | None = None, *, own_process: bool = False) -> int:
         if own_process:
             # The imports' objects (a million: pydrake, scipy) live as long as the
             # process; the cyclic collector need not walk them again in every full
-            # collection and at exit (0.2-0.35 s of the seal demo's 2.1-2.4 s).
+            # collection and at exit (0.2-0.35 s of the seal demo's 2.1-2.4 s); nor,
+            # disabled until here, in the imports (40-60 ms).
             gc.freeze()
+            gc.enable()
         # After pydrake's import (it sets the level): its INFO lines would break
         # "one line on stderr".
         logging.getLogger("drake").setLevel(logging.WARNING)

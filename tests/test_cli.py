@@ -194,3 +194,21 @@ def test_self_collision_writes_where_the_user_says_not_into_the_package(
     assert main(["robots", "self-collision", "ur10e", "--samples", "20", "--out", "m.yaml"]) == 0
     assert (tmp_path / "m.yaml").read_text() == (tmp_path / MATRIX_FILE).read_text()
     assert (shipped.read_bytes(), shipped.stat().st_mtime_ns) == before
+
+
+def test_the_command_collects_garbage_after_its_imports():
+    """``command()`` imports with the collector off, freezes what the imports made and
+    turns the collector on again: a long session or placement run collects its cycles."""
+    import subprocess
+    import sys
+
+    probe = (
+        "import gc, sys\n"
+        "from offline_prog import cli\n"
+        "sys.argv = ['offline-prog', 'robots', 'list']\n"
+        "code = cli.command()\n"
+        "print(code, gc.isenabled(), gc.get_freeze_count())\n"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    code, enabled, frozen = done.stdout.split()[-3:]
+    assert (code, enabled) == ("0", "True") and int(frozen) > 100_000, done.stdout
