@@ -23,7 +23,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import interp_rows, true_runs
+from offline_prog.arrays import interp_rows, row_max, true_runs
 from offline_prog.constants import TimeLaw
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.joint_timing import JointRates
@@ -111,7 +111,7 @@ def verified_timing(time, rates: JointRates, path, robot: RobotModel, q_grid, *,
         # The exact path only where the grid's q‴ puts the jerk above SCREEN_USE.
         limits = (robot.qd_max, robot.qdd_max, jerk_max)
         model = joint_use(rates, with_jerk(rates), retiming.law, t, limits)
-        t = t[model["jerk"].max(axis=1) >= SCREEN_USE]
+        t = t[row_max(model["jerk"]) >= SCREEN_USE]
         if len(t) == 0:
             return retiming, rates
         sigma = retiming.law(t)[0]
@@ -122,7 +122,7 @@ def verified_timing(time, rates: JointRates, path, robot: RobotModel, q_grid, *,
         )
         dddq = exact_jerk_rates(path, robot, sigma, q_grid, grid)
         use = jerk_use(retiming.law, t, exact, dddq, jerk_max)
-        over = use.max(axis=1) > 1.0
+        over = row_max(use) > 1.0
         if not over.any():
             return retiming, rates
         if round_ == MAX_ROUNDS:

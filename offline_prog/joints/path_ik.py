@@ -16,6 +16,7 @@ import dataclasses
 
 import numpy as np
 
+from offline_prog.arrays import row_max
 from offline_prog.errors import Failure
 from offline_prog.robot.model import RobotModel
 
@@ -105,7 +106,7 @@ def branch_results(
         robot.q_upper,
     )
     q = q + offsets[:, None, :]
-    steps = np.abs(step).max(axis=-1)  # (8, N−1)
+    steps = row_max(np.abs(step))  # (8, N−1)
     results = []
     for b in range(8):
         margin = float(margins[b].min())

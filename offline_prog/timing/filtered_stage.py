@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
+from offline_prog.arrays import row_max, true_runs
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, ProcessIntent
 from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.jerk_stage import JerkLimitedTiming, steady_jerk_limit
@@ -80,25 +80,31 @@ def _lower(curve: np.ndarray, sigma: np.ndarray, lo, hi, values) -> None:
 def _excess(use: dict, jerk_path: np.ndarray):
     """Per sample, (factor on the speed, factor on the acceleration) that would bring
     it to its limits: 1 where none is needed."""
-    speed_over = np.maximum.reduce(
-        [
-            use["velocity"],
-            np.where(
-                use["acceleration_speed"] >= use["acceleration_change"],
-                np.sqrt(use["acceleration"]),
-                0.0,
-            ),
-            np.where(use["jerk_speed"] >= use["jerk_change"], np.cbrt(use["jerk"]), 0.0),
-        ]
-    ).max(axis=1)
-    change_over = np.maximum.reduce(
-        [
-            np.where(
-                use["acceleration_speed"] < use["acceleration_change"], use["acceleration"], 0.0
-            ),
-            np.where(use["jerk_speed"] < use["jerk_change"], use["jerk"], 0.0),
-        ]
-    ).max(axis=1)
+    speed_over = row_max(
+        np.maximum.reduce(
+            [
+                use["velocity"],
+                np.where(
+                    use["acceleration_speed"] >= use["acceleration_change"],
+                    np.sqrt(use["acceleration"]),
+                    0.0,
+                ),
+                np.where(use["jerk_speed"] >= use["jerk_change"], np.cbrt(use["jerk"]), 0.0),
+            ]
+        )
+    )
+    change_over = row_max(
+        np.maximum.reduce(
+            [
+                np.where(
+                    use["acceleration_speed"] < use["acceleration_change"],
+                    use["acceleration"],
+                    0.0,
+                ),
+                np.where(use["jerk_speed"] < use["jerk_change"], use["jerk"], 0.0),
+            ]
+        )
+    )
     return np.maximum(speed_over, 1.0), np.maximum(np.maximum(change_over, jerk_path), 1.0)
 
 

@@ -27,7 +27,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
+from offline_prog.arrays import row_max, row_min, true_runs
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, ProcessIntent
 from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.joint_timing import JointRates
@@ -106,7 +106,7 @@ def static_limit(rates: JointRates, dddq: np.ndarray, limits) -> np.ndarray:
         by_velocity = qd_max / np.abs(rates.dq)
         by_acceleration = np.sqrt(qdd_max / np.abs(rates.ddq))
         by_jerk = np.cbrt(qddd_max / np.abs(dddq))
-    return np.minimum.reduce([by_velocity, by_acceleration, by_jerk]).min(axis=1)
+    return row_min(np.minimum.reduce([by_velocity, by_acceleration, by_jerk]))
 
 
 def steady_jerk_limit(rates: JointRates, limits) -> np.ndarray:
@@ -114,7 +114,7 @@ def steady_jerk_limit(rates: JointRates, limits) -> np.ndarray:
     [m/s] (a speed limit curve TOPP-RA can take; it knows no jerk)."""
     with np.errstate(divide="ignore"):
         by_jerk = np.cbrt(LIMIT_SHARE * limits[2] / np.abs(with_jerk(rates)))
-    return by_jerk.min(axis=1)
+    return row_min(by_jerk)
 
 
 def ceiling(profile: ToppProfile, steady: np.ndarray, v_process: float, process: str):
@@ -191,13 +191,15 @@ def jerk_limited_law(
         # and any term over on its own: lower the cap there by the excess.
         on_plateau = (np.abs(use["sdd"]) < 1e-9) & (np.abs(use["sddd"]) < 1e-9)
         plateau = on_plateau[:, None]
-        speed_over = np.maximum.reduce(
-            [
-                use["velocity"],
-                np.sqrt(np.where(plateau, use["acceleration"], use["acceleration_speed"])),
-                np.cbrt(np.where(plateau, use["jerk"], use["jerk_speed"])),
-            ]
-        ).max(axis=1)
+        speed_over = row_max(
+            np.maximum.reduce(
+                [
+                    use["velocity"],
+                    np.sqrt(np.where(plateau, use["acceleration"], use["acceleration_speed"])),
+                    np.cbrt(np.where(plateau, use["jerk"], use["jerk_speed"])),
+                ]
+            )
+        )
         over = speed_over > 1.0
         if over.any():
             lowered = STEP_SHARE * use["speed"][over] / speed_over[over]
@@ -207,7 +209,7 @@ def jerk_limited_law(
         # Over during a speed change: soften that change (the speed-up at the start of
         # the law's plateau it lies on, or the slow-down at its end).
         change_over = np.where(
-            on_plateau, 0.0, np.maximum(use["acceleration"], use["jerk"]).max(axis=1)
+            on_plateau, 0.0, row_max(np.maximum(use["acceleration"], use["jerk"]))
         )
         sdd = use["sdd"]
         ends = np.array([b for _, _, b in law.plateaus])

@@ -17,7 +17,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import interp_rows, true_runs
+from offline_prog.arrays import interp_rows, row_max, row_min, true_runs
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ
 from offline_prog.timing.time_law import Sin2TimeLaw, sin2_plateau_law
 
@@ -61,7 +61,7 @@ def speed_cap(rates: JointRates, qd_max: np.ndarray, qdd_max: np.ndarray) -> np.
     with np.errstate(divide="ignore"):
         by_speed = SPEED_LIMIT_SHARE * qd_max / np.abs(rates.dq)
         by_accel = np.sqrt(CENTRIPETAL_SHARE * qdd_max / np.abs(rates.ddq))
-    return np.minimum(by_speed.min(axis=1), by_accel.min(axis=1))
+    return np.minimum(row_min(by_speed), row_min(by_accel))
 
 
 def _caps_from(sigma: np.ndarray, cap: np.ndarray, v_process: float, length: float):
@@ -165,7 +165,7 @@ def retime(
         centripetal_over = np.where(
             (accel > 1.0) & (centripetal >= tangential), np.sqrt(accel), 1.0
         )
-        over_speed = np.maximum(too_fast, centripetal_over).max(axis=1)
+        over_speed = row_max(np.maximum(too_fast, centripetal_over))
         bad = over_speed > 1.0
         if bad.any():
             _, sd, _, _ = law(t)
