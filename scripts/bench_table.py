@@ -3,7 +3,8 @@
     python scripts/bench.py --only table [--runs 3] [--big-runs 1]
 
 Whole commands are fresh processes as a user runs them (stdout piped: no progress
-display), median of ``--runs``; the 30-seam job (tests/job/many_seams.py, order auto)
+display; the package byte-compiled first, as the README's install leaves it), median
+of ``--runs``; the 30-seam job (tests/job/many_seams.py, order auto)
 median of ``--big-runs``. The import floor is the median wall time of
 ``python -c "import pydrake.all"`` measured between the other figures, so each ratio
 holds on a noisy machine. The placement candidate is the seal job's placement demo
@@ -16,6 +17,7 @@ demo cell.
 
 from __future__ import annotations
 
+import compileall
 import statistics
 import subprocess
 import sys
@@ -133,7 +135,11 @@ def session_tool_pose(cell: Path, repeats: int) -> float:
 
 
 def bench_table(runs: int = 3, big_runs: int = 1) -> None:
+    # Byte-compiled, as the README's install leaves it (a machine that sets
+    # PYTHONDONTWRITEBYTECODE would else compile every module in every command).
+    compiled = compileall.compile_dir(ROOT / "offline_prog", quiet=1)
     print(f"== issue 25: interactive speed (medians; floor = import pydrake.all, {runs} runs) ==")
+    print(f"  the package byte-compiled as the README's install does: {bool(compiled)}")
     rows: list[tuple[str, float, float]] = []
 
     def row(name: str, seconds: float) -> None:
