@@ -15,16 +15,13 @@ A cache that cannot be read or written costs the search, never the answer.
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import hashlib
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from offline_prog.disk_cache import cache_dir
+from offline_prog.disk_cache import cache_dir, keep
 
 
 @functools.cache
@@ -73,16 +70,4 @@ def read_hint(key: str) -> int | None:
 
 def keep_hint(key: str, n_control_points: int) -> None:
     """Keep the count the search ``key`` found (written whole or not at all)."""
-    folder = cache_dir("fits")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=folder, prefix=f".{key}.", suffix=".tmp")
-    except OSError:  # a read-only cache: the search runs every time
-        return
-    try:
-        with os.fdopen(handle, "w") as file:
-            file.write(str(int(n_control_points)))
-        os.replace(temp, folder / key)
-    except OSError:  # a full disk: not kept
-        with contextlib.suppress(OSError):
-            os.unlink(temp)
+    keep(cache_dir("fits") / key, lambda stream: stream.write(str(int(n_control_points)).encode()))

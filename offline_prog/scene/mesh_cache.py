@@ -11,7 +11,6 @@ content hash (and scale and CoACD's settings) in ``$OFFLINE_PROG_CACHE`` or
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
 import re
@@ -23,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from offline_prog.disk_cache import cache_dir
+from offline_prog.disk_cache import cache_dir, keep
 
 if TYPE_CHECKING:  # trimesh costs ~0.5 s to import; loaded where a mesh is used
     import trimesh
@@ -112,18 +111,7 @@ def drawn_arrays(
     except Exception:  # not kept yet, or not readable (np.load's errors vary): made again
         pass
     arrays = convert()
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp = tempfile.mkstemp(dir=target.parent, prefix=f".{key}.", suffix=".tmp")
-    except OSError:  # a read-only cache: drawn from the file every time
-        return arrays
-    try:
-        with os.fdopen(handle, "wb") as file:
-            np.savez(file, **arrays)
-        os.replace(temp, target)
-    except OSError:  # a full disk: not kept
-        with contextlib.suppress(OSError):
-            os.unlink(temp)
+    keep(target, lambda stream: np.savez(stream, **arrays))  # read-only cache: not kept
     return arrays
 
 
