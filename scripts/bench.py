@@ -1,10 +1,11 @@
 """Benchmark: plan the demo cells stage by stage, and compare path IK with references.
 
 Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]
-[--only table|command|collision|timing|session|place] [--runs 3] [--big-runs 1]``;
-``--only table`` prints issue 25's table (scripts/bench_table.py: each figure with the
-import floor of the same run), which a full run prints first; ``--only place`` runs
-scripts/bench_place.py (the placement search, ~10 minutes)
+[--only table|command|collision|timing|session|place|candidate] [--runs 3]
+[--big-runs 1]``; ``--only table`` prints issue 25's table (scripts/bench_table.py: each
+figure with the import floor of the same run), which a full run prints first; ``--only
+place`` runs scripts/bench_place.py (the placement search, ~10 minutes), ``--only
+candidate`` scripts/bench_candidate.py (where a placement candidate's time goes)
 
 All figures come from the same process on the same machine, so the ratios
 hold even where the absolute numbers drift. Path IK is compared on one flange
@@ -274,7 +275,7 @@ def main() -> None:
     parser.add_argument("--drake-samples", type=int, default=300)
     parser.add_argument(
         "--only",
-        choices=["table", "command", "collision", "timing", "session", "place"],
+        choices=["table", "command", "collision", "timing", "session", "place", "candidate"],
         help="run one part of the benchmark",
     )
     parser.add_argument("--runs", type=int, default=3, help="runs of each table figure")
@@ -299,6 +300,12 @@ def main() -> None:
 
         sys.argv = sys.argv[:1]
         bench_place.main()
+        return
+    if args.only == "candidate":  # its own script (scripts/bench_candidate.py)
+        import bench_candidate
+
+        sys.argv = sys.argv[:1]
+        bench_candidate.main()
         return
     bench_command(CELLS / "seal_plate_kr16.yaml")
     if args.only == "command":

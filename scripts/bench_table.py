@@ -70,11 +70,9 @@ def many_seams_command(n: int, runs: int) -> float:
         return plan_command(many_seam_cell(Path(folder), n), runs)
 
 
-def place_candidate() -> float:
-    """Median seconds of one feasible job candidate through place's serial engine (of
-    CANDIDATES seeded ones; those the robot cannot reach fail in a fraction of it)."""
+def place_batch():
+    """(the place job's payload, CANDIDATES seeded candidates of its search space)."""
     from offline_prog.config.cell import load_cell
-    from offline_prog.placement.engine import SerialEngine
     from offline_prog.placement.payload import cell_payload
     from offline_prog.placement.space import check_place
 
@@ -82,7 +80,16 @@ def place_candidate() -> float:
     _, space = check_place(PLACE_JOB, cell)
     rng = np.random.default_rng(0)
     batch = [space.candidate(x, 0) for x in rng.uniform(0.1, 0.9, (CANDIDATES, 4))]
-    engine = SerialEngine(cell_payload(PLACE_JOB, cell))
+    return cell_payload(PLACE_JOB, cell), batch
+
+
+def place_candidate() -> float:
+    """Median seconds of one feasible job candidate through place's serial engine (of
+    CANDIDATES seeded ones; those the robot cannot reach fail in a fraction of it)."""
+    from offline_prog.placement.engine import SerialEngine
+
+    payload, batch = place_batch()
+    engine = SerialEngine(payload)
     try:
         engine.map("screen", batch[:1])  # loads the cell, as a worker has
         seconds = []
@@ -100,16 +107,10 @@ def place_throughput(workers: int = 2, rounds: int = 5) -> float:
     """Seconds per feasible job candidate through ``place``'s default engine (a
     LocalCluster of one worker per core), after each worker has loaded the cell: the
     feasible ones of place_candidate's seeded candidates, ``rounds`` times over."""
-    from offline_prog.config.cell import load_cell
     from offline_prog.placement.engine import DaskEngine
-    from offline_prog.placement.payload import cell_payload
-    from offline_prog.placement.space import check_place
 
-    cell = load_cell(PLACE_JOB)
-    _, space = check_place(PLACE_JOB, cell)
-    rng = np.random.default_rng(0)
-    batch = [space.candidate(x, 0) for x in rng.uniform(0.1, 0.9, (CANDIDATES, 4))]
-    engine = DaskEngine(cell_payload(PLACE_JOB, cell), workers=workers)
+    payload, batch = place_batch()
+    engine = DaskEngine(payload, workers=workers)
     try:
         feasible = [e.candidate for e in engine.map("plan", batch) if e.feasible]
         start = time.perf_counter()
