@@ -52,7 +52,7 @@ STAGES = (
 )
 
 
-def run(engine, candidates) -> tuple[float, list]:
+def run(engine, candidates) -> tuple[list[float], list]:
     """(CPU seconds of each candidate, their evaluations)."""
     seconds, evaluations = [], []
     for candidate in candidates:
@@ -61,6 +61,15 @@ def run(engine, candidates) -> tuple[float, list]:
         seconds.append(time.process_time() - start)
         evaluations.append(evaluation)
     return seconds, evaluations
+
+
+def measured(engine, candidates, rounds: int) -> tuple[float, list[float]]:
+    """(median CPU seconds of a candidate over ``rounds``, their cycle times [s])."""
+    seconds = []
+    for _ in range(rounds):
+        each, evaluations = run(engine, candidates)
+        seconds += each
+    return statistics.median(seconds), [e.cycle_time_s for e in evaluations]
 
 
 def shares(engine, candidates) -> list[tuple[str, float]]:
@@ -89,25 +98,22 @@ def main() -> None:
         engine.map("screen", batch[:1])  # loads the cell, as a worker has
         _, evaluations = run(engine, batch)
         feasible = [e.candidate for e in evaluations if e.feasible]
-        base = [s for _ in range(args.rounds) for s in run(engine, feasible)[0]]
-        base_cycle = [e.cycle_time_s for e in run(engine, feasible)[1]]
+        base, base_cycle = measured(engine, feasible, args.rounds)
         print(f"== one feasible seal-job candidate ({len(feasible)} of {len(batch)} seeded) ==")
-        print(f"  CPU time, median of {len(base)}: {statistics.median(base):.2f} s")
+        print(f"  CPU time, median of {args.rounds} rounds × {len(feasible)}: {base:.2f} s")
         print("  shares (cProfile, cumulative):")
         for label, share in shares(engine, feasible):
             print(f"    {label:48s} {share * 100:5.1f} %")
         cannot_win = path_timing._cannot_win
         path_timing._cannot_win = lambda *args, **kwargs: True
         try:
-            alone = [s for _ in range(args.rounds) for s in run(engine, feasible)[0]]
-            cycle = [e.cycle_time_s for e in run(engine, feasible)[1]]
+            alone, cycle = measured(engine, feasible, args.rounds)
         finally:
             path_timing._cannot_win = cannot_win
-        ratio = statistics.median(alone) / statistics.median(base)
         longer = max(c / b - 1.0 for c, b in zip(cycle, base_cycle, strict=True))
         print(
             "  what-if (not a product option): the averaged-profile stage skipped:"
-            f" {statistics.median(alone):.2f} s ({ratio:.2f}× the above), cycle times up to"
+            f" {alone:.2f} s ({alone / base:.2f}× the above), cycle times up to"
             f" {longer * 100:.1f} % longer"
         )
     finally:
