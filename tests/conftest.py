@@ -1,6 +1,7 @@
 """Shared fixtures: seeded random paths, frames and cell files."""
 
 import re
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,14 @@ from offline_prog.path.process_frames import constant_normal
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = REPO / "cells"
+
+# The commands the tests start and stop with Ctrl-C (a session, a preview, place) must
+# get SIGINT as a terminal's foreground command does. A run started in the background by
+# a shell without job control (a CI script, `cmd &`) ignores SIGINT, and an ignored
+# signal stays ignored across exec: the session then never stopped (30 s, killed). A
+# handler is reset to the default on exec, so the commands get Ctrl-C again.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def with_own_io(text: str, io: str) -> str:
