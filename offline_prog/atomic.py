@@ -145,7 +145,7 @@ def staged_folder(target: Path) -> Iterator[Path]:
 def read_manifest(folder: Path) -> dict | None:
     """The manifest of a folder we wrote, or None (no manifest, or not ours)."""
     try:
-        manifest = json.loads((Path(folder) / MANIFEST).read_text())
+        manifest = json.loads((Path(folder) / MANIFEST).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
     return (

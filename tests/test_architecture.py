@@ -102,3 +102,49 @@ def test_robot_descriptions_are_package_data():
                 if file.is_file():
                     relative = file.relative_to(PACKAGE)
                     assert any(relative.match(p) for p in patterns), f"{relative} not package data"
+
+
+# Our own readers, which decode UTF-8 themselves (config.safe_yaml.read_text: the size
+# limit, a BOM, the one-line error).
+OWN_TEXT_READERS = {"safe_yaml"}
+
+
+def _text_io_without_encoding(tree: ast.AST) -> list[int]:
+    """Lines of ``open(...)`` in text mode, ``.read_text(...)`` and ``.write_text(...)``
+    calls that do not name their ``encoding``."""
+    lines = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call) or any(k.arg == "encoding" for k in node.keywords):
+            continue
+        if isinstance(node.func, ast.Name) and node.func.id == "open":
+            mode = node.args[1] if len(node.args) > 1 else None
+            mode = next((k.value for k in node.keywords if k.arg == "mode"), mode)
+            binary = isinstance(mode, ast.Constant) and "b" in str(mode.value)
+            if not binary:
+                lines.append(node.lineno)
+        elif isinstance(node.func, ast.Attribute) and node.func.attr in ("read_text", "write_text"):
+            owner = node.func.value
+            if not (isinstance(owner, ast.Name) and owner.id in OWN_TEXT_READERS):
+                lines.append(node.lineno)
+    return lines
+
+
+def test_text_files_are_read_and_written_as_utf8():
+    """Every text file the package reads or writes names its encoding: the locale's would
+    misread a cell's σ, or fail to write a robot folder's README, where it is not UTF-8
+    (a C or POSIX locale only gets UTF-8 from Python's own coercion)."""
+    found = [
+        f"{file.relative_to(PACKAGE.parent)}:{line}"
+        for file in sorted(PACKAGE.rglob("*.py"))
+        for line in _text_io_without_encoding(ast.parse(file.read_text(encoding="utf-8")))
+    ]
+    assert not found, "text I/O without encoding= at " + ", ".join(found)
+
+
+def test_the_encoding_check_sees_each_form():
+    code = (
+        "open(a)\nopen(a, 'w')\nopen(a, mode='rb')\nopen(a, encoding='utf-8')\n"
+        "p.read_text()\np.write_text(t, encoding='utf-8')\nq.write_text(t)\nos.open(a, 0)\n"
+        "safe_yaml.read_text(f)\n"
+    )
+    assert _text_io_without_encoding(ast.parse(code)) == [1, 2, 5, 7]

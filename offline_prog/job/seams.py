@@ -95,7 +95,7 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
 def _has_seam_column(file, seam: SeamConfig) -> bool:
     """The seam's CSV has a ``seam`` column (its header's last name)."""
     try:
-        with open(file.parent / seam.points) as stream:
+        with open(file.parent / seam.points, encoding="utf-8") as stream:
             for line in stream:
                 if line.strip() and not line.startswith("#"):
                     return line.strip().lower().split(",")[-1].strip() == "seam"

@@ -63,7 +63,7 @@ def hint_key(
 def read_hint(key: str) -> int | None:
     """The kept count of the search ``key``, or None (none kept, or unreadable)."""
     try:
-        return int((cache_dir("fits") / key).read_text())
+        return int((cache_dir("fits") / key).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
 

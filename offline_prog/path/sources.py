@@ -61,7 +61,7 @@ def read_csv_points(
     of the first and last steps is kept for the periodic fit to close
     (``path.closing``); a larger one is a missing stretch, OpenEndsError.
     """
-    with open(file, newline="") as stream:
+    with open(file, newline="", encoding="utf-8") as stream:
         reader = csv.reader(row for row in stream if row.strip() and not row.startswith("#"))
         header = [h.strip().lower() for h in next(reader, [])]
         rows = list(reader)

@@ -159,7 +159,7 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict, t
 
 def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) -> str:
     """The cell file's text with the best placement, to be written into ``out_dir``."""
-    text = cell_file.read_text()
+    text = cell_file.read_text(encoding="utf-8")
     poses = {"tool.X_IT": best.candidate.X_IT, "part.X_PE": best.candidate.X_PE}
     for i, pose in moved_obstacles(ctx, best.candidate).items():
         poses[f"obstacles.{i}.pose"] = pose
@@ -172,4 +172,4 @@ def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) 
 
 
 def write_json(file: Path, data: dict) -> None:
-    file.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
+    file.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n", encoding="utf-8")

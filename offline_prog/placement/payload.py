@@ -72,7 +72,7 @@ def cell_payload(file: Path, cell: Cell) -> CellPayload:
     paths = [cell_path, *sorted(set(found.values()))]
     root = Path(os.path.commonpath([p.parent for p in paths]))
     text = with_values(
-        cell_path.read_text(),
+        cell_path.read_text(encoding="utf-8"),
         {},
         {key: os.path.relpath(path, cell_path.parent) for key, path in found.items()},
     )

@@ -130,13 +130,17 @@ def engine_figures(engine, result: Placement, started: float) -> dict:
 def write_folder(out_dir: Path, cell_file: Path, ctx: Context, result: Placement, data: dict):
     """Stage ``outputs``: the folder, written aside and swapped in when complete."""
     with staged_folder(out_dir) as folder:
-        (folder / "placed.yaml").write_text(placed_text(cell_file, ctx, result.best, out_dir))
+        (folder / "placed.yaml").write_text(
+            placed_text(cell_file, ctx, result.best, out_dir), encoding="utf-8"
+        )
         preview = None
         if result.best.feasible:
             write_best_preview(ctx, result.best, folder / "best_preview.html")
             preview = "best_preview.html"
         write_json(folder / "placement.json", data)
-        (folder / "placement.html").write_text(render_placement_html(result, data, preview))
+        (folder / "placement.html").write_text(
+            render_placement_html(result, data, preview), encoding="utf-8"
+        )
         write_manifest(folder, {"plan": sorted(p.name for p in folder.iterdir())})
 
 

@@ -172,7 +172,7 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     if not path.is_file():
         raise ValueError(f"{path}: file not found (each robot folder needs a {PARAMS_FILE})")
     try:
-        record = yaml.safe_load(path.read_text())
+        record = yaml.safe_load(path.read_text(encoding="utf-8"))
     except yaml.YAMLError as error:
         raise ValueError(f"{path}: not valid YAML: {' '.join(str(error).split())}") from None
     check = _Checker(path)

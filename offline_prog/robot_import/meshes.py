@@ -150,9 +150,12 @@ def _write(out: Path, link: str, role: str, meshes, colours, trimesh) -> list[st
                 f"newmtl {name}\nKa 0 0 0\nKd {r:g} {g:g} {b:g}\nd {a:g}\n"
                 "Ks 0.05 0.05 0.05\nNs 10\nillum 2\n\n"
                 for (name, _), (r, g, b, a) in zip(groups, colours, strict=True)
-            )
+            ),
+            encoding="utf-8",
         )
-        (folder / f"{link}.obj").write_text(header + f"mtllib {link}.mtl\n" + _obj(groups, True))
+        (folder / f"{link}.obj").write_text(
+            header + f"mtllib {link}.mtl\n" + _obj(groups, True), encoding="utf-8"
+        )
         return [f"meshes/visual/{link}.obj"]
     merged = trimesh.util.concatenate(meshes)
     hull = merged.convex_hull
@@ -166,7 +169,7 @@ def _write(out: Path, link: str, role: str, meshes, colours, trimesh) -> list[st
         pieces = [trimesh.Trimesh(v, f, process=False) for v, f in parts]
     names = [f"{link}.obj"] if len(pieces) == 1 else [f"{link}_{k}.obj" for k in range(len(pieces))]
     for name, piece in zip(names, pieces, strict=True):
-        (folder / name).write_text(header + _obj([(None, piece)], False))
+        (folder / name).write_text(header + _obj([(None, piece)], False), encoding="utf-8")
     return [f"meshes/collision/{name}" for name in names]
 
 

@@ -66,7 +66,9 @@ def write_urdf(chain: Chain, files: dict, out: Path, name: str) -> Path:
         robot.append(copy)
     ET.indent(robot, "  ")
     file = out / f"{name}.urdf"
-    file.write_text('<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n")
+    file.write_text(
+        '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n", encoding="utf-8"
+    )
     return file
 
 

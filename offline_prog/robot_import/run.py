@@ -89,7 +89,7 @@ def import_robot(
             shutil.copyfile(licence, staging / "meshes" / "LICENSE")
         if sources:
             (staging / "meshes" / "SOURCES.md").write_text(
-                record.sources_md(name, sources, licence)
+                record.sources_md(name, sources, licence), encoding="utf-8"
             )
         record.write_urdf(chain, files, staging, name)
         limits, notes = record.limits_record(chain)
@@ -103,7 +103,7 @@ def import_robot(
             notes=notes,
             controller=controller,
         )
-        (staging / PARAMS_FILE).write_text(text)
+        (staging / PARAMS_FILE).write_text(text, encoding="utf-8")
         _load_staged(staging, name)
         if target.exists():
             shutil.rmtree(target)
@@ -125,7 +125,8 @@ def import_robot(
             packages=packages,
             pairs=pairs,
             samples=samples,
-        )
+        ),
+        encoding="utf-8",
     )
     return ImportResult(target, robot, params, fk, pairs)
 

@@ -93,7 +93,7 @@ def description_text(file: Path, packages: dict[str, Path]) -> str:
     if not file.is_file():
         raise InputError(file, "", "description file not found")
     if file.suffix.lower() == ".urdf":
-        return file.read_text()
+        return file.read_text(encoding="utf-8")
     if file.suffix.lower() != ".xacro":
         raise InputError(file, "", "expected a .urdf or .xacro file")
     import xacro

@@ -50,7 +50,7 @@ def as_obj(mesh_file: Path, scale: float) -> Path:
         mesh.apply_scale(scale)
         target.parent.mkdir(parents=True, exist_ok=True)
         temp = target.with_suffix(f".{os.getpid()}.tmp")
-        temp.write_text(trimesh.exchange.obj.export_obj(mesh))
+        temp.write_text(trimesh.exchange.obj.export_obj(mesh), encoding="utf-8")
         os.replace(temp, target)
     return target
 
@@ -78,7 +78,9 @@ def convex_pieces(file: Path, scale: float, mesh: trimesh.Trimesh) -> tuple[Path
         temp = Path(tempfile.mkdtemp(dir=target.parent, prefix=f".{key}."))
         for i, (vertices, faces) in enumerate(parts):
             piece = trimesh.Trimesh(vertices, faces, process=False)
-            (temp / f"piece_{i:03d}.obj").write_text(trimesh.exchange.obj.export_obj(piece))
+            (temp / f"piece_{i:03d}.obj").write_text(
+                trimesh.exchange.obj.export_obj(piece), encoding="utf-8"
+            )
         try:
             os.rename(temp, target)
         except OSError:  # another process cached it first

@@ -171,7 +171,7 @@ def read_matrix(robot_folder: Path) -> list[LinkPair] | None:
     file = Path(robot_folder) / MATRIX_FILE
     if not file.is_file():
         return None
-    text = file.read_text()
+    text = file.read_text(encoding="utf-8")
     key = (str(file.resolve()), text)
     pairs = _matrices.get(key)  # a plan (a session's re-plan) builds its cell each time
     if pairs is None:

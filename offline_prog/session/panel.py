@@ -48,7 +48,11 @@ SEAMS_LINK = (
 
 def page(meshcat_port: int, *, seams: bool = False) -> bytes:
     """The panel page; with a link to the model's seams page when ``seams``."""
-    text = resources.files("offline_prog.session").joinpath("assets/panel.html").read_text()
+    text = (
+        resources.files("offline_prog.session")
+        .joinpath("assets/panel.html")
+        .read_text(encoding="utf-8")
+    )
     text = text.replace("__SEAMS_LINK__", SEAMS_LINK if seams else "")
     return text.replace("__MESHCAT_PORT__", str(int(meshcat_port))).encode()
 

@@ -32,7 +32,9 @@ def _columns(plan_dir: Path, report: dict) -> dict[str, np.ndarray]:
     (empty cells NaN: the quality column off the dispensing rows). Only those rows and
     columns are parsed, by numpy's C reader: the same numbers as converting every
     cell's text."""
-    header, *body = (plan_dir / "trajectory.csv").read_text().removesuffix("\n").split("\n")
+    header, *body = (
+        (plan_dir / "trajectory.csv").read_text(encoding="utf-8").removesuffix("\n").split("\n")
+    )
     header = next(csv.reader([header]))
     drawn = [name for name in header if _drawn(name, report)]
     step = max(1, len(body) // MAX_PLOT_POINTS)
@@ -234,7 +236,7 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
     folder's)."""
     plan_dir = Path(plan_dir)
     folder_name = folder_name or plan_dir.name
-    report = json.loads((plan_dir / "report.json").read_text())
+    report = json.loads((plan_dir / "report.json").read_text(encoding="utf-8"))
     col = _columns(plan_dir, report)
     job = report["job"]
     ok = report["collision_free"]

@@ -43,9 +43,9 @@ def load_plan_folder(plan_dir: Path) -> tuple[dict, dict[str, np.ndarray], Progr
     plan_dir = Path(plan_dir)
     file = plan_dir / "report.json"
     try:
-        report = json.loads(file.read_text())
+        report = json.loads(file.read_text(encoding="utf-8"))
         file = plan_dir / "trajectory.csv"
-        with open(file) as stream:
+        with open(file, encoding="utf-8") as stream:
             header = stream.readline().strip().split(",")
             table = np.loadtxt(stream, delimiter=",", ndmin=2)
     except (OSError, ValueError) as error:

@@ -281,15 +281,16 @@ def read_clearance(plan_dir: Path) -> dict | None:
     file = Path(plan_dir) / "clearance.csv"
     if not file.is_file():
         return None
-    names = file.read_text().splitlines()[0].split(",")
+    names = file.read_text(encoding="utf-8").splitlines()[0].split(",")
     table = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2)
     return {name: table[:, i] for i, name in enumerate(names)}
 
 
 # Draws every chart of the JSON in #plot-data into its <div id=...> (uPlot, one per panel).
-PLOT_SCRIPT = (ASSETS / "plots.js").read_text()
+PLOT_SCRIPT = (ASSETS / "plots.js").read_text(encoding="utf-8")
 
 
 def plot_assets() -> tuple[str, str]:
     """(uPlot's CSS, uPlot's script) to inline in the page."""
-    return (ASSETS / "uPlot.min.css").read_text(), (ASSETS / "uPlot.iife.min.js").read_text()
+    css, script = (ASSETS / name for name in ("uPlot.min.css", "uPlot.iife.min.js"))
+    return css.read_text(encoding="utf-8"), script.read_text(encoding="utf-8")

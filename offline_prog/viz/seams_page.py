@@ -130,6 +130,6 @@ def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
         )
     part = Path(part)
     out = Path(out) if out is not None else part.with_name(f"{part.stem}_seams.html")
-    out.write_text(seams_html(catalog))
+    out.write_text(seams_html(catalog), encoding="utf-8")
     say(f"page      {out}", highlight=False)
     return out

@@ -214,8 +214,12 @@ class StaticScene:
 
     def html(self, title: str) -> str:
         """The standalone page: Drake's viewer with meshcat.js inlined and these commands."""
-        page = (DRAKE_VIEWER / "meshcat.html").read_text()
-        script = (DRAKE_VIEWER / "meshcat.js").read_text().replace("</script", "<\\/script")
+        page = (DRAKE_VIEWER / "meshcat.html").read_text(encoding="utf-8")
+        script = (
+            (DRAKE_VIEWER / "meshcat.js")
+            .read_text(encoding="utf-8")
+            .replace("</script", "<\\/script")
+        )
         page = page.replace(_SCRIPT_TAG, f"<script>{script}</script>")
         start, end = page.index(_BLOCK[0]), page.index(_BLOCK[1]) + len(_BLOCK[1])
         replay = "\n".join(
