@@ -131,7 +131,7 @@ def _text_io_without_encoding(tree: ast.AST) -> list[int]:
 
 def test_text_files_are_read_and_written_as_utf8():
     """Every text file the package reads or writes names its encoding: the locale's would
-    misread a cell's σ, or fail to write a robot folder's README, where it is not UTF-8
+    misread a cell's σ, or fail to write a robot folder's SOURCES.md (its …), where it is not UTF-8
     (a C or POSIX locale only gets UTF-8 from Python's own coercion)."""
     found = [
         f"{file.relative_to(PACKAGE.parent)}:{line}"
