@@ -11,25 +11,27 @@ def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
+def _fold_columns(ufunc: np.ufunc, x: np.ndarray) -> np.ndarray:
+    """(...) ``ufunc`` applied across the last axis of x (..., K), K ≥ 1, one column at
+    a time into a new array."""
+    x = np.asarray(x)
+    out = np.array(x[..., 0])
+    for k in range(1, x.shape[-1]):
+        ufunc(out, x[..., k], out=out)
+    return out
+
+
 def row_max(x: np.ndarray) -> np.ndarray:
     """(...) the largest entry along the last axis of x (..., K), K ≥ 1: the numbers of
     ``x.max(axis=-1)`` (NaN where a row holds one), several times faster for a short
     axis such as a robot's six joints, which numpy reduces element by element."""
-    x = np.asarray(x)
-    out = np.array(x[..., 0])
-    for k in range(1, x.shape[-1]):
-        np.maximum(out, x[..., k], out=out)
-    return out
+    return _fold_columns(np.maximum, x)
 
 
 def row_min(x: np.ndarray) -> np.ndarray:
     """(...) the smallest entry along the last axis of x (..., K): ``x.min(axis=-1)``'s
     numbers, as :func:`row_max` gives ``x.max(axis=-1)``'s."""
-    x = np.asarray(x)
-    out = np.array(x[..., 0])
-    for k in range(1, x.shape[-1]):
-        np.minimum(out, x[..., k], out=out)
-    return out
+    return _fold_columns(np.minimum, x)
 
 
 def at_index(values: np.ndarray, x: float):
