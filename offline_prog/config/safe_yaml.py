@@ -145,32 +145,36 @@ def _check_nodes(file: Path, root: yaml.Node) -> None:
 def _check_depth(file: Path, text: str) -> None:
     """Nesting depth from the parser's events (an iterative pass, no node built).
 
-    libyaml's parser (where installed) and PyYAML's are both iterative, and both yield
-    events as they scan, so our limit fires first, with our message and line. libyaml's
-    scanner looks up to 1,024 characters ahead for a key, and the libyaml bundled with
-    PyYAML 6.0.4 stops at 1,000 levels with a message of its own: that one is
-    ours too (the line it names).
+    libyaml's parser (where installed) yields events as it scans, so our limit fires
+    first, with our message and line, on most texts. Where it stops with an error of
+    its own (a syntax error, or its own nesting limit: its scanner looks up to 1,024
+    characters ahead, and the libyaml bundled with PyYAML 6.0.4 stops at 1,000 levels),
+    PyYAML's pure-Python parser, iterative and without a limit, reads the text again:
+    our limit, or the error it finds, is the answer. No message text is matched.
     """
-    depth = 0
     try:
-        for event in yaml.parse(text, Loader=_BaseLoader):
-            if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
-                depth += 1
-                if depth > MAX_YAML_DEPTH:
-                    line = event.start_mark.line + 1
-                    raise InputError(
-                        file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
-                    )
-            elif isinstance(event, yaml.SequenceEndEvent | yaml.MappingEndEvent):
-                depth -= 1
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        if mark is None or "maximum nesting depth" not in str(error):
+        _walk_depth(file, text, _BaseLoader)
+    except yaml.YAMLError:
+        if _BaseLoader is yaml.SafeLoader:
             raise
-        line = mark.line + 1
-        raise InputError(
-            file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
-        ) from None
+        _walk_depth(file, text, yaml.SafeLoader)  # raises ours, or its own error
+        raise
+
+
+def _walk_depth(file: Path, text: str, loader) -> None:
+    """Raises InputError where the events of ``loader``'s parser nest deeper than
+    MAX_YAML_DEPTH (yaml.YAMLError where the text is not YAML)."""
+    depth = 0
+    for event in yaml.parse(text, Loader=loader):
+        if isinstance(event, yaml.SequenceStartEvent | yaml.MappingStartEvent):
+            depth += 1
+            if depth > MAX_YAML_DEPTH:
+                line = event.start_mark.line + 1
+                raise InputError(
+                    file, "", f"line {line}: nested deeper than {MAX_YAML_DEPTH} levels"
+                )
+        elif isinstance(event, yaml.SequenceEndEvent | yaml.MappingEndEvent):
+            depth -= 1
 
 
 def load(file: Path, text: str):
