@@ -268,7 +268,24 @@ def _import_flags(robot_commands) -> None:
         default=10_000,
         help="self-collision configurations (10000)",
     )
-    imp.add_argument("--force", action="store_true", help="replace an existing robot folder")
+    imp.add_argument(
+        "--force",
+        action="store_true",
+        help="replace a robot folder an earlier `robots import` wrote (no other folder)",
+    )
+    imp.add_argument(
+        "--allow-file-meshes",
+        action="store_true",
+        help="read file:// mesh names (anywhere on disk); default: only package:// and "
+        "relative names inside the --package-path folders",
+    )
+    imp.add_argument(
+        "--j23-coupled",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the controller counts axis 3 from the horizontal (ABB: required, model-"
+        "dependent, e.g. true for the IRB 2400; FANUC: always)",
+    )
 
 
 def _seams_flags(commands) -> None:

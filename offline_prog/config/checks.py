@@ -34,9 +34,27 @@ def _error(file, key, reason) -> InputError:
     return InputError(file, key, reason)
 
 
+def _check_robots_dir(file: Path, model: str, folder: Path) -> None:
+    """A cell's ``robot.robots_dir`` is a folder holding the robot: the robot is taken
+    from there, never from a folder searched after it (a mistyped folder would plan
+    with the bundled robot of the same name)."""
+    if not folder.is_dir():
+        raise _error(file, "robot.robots_dir", f"folder not found: {folder}")
+    if find_robot(model, [folder]) is None:
+        have = sorted({name for name, _, _ in robots_in([folder])})
+        raise _error(
+            file,
+            "robot.robots_dir",
+            f"{folder} holds no robot folder {model!r} (have: {', '.join(have) or 'none'}); "
+            "without robots_dir the robot comes from OFFLINE_PROG_ROBOTS or the bundled ones",
+        )
+
+
 def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     """Semantic checks the types alone cannot express."""
     folders = search_path(robots_dir, cell_file=file, robots_dir=cell.robot.robots_dir)
+    if cell.robot.robots_dir is not None:
+        _check_robots_dir(file, cell.robot.model, folders[0])
     if find_robot(cell.robot.model, folders) is None:
         have = sorted({name for name, _, _ in robots_in(folders)})
         raise _error(

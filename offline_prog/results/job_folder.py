@@ -35,6 +35,7 @@ from offline_prog.results.plan_folder import (
 )
 from offline_prog.results.report import collision_summary, payload_summary, report
 from offline_prog.results.timing_bound import timing_bound_report
+from offline_prog.robot.record import robot_source
 from offline_prog.timing.trajectory import CSV_COLUMNS, tait_bryan_xyz
 from offline_prog.viz.job_preview import write_job_preview_html
 from offline_prog.viz.job_report_html import write_job_report_html
@@ -161,6 +162,7 @@ def job_report(job: JobPlan) -> dict:
         "cell": str(job.cell_file),
         "name": job.cell.name,
         "robot": job.cell.robot.model,
+        **robot_source(job.robot),
         "tool": job.cell.tool.name,
         "part": job.cell.part.name,
         "payload": payload_summary(job.cell),
