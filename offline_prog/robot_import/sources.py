@@ -42,9 +42,15 @@ class Packages:
         """``path`` resolved, when it lies in one of the roots.
 
         Raises:
-            InputError: naming ``file`` and ``key``, when it lies elsewhere.
+            InputError: naming ``file`` and ``key``, when it lies elsewhere, cannot be
+                resolved or is neither a file nor a folder (a pipe would block a read).
         """
-        resolved = Path(path).resolve()
+        try:
+            resolved = Path(path).resolve()
+        except (OSError, RuntimeError) as error:  # a symbolic-link loop, a name too long
+            raise InputError(file, key, f"cannot be resolved ({error})") from None
+        if resolved.exists() and not (resolved.is_file() or resolved.is_dir()):
+            raise InputError(file, key, f"{resolved} is not a regular file")
         if not any(resolved.is_relative_to(root) for root in self.roots):
             raise InputError(
                 file,

@@ -17,10 +17,15 @@ from offline_prog.robot.record import folder_sha256
 from offline_prog.robot_import import run as import_run
 
 KUKA = ROBOTS_DIR / "kuka_kr16_2" / "kuka_kr16_2.urdf"
+# The same robot drawn with boxes and cylinders: no meshes to convert (a faster import).
+PRIMITIVES = ROBOTS_DIR / "kuka_kr16_2" / "kuka_kr16_2_primitives.urdf"
 
 
-def _argv(out: Path, name: str) -> list[str]:
-    return ["robots", "import", str(KUKA), "--name", name, "--out", str(out), "--samples", "10"]
+def _argv(out: Path, name: str, description: Path = PRIMITIVES) -> list[str]:
+    return ["robots", "import", str(description), "--name", name, "--out", str(out)] + [
+        "--samples",
+        "10",
+    ]
 
 
 def _run(capsys, argv: list[str]) -> tuple[int, list[str]]:
@@ -38,7 +43,7 @@ def _tree(folder: Path) -> dict[str, bytes]:
 def imported(tmp_path_factory) -> Path:
     """The bundled KR 16-2's URDF imported once: ``<tmp>/robots/kr16``."""
     out = tmp_path_factory.mktemp("imported") / "robots"
-    assert main(_argv(out, "kr16")) == 0
+    assert main(_argv(out, "kr16", KUKA)) == 0
     return out / "kr16"
 
 
