@@ -126,6 +126,7 @@ def import_robot(
         readme = readme_text(**facts, fk=fk, packages=packages, pairs=pairs, samples=samples)
         (staging / "README.md").write_text(readme, encoding="utf-8")
         mark(staging)
+        check_target(target, force=force)  # again: a folder may have appeared meanwhile
     return ImportResult(target, load_robot(name, Path(out)), params, fk, pairs)
 
 
