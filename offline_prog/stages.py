@@ -16,8 +16,8 @@ from pydrake.math import RigidTransform
 
 from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
 from offline_prog.collision.check import check_trajectory
-from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.calibration_keys import check_controller_frames
+from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
 from offline_prog.config.robot_search import find_robot, search_path

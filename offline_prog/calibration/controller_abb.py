@@ -125,8 +125,13 @@ def read_rapid(file: str, text: str) -> RapidData:
         InputError: a declaration whose value is not an aggregate, or a name given twice.
     """
     tooldata, wobjdata = {}, {}
-    for match in _DECLARATION.finditer(_without_comments(text)):
-        kind, name, value = match.group(1).lower(), match.group(2), match.group(3)
+    code = _without_comments(text)
+    # Declarations are found in the code with its strings blanked (a string may hold
+    # anything, "PERS tooldata ..." too); each value is then read from the code itself.
+    blanked = re.sub(r'"[^"\n]*"', lambda m: '"' + " " * (len(m.group()) - 2) + '"', code)
+    for match in _DECLARATION.finditer(blanked):
+        kind, name = match.group(1).lower(), match.group(2)
+        value = code[match.start(3) : match.end(3)]
         table = tooldata if kind == "tooldata" else wobjdata
         if name in table:
             raise InputError(file, name, f"PERS {kind} {name} is declared twice")

@@ -88,8 +88,7 @@ def check_touches(problem: Problem) -> None:
         check_pivot(file, problem.X_IE[tip])
     if part.any():
         names = [t for t, is_part in zip(problem.touches.targets, part, strict=True) if is_part]
-        points = {t: p for t, p in zip(problem.touches.targets, problem.p_PK, strict=True)}
-        check_grasp(file, names, {name: points[name] for name in names})
+        check_grasp(file, names, problem.part_points)
 
 
 def start_values(problem: Problem) -> Values:

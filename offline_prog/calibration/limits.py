@@ -18,7 +18,7 @@ MIN_PART_POINTS = 3
 # The pivot separates tip and pointer only if the flange turns about two axes: the
 # rms turn about the least-turned axis (sqrt of the spread matrix's smallest
 # eigenvalue per touch) must reach this [deg].
-MIN_PIVOT_SPREAD_DEG = 10.0
+MIN_PIVOT_SPREAD_DEG = 5.0
 # Part points closer than this (rms) to one line do not fix the grasp's rotation [mm].
 MIN_PART_SPREAD_MM = 5.0
 # The tool_axis touches may tilt the axis at most this far from the cell's +z of T.

@@ -136,6 +136,7 @@ class Problem:
         p_PK: (N, 3) the part point of each PART touch in P [mm] (NaN otherwise).
         nominal: the cell's values.
         blocks: the unknowns estimated, in BLOCKS' order.
+        part_points: calibration.part_points {name: [x, y, z] in P [mm]}, touched or not.
     """
 
     touches: Touches
@@ -144,6 +145,7 @@ class Problem:
     p_PK: np.ndarray
     nominal: Nominal
     blocks: tuple[str, ...]
+    part_points: dict[str, list[float]]
 
     @classmethod
     def of(cls, touches: Touches, X_IE: np.ndarray, calibration: CalibrationConfig, nominal):
@@ -160,7 +162,7 @@ class Problem:
             blocks.append("axis")
         if (kinds == PART).any():
             blocks += ["grasp_translation", "grasp_rotation"]
-        return cls(touches, X_IE, kinds, p_PK, nominal, tuple(blocks))
+        return cls(touches, X_IE, kinds, p_PK, nominal, tuple(blocks), dict(points))
 
     def without(self, i: int) -> Problem:
         """The problem less touch i (the unknowns stay those of the whole file)."""

@@ -207,16 +207,20 @@ def _xyz(values, sigmas=None, digits: int = 2) -> str:
     return ", ".join(f"{v:.{digits}f} ±{s:.{digits}f}" for v, s in zip(values, sigmas, strict=True))
 
 
-def summary(inputs, calibration, files: dict) -> list[str]:
-    """One line per frame (X_IT, the pointer, X_PE), the touches, the path shift."""
+def summary(inputs, calibration, files: dict | None = None) -> list[str]:
+    """One line per frame (X_IT, the pointer, X_PE), the touches, the path shift (and
+    the files written)."""
     p_IT, rpy_IT = np.array(calibration.pose_IT[0]) * 1e3, calibration.pose_IT[1]
     p_PE, rpy_PE = np.array(calibration.pose_PE[0]) * 1e3, calibration.pose_PE[1]
     old_IT, old_PE = inputs.X_IT.translation() * 1e3, inputs.X_PE.translation() * 1e3
     worst = max(calibration.shifts, key=lambda s: s.max_mm)
+    seam = f"seam {worst.seam} " if len(calibration.shifts) > 1 else ""
     tail = (
-        f"the planned path on the part moves up to {worst.max_mm:.2f} mm (seam {worst.seam} "
-        f"at σ = {worst.sigma_mm:.1f} mm); wrote {files['calibrated']} and {files['json']}"
+        f"the planned path on the part moves up to {worst.max_mm:.2f} mm ({seam}at σ = "
+        f"{worst.sigma_mm:.1f} mm)"
     )
+    if files is not None:
+        tail += f"; wrote {files['calibrated']} and {files['json']}"
     turned = {
         key: _angle_deg(old.rotation().inverse().multiply(new.rotation()).matrix())
         for key, old, new in (

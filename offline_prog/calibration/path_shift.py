@@ -12,6 +12,10 @@ instead of p_PF(σ): the distance between them is how far the path moves on the 
 and the angle between R_PF(σ) and the tool's real orientation on the part,
 ``R_PE' R_PE⁻¹ R_PF(σ) R_IT⁻¹ R_IT'``, how far the tool tilts against it. Both are
 frame algebra on the fitted seams (no joints), at the cell's own tool rotation (0).
+
+:func:`moved_flange` is the other view of the same change: the flange path the
+calibrated cell asks for, ``X_IE'(σ) = X_IT' X_IT⁻¹ X_IE(σ) X_PE⁻¹ X_PE'`` (the same
+process frames, tool turn included), beside the nominal one (the session draws both).
 """
 
 from __future__ import annotations
@@ -88,3 +92,19 @@ def path_shift(inputs: Inputs, X_IT_new: RigidTransform, X_PE_new: RigidTransfor
             )
         )
     return out
+
+
+def moved_flange(
+    p_IE: np.ndarray,
+    R_IE: np.ndarray,
+    *,
+    X_IT: RigidTransform,
+    X_PE: RigidTransform,
+    X_IT_new: RigidTransform,
+    X_PE_new: RigidTransform,
+) -> np.ndarray:
+    """(N, 3) [m] the flange positions of the calibrated cell for the nominal flange
+    poses p_IE (N, 3) [m], R_IE (N, 3, 3) (module docstring)."""
+    A = (X_IT_new @ X_IT.inverse()).GetAsMatrix4()
+    p_B = (X_PE.inverse() @ X_PE_new).translation()
+    return (p_IE + R_IE @ p_B) @ A[:3, :3].T + A[:3, 3]

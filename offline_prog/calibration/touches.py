@@ -91,7 +91,12 @@ def read_touches(
 
 
 def parse_touches(
-    file: str, text: str, robot: RobotModel, calibration: CalibrationConfig, *, controller_angles
+    file: str,
+    text: str,
+    robot: RobotModel,
+    calibration: CalibrationConfig,
+    *,
+    controller_angles: bool = False,
 ) -> Touches:
     """The touches in ``text`` (a file's content; ``file`` names it in messages).
 

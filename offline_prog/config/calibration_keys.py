@@ -95,9 +95,9 @@ def check_controller_frames(file: Path, cell, language: str | None) -> None:
         low, high = CONTROLLER_FRAME_RANGES.get(language, {}).get(owner, (1, 10_000))
         if not low <= number <= high:
             data = CONTROLLER_FRAME_NAMES.get(language, {}).get(owner, "frame")
+            whose = f" of the robot's {language} controller" if language else ""
             raise _error(
                 file,
                 f"{owner}.controller_frame",
-                f"{number} is not a {data} number of the robot's {language or 'controller'} "
-                f"controller (use {low}..{high})",
+                f"{number} is not a {data} number{whose} (use {low}..{high})",
             )

@@ -22,6 +22,31 @@ from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import fit_path, load_inputs
 
+CELLS = Path(__file__).resolve().parents[2] / "cells"
+# calibration: blocks for the demo cells without one (points of each part, in P [mm]).
+BLOCKS = {
+    "weld_seam_irb2400": "{a: [-150, -40, 0], b: [150, -35, 0], c: [0, 30, 0]}",
+    "tape_cylinder_ur10e": "{a: [-150, 0, 0], b: [150, 0, 0], c: [0, 60, -6]}",
+}
+
+
+def calibration_cell(folder: Path, name: str, *, model: str = "", robots_dir: str = "") -> Path:
+    """A copy of demo cell ``name`` in ``folder`` with a calibration: block (its data
+    files named by absolute path; ``model``/``robots_dir`` put another robot in)."""
+    text = (CELLS / f"{name}.yaml").read_text(encoding="utf-8")
+    text = text.replace(": data/", f": {CELLS}/data/")
+    if name in BLOCKS:
+        text += (
+            "calibration:\n  pointer_mm: [0, 0, 250]\n  tool_axis_point_mm: 50\n"
+            f"  part_points: {BLOCKS[name]}\n"
+        )
+    if model:
+        old = text[text.index("  model: ") : text.index("\n", text.index("  model: ")) + 1]
+        text = text.replace(old, f"  model: {model}\n  robots_dir: {robots_dir}\n")
+    file = folder / f"{name}.yaml"
+    file.write_text(text, encoding="utf-8")
+    return file
+
 
 @dataclasses.dataclass(frozen=True)
 class TrueCell:
