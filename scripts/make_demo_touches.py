@@ -5,7 +5,7 @@ The touches a technician would take on the seal demo's cell as it "really" is: t
 nozzle 1.5 mm and 0.3° from where cells/seal_plate_kr16.yaml puts it, the plate held
 1.5 mm and 0.3° off its nominal grasp, the pointer's tip 0.8 mm from ``pointer_mm``;
 8 tool_tip and 4 tool_axis touches with the flange tilted 15-30°, each part point
-touched twice, 0.02 mm touch noise (tests/calibration/synthetic_touches.py).
+touched three times, 0.02 mm touch noise (tests/calibration/synthetic_touches.py).
 ``offline-prog calibrate cells/seal_plate_kr16.yaml --touches ...`` recovers them.
 """
 

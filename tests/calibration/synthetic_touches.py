@@ -12,11 +12,9 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-from pydrake.math import RigidTransform, RollPitchYaw
 from scipy.spatial.transform import Rotation
 
 from offline_prog.calibration.touches import HEADER
-from offline_prog.config.cell import transform
 from offline_prog.job.seams import seam_inputs
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.robot.model import ROBOTS_DIR
@@ -117,7 +115,7 @@ def synthetic_touches(
     noise_mm: float = 0.02,
     n_tip: int = 8,
     n_axis: int = 4,
-    per_point: int = 2,
+    per_point: int = 3,
     tilt_deg: tuple[float, float] = (15.0, 30.0),
     controller_angles: bool = False,
 ) -> Touched:
@@ -177,10 +175,3 @@ def nominal_truth(inputs, rng, *, mm: float = 2.0, deg: float = 0.5, pointer_mm=
     nominal = np.asarray(inputs.cell.calibration.pointer_mm or [0.0, 0.0, 0.0], dtype=float)
     pointer = nominal + rng.normal(scale=1.0, size=3) if pointer_mm is None else pointer_mm
     return TrueCell(X_IT, X_PE, np.asarray(pointer, dtype=float))
-
-
-def rpy_deg(X: np.ndarray) -> list[float]:
-    return list(np.degrees(RollPitchYaw(RigidTransform(X).rotation()).vector()))
-
-
-__all__ = ["TrueCell", "Touched", "start_pose", "synthetic_touches", "nominal_truth", "transform"]

@@ -58,7 +58,7 @@ def test_calibration_json_holds_the_contract_figures(demo):
     assert set(estimates) == {"tool_tip", "pointer", "tool_axis", "grasp"}
     assert len(estimates["tool_tip"]["sigma_mm"]) == 3 and estimates["tool_axis"]["sigma_deg"] > 0
     assert set(estimates["grasp"]) >= {"p_PE_mm", "sigma_mm", "rotation_sigma_deg"}
-    assert [t["line"] for t in data["touches"]] == list(range(6, 24))
+    assert [t["line"] for t in data["touches"]] == list(range(6, 27))
     assert all(len(t["residual_mm"]) == 3 and t["used"] for t in data["touches"])
     distances = [np.linalg.norm(t["residual_mm"]) for t in data["touches"]]
     assert data["rms_mm"] == pytest.approx(np.sqrt(np.mean(np.square(distances))), rel=1e-3)

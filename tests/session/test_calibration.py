@@ -49,7 +49,7 @@ def test_the_calibrated_path_is_the_calibrated_cells(calibrated):
     from offline_prog.calibration.path_shift import moved_flange
 
     plan = calibrated.view.shown.plan
-    c = calibrated.calibration.calibration
+    c = calibrated.last_calibration.calibration
     flange = plan.trajectory.flange
     moved = moved_flange(
         flange.p_IE,
@@ -86,7 +86,7 @@ def test_a_bad_touches_file_is_refused_and_nothing_changes(calibrated, args, rea
 
 
 def test_use_calibrated_values_sets_the_controls_and_re_plans(calibrated):
-    c = calibrated.calibration.calibration
+    c = calibrated.last_calibration.calibration
     generation = calibrated.snapshot()["generation"]
     assert calibrated.action("calibrated") == {"ok": True}
     snapshot = calibrated.snapshot()
