@@ -22,6 +22,7 @@ sys.path[:0] = [str(REPO), str(REPO / "tests"), str(REPO / "tests" / "calibratio
 
 from synthetic_touches import (  # noqa: E402
     calibration_cell,
+    import_fanuc,
     nominal_truth,
     start_pose,
     synthetic_touches,
@@ -56,18 +57,7 @@ def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="calibration-accuracy-"))
     cells = {name: calibration_cell(folder, name) for name in DEMOS}
     if args.fanuc:
-        from offline_prog.robot_import.run import import_robot
-
-        fanuc = REPO.parent / "shared/robots/ros-industrial-fanuc"
-        fanuc = fanuc if fanuc.is_dir() else Path("/work/shared/robots/ros-industrial-fanuc")
-        import_robot(
-            fanuc / "fanuc_m20ia_support/urdf/m20ia.xacro",
-            name="fanuc_m20ia",
-            out=folder / "robots",
-            package_paths=[fanuc],
-            vendor="fanuc",
-            samples=100,
-        )
+        import_fanuc(folder / "robots")
         (folder / "fanuc").mkdir()
         cells["seal_plate_fanuc_m20ia"] = calibration_cell(
             folder / "fanuc", "seal_plate_kr16", model="fanuc_m20ia", robots_dir="../robots"

@@ -21,11 +21,37 @@ from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import fit_path, load_inputs
 
 CELLS = Path(__file__).resolve().parents[2] / "cells"
+# The ROS-Industrial FANUC support packages (README: robots import), or None.
+SHARED_FANUC = next(
+    (
+        p
+        for p in (
+            CELLS.parents[1] / "shared/robots/ros-industrial-fanuc",
+            Path("/work/shared/robots/ros-industrial-fanuc"),
+        )
+        if p.is_dir()
+    ),
+    None,
+)
 # calibration: blocks for the demo cells without one (points of each part, in P [mm]).
 BLOCKS = {
     "weld_seam_irb2400": "{a: [-150, -40, 0], b: [150, -35, 0], c: [0, 30, 0]}",
     "tape_cylinder_ur10e": "{a: [-150, 0, 0], b: [150, 0, 0], c: [0, 60, -6]}",
 }
+
+
+def import_fanuc(robots_dir: Path) -> None:
+    """The FANUC M-20iA imported from SHARED_FANUC into ``robots_dir`` (~15 s)."""
+    from offline_prog.robot_import.run import import_robot
+
+    import_robot(
+        SHARED_FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
+        name="fanuc_m20ia",
+        out=robots_dir,
+        package_paths=[SHARED_FANUC],
+        vendor="fanuc",
+        samples=100,
+    )
 
 
 def calibration_cell(folder: Path, name: str, *, model: str = "", robots_dir: str = "") -> Path:

@@ -5,14 +5,15 @@ reported standard deviations cover the true errors (a seeded property test over 
 draws); degenerate touches are refused in one line saying what to add."""
 
 import types
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 from synthetic_touches import (
+    SHARED_FANUC,
     TrueCell,
     calibration_cell,
+    import_fanuc,
     nominal_truth,
     start_pose,
     synthetic_touches,
@@ -26,15 +27,6 @@ from offline_prog.errors import InputError
 
 TIP_MM, AXIS_DEG, GRASP_MM, GRASP_DEG, POINTER_MM = 0.1, 0.1, 0.1, 0.05, 0.1
 DEMOS = ["seal_plate_kr16", "weld_seam_irb2400", "tape_cylinder_ur10e"]
-FANUC = Path("/work/shared/robots/ros-industrial-fanuc")
-SHARED_FANUC = next(
-    (
-        p
-        for p in (Path(__file__).resolve().parents[3] / "shared/robots/ros-industrial-fanuc", FANUC)
-        if p.is_dir()
-    ),
-    None,
-)
 
 
 @pytest.fixture(scope="module")
@@ -85,17 +77,8 @@ def fanuc_cell(tmp_path_factory):
     """The seal demo on a FANUC M-20iA imported from the ROS-I package (README)."""
     if SHARED_FANUC is None:
         pytest.skip("../shared/robots/ros-industrial-fanuc is absent")
-    from offline_prog.robot_import.run import import_robot
-
     folder = tmp_path_factory.mktemp("fanuc")
-    import_robot(
-        SHARED_FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
-        name="fanuc_m20ia",
-        out=folder / "robots",
-        package_paths=[SHARED_FANUC],
-        vendor="fanuc",
-        samples=100,
-    )
+    import_fanuc(folder / "robots")
     cell = calibration_cell(folder, "seal_plate_kr16", model="fanuc_m20ia", robots_dir="robots")
     return start_pose(cell)
 
