@@ -29,7 +29,7 @@ from offline_prog.calibration.controller_abb import (
     stationary_tool,
 )
 from offline_prog.calibration.controller_kuka import read_config_dat
-from offline_prog.calibration.limits import MAX_TOUCHES_BYTES
+from offline_prog.calibration.limits import MAX_CONTROLLER_FILE_BYTES
 from offline_prog.config.safe_yaml import read_text
 from offline_prog.errors import InputError
 from offline_prog.export.kuka.kuka import X_KE
@@ -64,7 +64,7 @@ def from_controller(file: Path, inputs) -> FromController:
             f"the robot's controller ({robot.language or 'none'}) has no frame file this "
             "command reads (KUKA $config.dat, ABB RAPID)",
         )
-    text = read_text(Path(file), what="controller file", max_bytes=MAX_TOUCHES_BYTES)
+    text = read_text(Path(file), what="controller file", max_bytes=MAX_CONTROLLER_FILE_BYTES)
     X_IB = inputs.X_IB.GetAsMatrix4()
     X_IT, X_PE = inputs.X_IT.GetAsMatrix4(), inputs.X_PE.GetAsMatrix4()
     if robot.language == "krl":

@@ -5,6 +5,8 @@ import numpy as np
 # The touches file: a few kB; larger is not a touches file.
 MAX_TOUCHES_BYTES = 1_000_000
 MAX_TOUCHES = 10_000
+# A controller file: a $config.dat is ~100 kB, a RAPID module with its robtargets a few MB.
+MAX_CONTROLLER_FILE_BYTES = 5_000_000
 # Angles all within ±this look like radians: a technician's touches turn some joint
 # farther than 6.3° (the pivot needs the flange tilted by tens of degrees).
 RADIANS_LIKE_DEG = 2.0 * np.pi + 0.01
