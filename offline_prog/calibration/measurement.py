@@ -56,6 +56,13 @@ def flange_poses(robot: RobotModel, X_IB: np.ndarray, q: np.ndarray) -> np.ndarr
     return X_IB @ X_BE
 
 
+def axis_derivative(R_IT: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """(3, 2) dz_T/da: how the tilted axis unit(z0 + a1 x0 + a2 y0) moves with (a1, a2)."""
+    w = R_IT[:, 2] + R_IT[:, :2] @ a
+    z = w / np.linalg.norm(w)
+    return (np.eye(3) - np.outer(z, z)) / np.linalg.norm(w) @ R_IT[:, :2]
+
+
 @dataclasses.dataclass(frozen=True)
 class Nominal:
     """The cell's values: the start of the estimate and what an unknown not estimated
@@ -239,9 +246,7 @@ class Problem:
         if "pointer" in at:
             J[pointer, :, at["pointer"]] = R_IE[pointer]
         if "axis" in at:
-            w = n.R_IT[:, 2] + n.R_IT[:, :2] @ x[at["axis"]]
-            z = w / np.linalg.norm(w)
-            dz = (np.eye(3) - np.outer(z, z)) / np.linalg.norm(w) @ n.R_IT[:, :2]
+            dz = axis_derivative(n.R_IT, x[at["axis"]])
             J[self.kinds == AXIS, :, at["axis"]] = -n.axis_mm * dz
         if "grasp_translation" in at:
             part = ~pointer

@@ -17,6 +17,7 @@ replaced.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from pathlib import Path
@@ -24,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.calibration.measurement import axis_rotation
+from offline_prog.calibration.measurement import axis_derivative
 from offline_prog.config.cell import load_cell, transform
 from offline_prog.config.cell_text import relocated_text
 from offline_prog.config.checks import check_cell
@@ -85,12 +86,7 @@ def estimates(inputs, calibration) -> dict:
             "from_pointer_mm": None if given is None else float(np.linalg.norm(v.pointer - given)),
         }
     if "axis" in at:
-        a = e.x[at["axis"]]
-        step = 1e-7  # dz/da by differences: the tilt's covariance as the axis' angle
-        dz = np.stack(
-            [(axis_rotation(n.R_IT, a + step * d)[:, 2] - v.R_IT[:, 2]) / step for d in np.eye(2)],
-            axis=1,
-        )
+        dz = axis_derivative(n.R_IT, e.x[at["axis"]])  # the tilt's covariance as the axis'
         C_z = dz @ e.block_covariance("axis") @ dz.T
         out["tool_axis"] = {
             "z_T": _list(v.R_IT[:, 2], 9),
@@ -124,7 +120,7 @@ def calibration_json(inputs, calibration, files: dict, source: dict) -> dict:
             "max_mm": worst.max_mm,
             "seam": worst.seam,
             "sigma_mm": worst.sigma_mm,
-            "seams": [s.__dict__ for s in shifts],
+            "seams": [dataclasses.asdict(s) for s in shifts],
         },
     }
     if calibration.controller is not None:
