@@ -103,6 +103,7 @@ def parser() -> argparse.ArgumentParser:
     )
     _session_flags(commands)
     _place_flags(commands)
+    _calibrate_flags(commands)
     _seams_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
@@ -236,6 +237,38 @@ def _place_flags(commands) -> None:
         "--scheduler",
         default=None,
         help="an existing Dask cluster's scheduler, e.g. tcp://host:8786",
+    )
+
+
+def _calibrate_flags(commands) -> None:
+    """``calibrate CELL (--touches FILE [--controller-angles] | --from-controller FILE)
+    --out calibrated.yaml``."""
+    calibrate = commands.add_parser(
+        "calibrate",
+        help="the fixed tool's TCP and the grasp from touches, or from the controller's frames",
+    )
+    calibrate.add_argument("cell", type=Path, help="work-cell YAML file")
+    source = calibrate.add_mutually_exclusive_group(required=True)
+    source.add_argument(
+        "--touches",
+        type=Path,
+        help="CSV target,q1_deg..q6_deg: touches of the tool's tip, its axis, part points",
+    )
+    source.add_argument(
+        "--from-controller",
+        type=Path,
+        help="the controller's calibrated frames: KUKA $config.dat or an ABB RAPID module",
+    )
+    calibrate.add_argument(
+        "--controller-angles",
+        action="store_true",
+        help="the touches' angles as the controller shows them (e.g. ABB/FANUC axis 3)",
+    )
+    calibrate.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="the calibrated cell file (calibration.json is written beside it)",
     )
 
 

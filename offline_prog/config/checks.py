@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cad_keys import check_cad, check_part_model
+from offline_prog.config.calibration_keys import check_calibration, check_controller_frames
 from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.config.job_checks import check_job
 from offline_prog.config.process_keys import check_process
@@ -129,6 +130,8 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
     _check_payload(file, cell)
     _check_shapes(file, cell)
+    check_calibration(file, cell.calibration)
+    check_controller_frames(file, cell, None)  # the robot's own ranges: stages.load_inputs
 
 
 def seam_keys(cell: Cell) -> list[tuple[str, PathConfig]]:
