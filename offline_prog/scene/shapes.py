@@ -23,6 +23,7 @@ from pydrake.math import RigidTransform
 from offline_prog.config.cell import Cell, transform
 from offline_prog.config.safe_yaml import short_repr
 from offline_prog.constants import MAX_MESH_EXTENT_M
+from offline_prog.errors import TravellingError
 from offline_prog.scene.mesh_cache import as_obj, convex_pieces
 
 if TYPE_CHECKING:  # trimesh costs ~0.5 s to import; loaded where a mesh is used
@@ -32,7 +33,7 @@ KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
 MESH_SCALES = {"m": 1.0, "mm": 1e-3}
 
 
-class ShapeError(ValueError):
+class ShapeError(TravellingError, ValueError):
     """A bad shape entry; str() is one line ``key: reason`` (``key`` like ``obstacles[2]``)."""
 
     def __init__(self, key: str, reason: str):

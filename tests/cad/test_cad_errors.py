@@ -1,6 +1,7 @@
 """Bad CAD input ends with one line naming the file, the key and the reason (exit 2);
 a cell without CAD keys never imports Open CASCADE."""
 
+import shutil
 import subprocess
 import sys
 
@@ -96,6 +97,25 @@ def test_the_command_line_says_it_in_one_line(plate, capsys, tmp_path):
     lines = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(lines) == 1
     assert "seams[0].cad.loop.face_near_mm" in lines[0] and "ambiguous" in lines[0]
+
+
+@pytest.mark.slow
+def test_a_bad_point_in_the_second_process_is_one_line_too(tmp_path, capsys):
+    """The demo's second seam, its chain point between two edges: planned on the forked
+    second process (two cores), the same exit 2 and line as on one (was exit 3)."""
+    text = (CELLS / "cad_seal_kr16.yaml").read_text(encoding="utf-8")
+    point = "[-191.21, -141.21, 3], [191.21, -141.21, 3]"
+    assert point in text
+    (tmp_path / "cell.yaml").write_text(
+        text.replace(point, "[0, -148.5, 1.5], [191.21, -141.21, 3]"), encoding="utf-8"
+    )
+    (tmp_path / "data").mkdir()
+    shutil.copy(CELLS / "data" / "seal_plate.step", tmp_path / "data")
+    code = main(["plan", str(tmp_path / "cell.yaml"), "--out", str(tmp_path / "out")])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1, lines
+    assert "seams[1].cad.chain.near_mm[0]" in lines[0] and "is ambiguous" in lines[0]
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_cell_without_cad_keys_does_not_import_open_cascade():
