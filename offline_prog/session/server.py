@@ -199,6 +199,8 @@ class Session:
         progress = self._progress(generation, supersede=kind == "plan")
         if kind == "plan":
             return self.replanner.plan(state, progress)
+        if kind == "export" and self._unchanged(state):  # the file as it is: no copy
+            return self.file, *outputs.export(self.file, self.out_root / self.file.stem, progress)
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
             planner = self.replanner
@@ -208,6 +210,14 @@ class Session:
             return saved
         out = self.out_root / saved.stem
         return saved, *outputs.export(saved, out, progress)
+
+    def _unchanged(self, state) -> bool:
+        """Whether ``state`` makes the cell of the file as it is on disk (the values as
+        loaded, whichever seam is active, and the file not edited since)."""
+        planner = self.replanner
+        if dataclasses.replace(state, seam=planner.initial.seam) != planner.initial:
+            return False
+        return cell_text.loads_to(self.file, planner.cell(state))
 
     # --- the main thread: MeshCat -------------------------------------------------------
 
@@ -260,9 +270,11 @@ class Session:
                 self.message = ("info", f"saved {answer}")
             return
         if kind == "export":
-            saved, folder, line = answer
+            cell_file, folder, line = answer
             with self.lock:
-                self.last_saved, self.last_exported = saved, folder
+                if cell_file != self.file:  # the edited values, saved for the folder
+                    self.last_saved = cell_file
+                self.last_exported = folder
                 self.message = ("info", line)
             return
         with self.lock:
