@@ -276,13 +276,17 @@ def _import_flags(robot_commands) -> None:
 
 
 def _seams_flags(commands) -> None:
-    """``seams PART.step|PART.stl [--out seams.html] [--mesh-units m|mm]``."""
+    """``seams PART.step|PART.stl [--out PAGE.html] [--mesh-units m|mm]``."""
     seams = commands.add_parser(
         "seams", help="list a part model's faces, loops and edge chains; write a 3D page"
     )
     seams.add_argument("part", type=Path, help="STEP (.step, .stp) or mesh (.stl, .obj, .ply)")
     seams.add_argument(
-        "--out", type=Path, default=None, help="the page (default: <part>_seams.html beside it)"
+        "--out",
+        type=Path,
+        default=None,
+        help="the page, a .html file (default: out/<part stem>_seams.html); a file this "
+        "command did not write is not replaced",
     )
     seams.add_argument(
         "--mesh-units", choices=("m", "mm"), default="m", help="a mesh file's unit (default m)"

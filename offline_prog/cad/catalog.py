@@ -166,12 +166,13 @@ def g1_chains(model) -> list[list[tuple[int, bool]]]:
     return chains
 
 
-def mesh_catalog(file: Path, mm_per_unit: float) -> Catalog:
-    """The regions ("faces"), their outer loops and the feature-edge runs of a mesh."""
+def mesh_catalog(file: Path, mm_per_unit: float, *, set_units: str) -> Catalog:
+    """The regions ("faces"), their outer loops and the feature-edge runs of a mesh
+    (``set_units``: how the user gives the file's unit, see ``mesh_model.read_mesh``)."""
     from offline_prog.cad.mesh_model import read_mesh
     from offline_prog.cad.mesh_seams import region_loops
 
-    model = read_mesh(file, mm_per_unit)
+    model = read_mesh(file, mm_per_unit, set_units=set_units)
     mesh = model.mesh
     v = mesh.vertices
     entries = []
