@@ -62,7 +62,7 @@ def step_catalog(file: Path) -> Catalog:
     """The faces, loops and G1 chains of a STEP model (read exactly)."""
     from offline_prog.cad.step_geometry import sample_edge, tessellate
     from offline_prog.cad.step_model import read_step
-    from offline_prog.cad.step_seams import face_label, outer_loop, sample_run
+    from offline_prog.cad.step_seams import around_itself, face_label, outer_loop, sample_run
 
     model = read_step(file)
     vertices, triangles, face_of = tessellate(model.shape, faces=model.faces)
@@ -87,7 +87,7 @@ def step_catalog(file: Path) -> Catalog:
             )
         )
         run = outer_loop(model, k)
-        if run:
+        if run and not around_itself(run):  # a cylinder's side has no one contour
             loop = sample_run(model, run, k, closed=True, offset_mm=0.0)
             entries.append(
                 Entry(
