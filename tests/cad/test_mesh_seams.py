@@ -4,13 +4,17 @@ model, within the tessellation's chord error the mesh seam reports."""
 import numpy as np
 import pytest
 import trimesh
-from cad_parts import cad_cell, filleted_plate, l_bracket, write_step, write_stl
-from test_step_seams import (
+from cad_parts import (
     PLATE,
     angle_deg,
     bracket_profile,
+    cad_cell,
+    filleted_plate,
+    l_bracket,
     rounded_rectangle,
     sampled,
+    write_step,
+    write_stl,
 )
 
 from offline_prog.errors import InputError
