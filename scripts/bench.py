@@ -42,7 +42,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))
 
-CELLS = Path(__file__).resolve().parents[1] / "cells"
+from bench_table import CELLS, add_table_flags, chosen_cells, table  # noqa: E402
 
 
 def best_of(repeats: int, function):
@@ -294,34 +294,13 @@ def main() -> None:
         choices=PARTS + OWN_SCRIPTS,
         help=f"run these parts (default: {' '.join(PARTS)})",
     )
-    parser.add_argument("--runs", type=int, default=3, help="runs of each figure (3)")
-    parser.add_argument("--big-runs", type=int, default=1, help="runs of the big job (1)")
-    parser.add_argument("--big-seams", type=int, default=30, help="seams of the big job (30)")
-    parser.add_argument(
-        "--candidates", type=int, default=5, help="placement candidates of the table (5)"
-    )
-    parser.add_argument(
-        "--cells", nargs="+", metavar="STEM", help="demo cells by file stem (default: all)"
-    )
+    add_table_flags(parser)  # --runs, --big-runs, --big-seams, --candidates, --cells
     args = parser.parse_args()
-    cells = sorted(CELLS.glob("*.yaml"))
-    if args.cells:
-        cells = [CELLS / f"{stem}.yaml" for stem in args.cells]
-        missing = [str(c) for c in cells if not c.is_file()]
-        if missing:
-            parser.error(f"no such cell: {', '.join(missing)}")
+    cells = chosen_cells(parser, args)
     one_seam = [c.stem for c in cells if "\nseams:" not in c.read_text(encoding="utf-8")]
     for part in args.only or PARTS:
         if part == "table":
-            from bench_table import bench_table
-
-            bench_table(
-                args.runs,
-                args.big_runs,
-                big_seams=args.big_seams,
-                candidates=args.candidates,
-                cells=cells,
-            )
+            table(args, cells)
         elif part == "command":
             bench_command(cells[0] if args.cells else CELLS / "seal_plate_kr16.yaml", args.runs)
         elif part == "stages":

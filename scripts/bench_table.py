@@ -186,8 +186,8 @@ def bench_table(
     print(f"  import floor, median of all: {statistics.median(r[2] for r in rows):.2f} s")
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_table_flags(parser: argparse.ArgumentParser) -> None:
+    """The table's sizes and cells (this script's flags; bench.py's too)."""
     parser.add_argument("--runs", type=int, default=3, help="runs of each figure (3)")
     parser.add_argument("--big-runs", type=int, default=1, help="runs of the big job (1)")
     parser.add_argument("--big-seams", type=int, default=30, help="seams of the big job (30)")
@@ -195,17 +195,33 @@ def main() -> None:
         "--candidates", type=int, default=CANDIDATES, help="seeded placement candidates (5)"
     )
     parser.add_argument(
-        "--cells", nargs="+", metavar="STEM", help="session cells by file stem (default: all)"
+        "--cells", nargs="+", metavar="STEM", help="demo cells by file stem (default: all)"
     )
-    args = parser.parse_args()
-    cells = [CELLS / f"{stem}.yaml" for stem in args.cells] if args.cells else None
+
+
+def chosen_cells(parser: argparse.ArgumentParser, args) -> list[Path]:
+    """The demo cells ``--cells`` names (default: every cell in cells/)."""
+    if not args.cells:
+        return sorted(CELLS.glob("*.yaml"))
+    cells = [CELLS / f"{stem}.yaml" for stem in args.cells]
+    missing = [str(c) for c in cells if not c.is_file()]
+    if missing:
+        parser.error(f"no such cell: {', '.join(missing)}")
+    return cells
+
+
+def table(args, cells: list[Path]) -> None:
+    """:func:`bench_table` with the flags of :func:`add_table_flags`."""
     bench_table(
-        args.runs,
-        args.big_runs,
-        big_seams=args.big_seams,
-        candidates=args.candidates,
-        cells=cells,
+        args.runs, args.big_runs, big_seams=args.big_seams, candidates=args.candidates, cells=cells
     )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_table_flags(parser)
+    args = parser.parse_args()
+    table(args, chosen_cells(parser, args))
 
 
 if __name__ == "__main__":
