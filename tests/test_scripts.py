@@ -146,7 +146,7 @@ def run_script(name: str, args: list[str], cwd: Path) -> subprocess.CompletedPro
         env=_env(),
         capture_output=True,
         text=True,
-        timeout=1800,
+        timeout=3600,
     )
     assert done.returncode == 0, (name, done.stdout[-1500:], done.stderr[-3000:])
     return done
