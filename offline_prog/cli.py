@@ -99,7 +99,8 @@ def _run_export(args, console: Console) -> None:
 
 
 def _serve_preview(plan, args, console: Console) -> None:
-    """Show the plan in a MeshCat server on --host (localhost) until Ctrl-C (or --seconds)."""
+    """Show the plan in a MeshCat server on --host (localhost) until Ctrl-C (or --seconds;
+    Ctrl-C ends the command with 130, as it does every other command)."""
     from offline_prog.job.records import JobPlan
     from offline_prog.viz.job_preview import show_job
     from offline_prog.viz.local_server import open_meshcat, url
@@ -115,12 +116,9 @@ def _serve_preview(plan, args, console: Console) -> None:
         f"({info['frames']} animation frames; Ctrl-C to stop)"
     )
     seconds = getattr(args, "seconds", None)
-    try:
-        deadline = None if seconds is None else time.monotonic() + seconds
-        while deadline is None or time.monotonic() < deadline:
-            time.sleep(0.2)
-    except KeyboardInterrupt:
-        pass
+    deadline = None if seconds is None else time.monotonic() + seconds
+    while deadline is None or time.monotonic() < deadline:  # Ctrl-C: exit 130, as elsewhere
+        time.sleep(0.2)
 
 
 def _run_place(args, console: Console, errors: Console) -> str:

@@ -11,6 +11,7 @@ import argparse
 import math
 from pathlib import Path
 
+from offline_prog import __version__
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
 from offline_prog.viz.local_server import MAX_PORT, MIN_PORT
 
@@ -76,6 +77,7 @@ def parser() -> argparse.ArgumentParser:
         description="Plan robot motions that carry a part past a spatially fixed tool.",
     )
     parser.set_defaults(debug=False)
+    parser.add_argument("--version", action="version", version=f"offline-prog {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     plan = commands.add_parser("plan", help="plan a cell and write the outputs")
     plan.add_argument("cell", type=Path, help="work-cell YAML file")
@@ -105,7 +107,9 @@ def parser() -> argparse.ArgumentParser:
     _place_flags(commands)
     _calibrate_flags(commands)
     _seams_flags(commands)
-    robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
+    robots = commands.add_parser(
+        "robots", help="robot descriptions: list, import (URDF or xacro), self-collision matrix"
+    )
     robot_commands = robots.add_subparsers(
         dest="robots_command", required=True, parser_class=_Parser
     )
@@ -322,13 +326,17 @@ def _import_flags(robot_commands) -> None:
 
 
 def _seams_flags(commands) -> None:
-    """``seams PART.step|PART.stl [--out seams.html] [--mesh-units m|mm]``."""
+    """``seams PART.step|PART.stl [--out PAGE.html] [--mesh-units m|mm]``."""
     seams = commands.add_parser(
         "seams", help="list a part model's faces, loops and edge chains; write a 3D page"
     )
     seams.add_argument("part", type=Path, help="STEP (.step, .stp) or mesh (.stl, .obj, .ply)")
     seams.add_argument(
-        "--out", type=Path, default=None, help="the page (default: <part>_seams.html beside it)"
+        "--out",
+        type=Path,
+        default=None,
+        help="the page, a .html file (default: out/<part stem>_seams.html); a file this "
+        "command did not write is not replaced",
     )
     seams.add_argument(
         "--mesh-units", choices=("m", "mm"), default="m", help="a mesh file's unit (default m)"

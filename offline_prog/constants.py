@@ -51,8 +51,9 @@ MAX_PLACE_BUDGET = 100_000
 # place.seed / --seed: the search seeds CMA-ES with seed + 1 + its restarts (at most one
 # per evaluation), and numpy takes seeds below 2³²: this bound leaves room for them.
 MAX_PLACE_SEED = 2**31 - 1
-# A cell's mesh larger than this across is a unit slip (a mm file read as m: 1000×).
-MAX_MESH_EXTENT_M = 20.0
+# A work cell is smaller than this across: a mesh larger, or a pose farther from its
+# frame's origin, is a unit slip (mm read as m: 1000×; config.unit_slips).
+MAX_CELL_EXTENT_M = 20.0
 
 
 class TimeLaw(enum.StrEnum):

@@ -9,6 +9,11 @@
   :class:`PlanFailedError` carries one out of a stage that cannot go on.
 
 The CLI maps both to exit codes in one place (``cli.EXIT_CODES``).
+
+Every error class of the package whose ``__init__`` takes other arguments than its
+message derives from :class:`TravellingError`: it pickles as its class, its ``args``
+and its fields, not through ``__init__``, so it reaches the parent of a forked process
+(``offline_prog.forked``) as it was raised there.
 """
 
 from __future__ import annotations
@@ -18,7 +23,25 @@ import enum
 from pathlib import Path
 
 
-class InputError(ValueError):
+def _rebuilt(cls: type, args: tuple, fields: dict) -> BaseException:
+    """The error ``cls`` with ``args`` and ``fields``, made without its ``__init__``."""
+    error = cls.__new__(cls, *args)
+    error.args = args
+    error.__dict__.update(fields)
+    return error
+
+
+class TravellingError:
+    """A mixin for exceptions: pickled as class, ``args`` and fields (``__dict__``),
+    whatever its ``__init__`` takes (``BaseException``'s own pickling calls
+    ``cls(*args)``, which fails or loses the fields when ``__init__`` builds the
+    message from other arguments)."""
+
+    def __reduce__(self):
+        return _rebuilt, (type(self), self.args, dict(self.__dict__))
+
+
+class InputError(TravellingError, ValueError):
     """Bad input; str() is one line: ``file: key: reason`` (key may be empty)."""
 
     def __init__(self, file: Path | str, key: str, reason: str):
@@ -51,7 +74,7 @@ class PlanFailure:
         )
 
 
-class PlanFailedError(Exception):
+class PlanFailedError(TravellingError, Exception):
     """A stage found a :class:`PlanFailure` it cannot go on from (no plan to write)."""
 
     def __init__(self, failure: PlanFailure):

@@ -6,9 +6,11 @@ a slow item does not hold up the rest. The child sends each outcome back pickled
 the objects both processes already hold (``shared``: the cell's inputs, the Drake
 scene, and everything reachable from them at the fork) sent as references, not copies.
 So the caller gets the same objects, and nothing the child cannot pickle (a Drake
-context) has to travel. An outcome the child cannot send is computed here again. Each
-outcome is the value or the exception the item raised (:class:`Outcome`), so the
-caller raises them in the items' order, as a serial loop would have.
+context) has to travel. An outcome the child cannot send, or this process cannot read
+back, is computed here again (the package's own errors travel:
+``errors.TravellingError``). Each outcome is the value or the exception the item
+raised (:class:`Outcome`), so the caller raises them in the items' order, as a serial
+loop would have.
 
 Where fork is not available, or only one core is, the items run here, one after the
 other.
@@ -178,7 +180,10 @@ def forked_map(
     for message in received:
         i = int.from_bytes(message[:4], "little")
         if len(message) > 4:
-            outcomes[i] = _Unpickler(io.BytesIO(message[4:]), objects).load()
+            try:
+                outcomes[i] = _Unpickler(io.BytesIO(message[4:]), objects).load()
+            except Exception:  # a class that pickles but does not unpickle: computed here
+                outcomes[i] = None
     return [
         outcome if outcome is not None else _run(function, items[i])
         for i, outcome in enumerate(outcomes)

@@ -1,11 +1,15 @@
 """Benchmark: plan the demo cells stage by stage, and compare path IK with references.
 
 Run: ``python scripts/bench.py [--samples 5000] [--drake-samples 300]
-[--only table|command|collision|timing|session|place|candidate] [--runs 3]
-[--big-runs 1]``; ``--only table`` prints issue 25's table (scripts/bench_table.py: each
-figure with the import floor of the same run), which a full run prints first; ``--only
-place`` runs scripts/bench_place.py (the placement search, ~10 minutes), ``--only
-candidate`` scripts/bench_candidate.py (where a placement candidate's time goes)
+[--only PART ...] [--runs 3] [--big-runs 1] [--big-seams 30] [--candidates 5]
+[--cells STEM ...]``. The parts, in a full run's order: ``table`` (issue 25's table,
+scripts/bench_table.py: each figure with the import floor of the same run),
+``command``, ``stages``, ``collision``, ``session``, ``ik`` (path IK), ``timing``
+(scripts/bench_timing.py); ``--only place`` runs scripts/bench_place.py (the placement
+search, ~10 minutes), ``--only candidate`` scripts/bench_candidate.py (where a
+placement candidate's time goes). ``--cells`` picks demo cells by file stem (default:
+every cell in cells/); every cell is planned as a job (a ``path:`` cell is a one-seam
+job), the path IK on its first seam.
 
 All figures come from the same process on the same machine, so the ratios
 hold even where the absolute numbers drift. Path IK is compared on one flange
@@ -31,25 +35,14 @@ import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.math import RigidTransform, RotationMatrix
 
-# This checkout's package, not an installed one (the subprocess figures run it too).
+# This checkout's package, not an installed one (the subprocess figures run it too); the
+# other scripts (bench_table, bench_timing) and their support (py_opw_reference).
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))
 
-from offline_prog.collision.check import check_trajectory  # noqa: E402
-from offline_prog.config.cell import transform  # noqa: E402
-from offline_prog.joints.drake_ik import solve_path, solve_pose  # noqa: E402
-from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch  # noqa: E402
-from offline_prog.plan import plan_cell, plan_job  # noqa: E402
-from offline_prog.scene.drake_cell import build_cell_model, build_drake_cell  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # py_opw_reference
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_timing
-
-from bench_table import bench_table  # noqa: E402
-from bench_timing import bench_timing  # noqa: E402
-
-CELLS = Path(__file__).resolve().parents[1] / "cells"
+from bench_table import CELLS, add_table_flags, chosen_cells, table  # noqa: E402
 
 
 def best_of(repeats: int, function):
@@ -73,14 +66,14 @@ def pose_errors(X_target: np.ndarray, X_got: np.ndarray) -> tuple[float, float]:
     return float(np.nanmax(distance)), float(angle.max())
 
 
-def bench_stages(cells: list[Path]) -> None:
-    print("== planning the demo cells (stage times, best of 3) ==")
+def bench_stages(cells: list[Path], runs: int = 3) -> None:
+    from offline_prog.plan import plan_job
+
+    print(f"== planning the demo cells (stage times, best of {runs}) ==")
     for file in cells:
-        total, plan = best_of(3, lambda file=file: plan_cell(file))
-        stages = ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in plan.timings_s.items())
-        print(
-            f"{file.stem:24s} {len(plan.trajectory.t):6d} samples  total {total:.3f} s  ({stages})"
-        )
+        total, job = best_of(runs, lambda file=file: plan_job(file))
+        stages = ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in job.timings_s.items())
+        print(f"{file.stem:24s} {len(job.samples.t):6d} samples  total {total:.3f} s  ({stages})")
 
 
 def bench_command(cell: Path, runs: int = 5) -> None:
@@ -90,6 +83,8 @@ def bench_command(cell: Path, runs: int = 5) -> None:
     import statistics
     import subprocess
     import tempfile
+
+    from offline_prog.plan import plan_job
 
     print(f"== whole command: offline-prog plan {cell.name} (median of {runs}) ==")
     walls = []
@@ -135,32 +130,38 @@ def _output_times(job, out: Path) -> dict[str, float]:
     return {"every output": time.perf_counter() - start}
 
 
-def bench_collision(cells: list[Path]) -> None:
-    """Collision checking of each demo plan with the vendor meshes (what plans use) and
-    with the primitive stand-ins (<robot>_primitives.urdf), same path, same process."""
+def bench_collision(cells: list[Path], runs: int = 3) -> None:
+    """Collision checking of each demo job with the vendor meshes (what plans use) and
+    with the primitive stand-ins (<robot>_primitives.urdf), same motion, same process:
+    the whole job's check (every sample of home, links, seams), as ``plan`` runs it."""
     import dataclasses
 
-    print("\n== collision check along the planned path (full cell geometry) ==")
+    from offline_prog.collision.check import check_trajectory
+    from offline_prog.plan import plan_job
+    from offline_prog.scene.drake_cell import build_cell_model
+
+    print("\n== collision check along the planned job (full cell geometry) ==")
     for file in cells:
-        plan = plan_cell(file)
-        traj, q, motion = plan.trajectory, plan.joints.q, plan.cell.motion
+        job = plan_job(file)
+        samples, motion = job.samples, job.cell.motion
+        q = samples.q
         rates = {}
-        stand_in = plan.robot.urdf_path.with_name(f"{plan.robot.name}_primitives.urdf")
+        stand_in = job.robot.urdf_path.with_name(f"{job.robot.name}_primitives.urdf")
         for model, robot in (
-            ("meshes", plan.robot),
-            ("stand-ins", dataclasses.replace(plan.robot, urdf_path=stand_in)),
+            ("meshes", job.robot),
+            ("stand-ins", dataclasses.replace(job.robot, urdf_path=stand_in)),
         ):
-            drake = build_cell_model(plan.cell, file, robot)
+            drake = build_cell_model(job.cell, file, robot)
             check = functools.partial(
                 check_trajectory,
                 drake,
                 q,
-                traj.t,
-                traj.s,
+                samples.t,
+                np.nan_to_num(samples.path_m),
                 clearance=motion.clearance,
                 self_clearance=motion.self_clearance,
             )
-            seconds, result = best_of(3, check)
+            seconds, result = best_of(runs, check)
             rates[model] = len(q) / seconds
             print(
                 f"{file.stem:24s} {model:9s} {len(q):6d} samples  {seconds * 1e3:7.1f} ms  "
@@ -181,7 +182,16 @@ def py_opw_robot(robot):
 
 
 def bench_path_ik(file: Path, n_samples: int, n_drake: int) -> None:
-    plan = plan_cell(file)
+    """Path IK on the cell's first seam (its plan in the job)."""
+    from pydrake.math import RigidTransform, RotationMatrix
+
+    from offline_prog.config.cell import transform
+    from offline_prog.joints.drake_ik import solve_path, solve_pose
+    from offline_prog.joints.path_ik import base_poses, branch_results, choose_branch
+    from offline_prog.plan import plan_job
+    from offline_prog.scene.drake_cell import build_drake_cell
+
+    plan = plan_job(file).seams[0]
     robot, cell = plan.robot, plan.cell
     X_IB = transform(cell.robot.X_IB)
     f = plan.flange(np.linspace(0.0, plan.flange.length, n_samples))
@@ -269,53 +279,48 @@ def bench_session(cells: list[Path], repeats: int = 3) -> None:
         print(line)
 
 
+# The parts of a full run, in order (place and candidate only when asked: minutes).
+PARTS = ("table", "command", "stages", "collision", "session", "ik", "timing")
+OWN_SCRIPTS = ("place", "candidate")  # scripts/bench_place.py, scripts/bench_candidate.py
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--samples", type=int, default=5000)
-    parser.add_argument("--drake-samples", type=int, default=300)
+    parser.add_argument("--samples", type=int, default=5000, help="path IK poses (5000)")
+    parser.add_argument("--drake-samples", type=int, default=300, help="Drake IK poses (300)")
     parser.add_argument(
         "--only",
-        choices=["table", "command", "collision", "timing", "session", "place", "candidate"],
-        help="run one part of the benchmark",
+        nargs="+",
+        choices=PARTS + OWN_SCRIPTS,
+        help=f"run these parts (default: {' '.join(PARTS)})",
     )
-    parser.add_argument("--runs", type=int, default=3, help="runs of each table figure")
-    parser.add_argument("--big-runs", type=int, default=1, help="runs of the 30-seam job")
+    add_table_flags(parser)  # --runs, --big-runs, --big-seams, --candidates, --cells
     args = parser.parse_args()
-    cells = sorted(CELLS.glob("*.yaml"))
-    if args.only in (None, "table"):
-        bench_table(args.runs, args.big_runs)
-        if args.only == "table":
-            return
-    if args.only == "session":
-        bench_session(cells)
-        return
-    if args.only == "collision":
-        bench_collision(cells)
-        return
-    if args.only == "timing":
-        bench_timing()
-        return
-    if args.only == "place":  # ~10 minutes: its own script (scripts/bench_place.py)
-        import bench_place
+    cells = chosen_cells(parser, args)
+    one_seam = [c.stem for c in cells if "\nseams:" not in c.read_text(encoding="utf-8")]
+    for part in args.only or PARTS:
+        if part == "table":
+            table(args, cells)
+        elif part == "command":
+            bench_command(cells[0] if args.cells else CELLS / "seal_plate_kr16.yaml", args.runs)
+        elif part == "stages":
+            bench_stages(cells, args.runs)
+        elif part == "collision":
+            bench_collision(cells, args.runs)
+        elif part == "session":
+            bench_session(cells, args.runs)
+        elif part == "ik":
+            for file in cells:
+                bench_path_ik(file, args.samples, args.drake_samples)
+        elif part == "timing":
+            from bench_timing import bench_timing
 
-        sys.argv = sys.argv[:1]
-        bench_place.main()
-        return
-    if args.only == "candidate":  # its own script (scripts/bench_candidate.py)
-        import bench_candidate
+            bench_timing(one_seam)
+        else:  # its own script, with its own defaults (place: ~10 minutes)
+            import importlib
 
-        sys.argv = sys.argv[:1]
-        bench_candidate.main()
-        return
-    bench_command(CELLS / "seal_plate_kr16.yaml")
-    if args.only == "command":
-        return
-    bench_stages(cells)
-    bench_collision(cells)
-    bench_session(cells)
-    for file in cells:
-        bench_path_ik(file, args.samples, args.drake_samples)
-    bench_timing()
+            sys.argv = sys.argv[:1]
+            importlib.import_module(f"bench_{part}").main()
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
 """Where a placement candidate's time goes (issue 25's one figure not met).
 
-Run: ``python scripts/bench_candidate.py [--rounds 3]``. In one process: the feasible
-ones of issue 25's seeded candidates of the seal job's placement demo
-(cells/placement/seal_job_far_kr16.yaml, ``bench_table.place_batch``) through
+Run: ``python scripts/bench_candidate.py [--rounds 3] [--candidates 5]``. In one
+process: the feasible ones of issue 25's seeded candidates of the seal job's placement
+demo (cells/placement/seal_job_far_kr16.yaml, ``bench_table.place_batch``) through
 ``place``'s serial engine, after the cell is loaded, as a worker runs them:
 
 1. their CPU time, median over ``--rounds``;
@@ -90,14 +90,20 @@ def shares(engine, candidates) -> list[tuple[str, float]]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=3, help="rounds of the CPU time (3)")
+    parser.add_argument(
+        "--candidates", type=int, default=5, help="seeded candidates, the feasible timed (5)"
+    )
     args = parser.parse_args()
-    payload, batch = place_batch()
+    payload, batch = place_batch(args.candidates)
     engine = SerialEngine(payload)
     try:
         engine.map("screen", batch[:1])  # loads the cell, as a worker has
         _, evaluations = run(engine, batch)
         feasible = [e.candidate for e in evaluations if e.feasible]
+        if not feasible:
+            print(f"== none of the {len(batch)} seeded candidates is feasible: nothing to time ==")
+            return
         base, base_cycle = measured(engine, feasible, args.rounds)
         print(f"== one feasible seal-job candidate ({len(feasible)} of {len(batch)} seeded) ==")
         print(f"  CPU time, median of {args.rounds} rounds × {len(feasible)}: {base:.2f} s")

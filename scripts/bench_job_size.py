@@ -1,7 +1,7 @@
 """Jobs of any size (issue 23): the whole ``offline-prog plan`` command on generated jobs
 of 30 and 100 seams, and the share of it the seam-order search takes.
 
-The jobs: n short seams on the demo plate (tests/job/many_seams.py: stripes and circles
+The jobs: n short seams on the demo plate (scripts/support/many_seams.py: stripes and circles
 on a grid, each allowed to run either way), order auto. Each command is a fresh process
 as a user runs it (stdout piped: no progress display); its wall time includes imports
 and writing the plan folder. The stage times and the order search's counters come from
@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tests" / "job"))  # the job generator lives with the tests
+sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))  # the job generator
 
 from many_seams import many_seam_cell  # noqa: E402
 
@@ -36,7 +36,7 @@ def bench(n: int, folder: Path) -> None:
     if done.returncode not in (0, 1):
         print(f"{n} seams: exit {done.returncode}: {done.stderr.strip()}")
         return
-    report = json.loads((out / "report.json").read_text())
+    report = json.loads((out / "report.json").read_text(encoding="utf-8"))
     job, search = report["job"], report["job"]["order_search"]
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in report["timings_s"].items())
     print(f"== {n} seams ({sum(job['options_per_seam'])} options), exit {done.returncode} ==")
@@ -57,7 +57,9 @@ def bench(n: int, folder: Path) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seams", type=int, nargs="+", default=[30, 100])
+    parser.add_argument(
+        "--seams", type=int, nargs="+", default=[30, 100], help="job sizes (30 100)"
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         for n in args.seams:

@@ -42,10 +42,10 @@ CLEARANCE = 0.005
 
 
 def cluttered_cell(folder: Path) -> Path:
-    text = (REPO / "cells" / "seal_plate_kr16.yaml").read_text()
+    text = (REPO / "cells" / "seal_plate_kr16.yaml").read_text(encoding="utf-8")
     text = text.replace("obstacles:   # in I\n", "obstacles:   # in I\n" + CLUTTER)
     file = folder / "cluttered.yaml"
-    file.write_text(text)
+    file.write_text(text, encoding="utf-8")
     return file
 
 
@@ -61,8 +61,8 @@ def clear_configurations(robot, checker, rng, count: int) -> np.ndarray:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--pairs", type=int, default=100)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--pairs", type=int, default=100, help="start/goal pairs (100)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
     parser.add_argument("--budget", type=float, default=10.0, help="seconds per link")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:

@@ -9,13 +9,16 @@ exactly (Held–Karp) — both by the synchronised-PTP link estimate (job.order)
 exact and heuristic solvers on random instances of 8–14 seams: runtime and the
 heuristic's gap.
 
-    python scripts/bench_order.py
+    python scripts/bench_order.py [--holes 6] [--sizes 8 10 12 14]
 
-Target (issue 13): auto air time within 5 % of brute force.
+``--holes`` takes fewer of the six holes (the job then has that many plus the two
+stripes); ``--sizes`` the random instances' seam counts. Target (issue 13): auto air time
+within 5 % of brute force.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 import tempfile
 import time
@@ -28,23 +31,24 @@ from offline_prog.job.link_costs import LinkCosts
 from offline_prog.job.order import _held_karp, order_job
 from offline_prog.job.order_search import local_search
 from offline_prog.job.stages import seam_options
-from offline_prog.plan import StageTimer, plan_seam
+from offline_prog.plan import SeamPlanner
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import build_scene, load_inputs
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tests" / "job"))  # the brute-force oracle lives with the tests
+sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))  # the brute-force oracle
 
 from order_oracle import brute_force_order  # noqa: E402
 
 HOLES = [(-120, -60), (0, -60), (120, -60), (-120, 40), (0, 40), (120, 40)]
 
 
-def eight_seam_cell(folder: Path) -> Path:
-    text = (REPO / "cells" / "seal_job_kr16.yaml").read_text()
+def eight_seam_cell(folder: Path, holes: int = len(HOLES)) -> Path:
+    """The demo job's cell with ``holes`` of the six holes and the two stripes."""
+    text = (REPO / "cells" / "seal_job_kr16.yaml").read_text(encoding="utf-8")
     head, tail = text[: text.index("\nseams:") + 1], text[text.index("\njob:") + 1 :]
     seams = ["seams:"]
-    for k, (x, y) in enumerate(HOLES):
+    for k, (x, y) in enumerate(HOLES[:holes]):
         seams.append(
             f"  - {{name: hole_{k}, analytic: {{kind: arc, center: [{x}, {y}, 0], radius: 20,"
             f" start_deg: 0, end_deg: 360}}, units: mm, closed: true, normal: [0, 0, 1],"
@@ -56,22 +60,27 @@ def eight_seam_cell(folder: Path) -> Path:
             f"end: [150, {y}, 0]}}, units: mm, normal: [0, 0, 1], direction: auto}}"
         )
     file = folder / "eight_seams.yaml"
-    file.write_text(head + "\n".join(seams) + "\n" + tail)
+    file.write_text(head + "\n".join(seams) + "\n" + tail, encoding="utf-8")
     return file
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--holes", type=int, default=len(HOLES), choices=range(len(HOLES) + 1), help="(6)"
+    )
+    parser.add_argument(
+        "--sizes", type=int, nargs="+", default=[8, 10, 12, 14], help="random instances' seams"
+    )
+    args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
-        inputs = load_inputs(eight_seam_cell(Path(folder)), ROBOTS_DIR)
+        inputs = load_inputs(eight_seam_cell(Path(folder), args.holes), ROBOTS_DIR)
         scene = build_scene(inputs)
         q_home = home_pose(inputs, scene)
         start = time.perf_counter()
-        options = seam_options(
-            inputs,
-            scene,
-            lambda k, r, i, s: plan_seam(i, s, StageTimer(lambda _: None)),
-            lambda _: None,
-        )
+        # The job's own seam planner (one process: the figures are this process's).
+        planner = SeamPlanner(lambda _: None, {}, parallel=False)
+        options = seam_options(inputs, scene, planner, lambda _: None).options
         planning = time.perf_counter() - start
     flat = [(o.seam, o.label, o.q_in, o.q_out) for seam in options for o in seam]
     robot, n = inputs.robot, len(options)
@@ -98,7 +107,7 @@ def main() -> None:
     )
     print("== exact (Held-Karp) vs heuristic on random instances, 2 options per seam ==")
     rng = np.random.default_rng(0)
-    for n in (8, 10, 12, 14):
+    for n in args.sizes:
         options = [
             (k, "", rng.uniform(-2, 2, 6), rng.uniform(-2, 2, 6))
             for k in range(n)

@@ -1,6 +1,7 @@
 """Benchmark: the time-optimal process law (issue 14) on every one-seam demo cell.
 
-Run: ``python scripts/bench_timing.py`` (``python scripts/bench.py --only timing``).
+Run: ``python scripts/bench_timing.py [CELL_STEM ...]`` (default: the one-seam demo
+cells; also ``python scripts/bench.py --only timing``).
 
 For each cell, in one process: the sin² plan and the time-optimal plan of the same
 cell (both intents), and TOPP-RA's own duration without the jerk stage. Prints
@@ -18,9 +19,9 @@ cell (both intents), and TOPP-RA's own duration without the jerk stage. Prints
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import io
-import sys
 import time
 from pathlib import Path
 
@@ -43,7 +44,8 @@ def plan_with(inputs, scene, **motion):
     cell = dataclasses.replace(
         inputs.cell, motion=dataclasses.replace(inputs.cell.motion, **motion)
     )
-    return plan_seam(dataclasses.replace(inputs, cell=cell), scene, StageTimer(lambda s: None))
+    stage = StageTimer(lambda s: None)
+    return plan_seam(dataclasses.replace(inputs, cell=cell), stage, results={"scene": scene})
 
 
 def csv_limit_use(plan) -> tuple[float, float, float]:
@@ -110,7 +112,7 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
     constant_speed, for cycle_time): ``path_timing`` as the plan runs it (TOPP-RA,
     the jerk stage, the averaged profile where it may win) on rates resampled to
     5,000 samples of the plan's path; best of 5."""
-    from offline_prog.joints.path_timing import path_timing
+    from offline_prog.joints.path_timing import PathLimits, time_path
     from offline_prog.timing.time_law import sin2_time_law
 
     robot, motion = plan.robot, plan.cell.motion
@@ -122,7 +124,7 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
     for _ in range(5):
         for process in ("constant_speed", "cycle_time"):
             start = time.perf_counter()
-            timing = path_timing(robot, rates, nominal, "time_optimal", process)
+            timing = time_path(rates, PathLimits.of(robot, nominal), "time_optimal", process)
             elapsed = time.perf_counter() - start
             best[process] = min(best.get(process, np.inf), elapsed)
             assert timing.feasible
@@ -205,4 +207,8 @@ def bench_timing(cells: list[str] = ONE_SEAM_CELLS) -> None:
 
 
 if __name__ == "__main__":
-    bench_timing(sys.argv[1:] or ONE_SEAM_CELLS)
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "cells", nargs="*", metavar="CELL_STEM", help="one-seam cells of cells/ by file stem"
+    )
+    bench_timing(parser.parse_args().cells or ONE_SEAM_CELLS)

@@ -12,7 +12,7 @@ this one's: a before/after on the same machine at about the same time.
 
 ``--baseline`` also times the KRL point selection as it was before it was batched
 (``process_points`` with one deviation per candidate segment and numpy call, kept in
-tests/selection_reference.py) against today's on each seam, and checks that both
+scripts/support/selection_reference.py) against today's on each seam, and checks that both
 select the same points with the same deviations.
 """
 
@@ -88,8 +88,8 @@ def parts(job, folder: Path, runs: int) -> dict[str, float]:
 
 def baseline(job, summary: dict, runs: int) -> None:
     """The KRL point selection of every seam, before and after, and whether they agree."""
-    # The point selection as it was (one segment per numpy call), kept with the tests.
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    # The point selection as it was (one segment per numpy call), kept for the tests too.
+    sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))
     from selection_reference import reference_process_points
 
     data = job_folder.job_program_data(job, summary)
@@ -112,9 +112,11 @@ def baseline(job, summary: dict, runs: int) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("cells", nargs="*", type=Path)
-    parser.add_argument("--runs", type=int, default=5)
-    parser.add_argument("--baseline", action="store_true")
+    parser.add_argument("cells", nargs="*", type=Path, help="cell files (default: the demos)")
+    parser.add_argument("--runs", type=int, default=5, help="writes of each folder (5)")
+    parser.add_argument(
+        "--baseline", action="store_true", help="also the KRL point selection before batching"
+    )
     parser.add_argument("--package", help="=DIR: the checkout whose offline_prog to time")
     args = parser.parse_args()
     cells = args.cells or [CELLS / name for name in DEMO_CELLS]

@@ -1,12 +1,14 @@
 """Print how closely CAD seams follow the analytic edge (issue 26's acceptance figures).
 
-Builds the test parts of tests/cad (filleted plate, L-bracket, chamfered cylinder) with
-Open CASCADE, writes STEP and STL (0.01 mm chords), plans each seam's fit as ``plan``
-does and prints the path error against the analytic edge [mm], the normal error [deg],
-the arc-length error [%], the fit's reported error against the exact edge and, for a
-mesh, the chord error it reports. Run: ``python scripts/cad_accuracy.py``.
+Builds the test parts of tests/cad (scripts/support/cad_parts.py: filleted plate,
+L-bracket, chamfered cylinder) with Open CASCADE, writes STEP and STL (0.01 mm chords),
+plans each seam's fit as ``plan`` does and prints the path error against the analytic
+edge [mm], the normal error [deg], the arc-length error [%], the fit's reported error
+against the exact edge and, for a mesh, the chord error it reports. Run:
+``python scripts/cad_accuracy.py [--parts plate bracket cylinder] [--stl-chord-mm 0.01]``.
 """
 
+import argparse
 import os
 import sys
 import tempfile
@@ -15,20 +17,23 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(REPO), str(REPO / "tests"), str(REPO / "tests" / "cad")]
+sys.path[:0] = [str(REPO), str(Path(__file__).resolve().parent / "support")]
 
 from cad_parts import (  # noqa: E402
     CYLINDER,
     PLATE,
     PLATE_R,
+    angle_deg,
+    bracket_profile,
     cad_cell,
     chamfered_cylinder,
     filleted_plate,
     l_bracket,
+    rounded_rectangle,
+    sampled,
     write_step,
     write_stl,
 )
-from test_step_seams import angle_deg, bracket_profile, rounded_rectangle, sampled  # noqa: E402
 
 from offline_prog.job.seams import seam_inputs  # noqa: E402
 from offline_prog.robot.model import ROBOTS_DIR  # noqa: E402
@@ -82,18 +87,31 @@ CASES = [
 ]
 
 
+PARTS = {"plate": filleted_plate, "bracket": l_bracket, "cylinder": chamfered_cylinder}
+
+
 def main() -> None:
-    folder = Path(tempfile.mkdtemp(prefix="cad_accuracy_"))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--parts", nargs="+", choices=list(PARTS), default=list(PARTS), help="(all three)"
+    )
+    parser.add_argument(
+        "--stl-chord-mm", type=float, default=0.01, help="the STL's chord tolerance (0.01)"
+    )
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="cad_accuracy_") as folder:
+        accuracy(Path(folder), args.parts, args.stl_chord_mm)
+
+
+def accuracy(folder: Path, parts: list[str], chord_mm: float) -> None:
+    """Write the ``parts`` (STEP and STL within ``chord_mm``) into ``folder``; print each
+    case's figures."""
     stdout = os.dup(1)
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)  # the STEP writer's banner (C++ stdout)
-    for name, build in (
-        ("plate", filleted_plate),
-        ("bracket", l_bracket),
-        ("cylinder", chamfered_cylinder),
-    ):
-        shape = build()
+    for name in parts:
+        shape = PARTS[name]()
         write_step(shape, folder / f"{name}.step")
-        write_stl(shape, folder / f"{name}.stl", 0.01)
+        write_stl(shape, folder / f"{name}.stl", chord_mm)
     sys.stdout.flush()
     os.dup2(stdout, 1)
     print(
@@ -101,6 +119,8 @@ def main() -> None:
         f"{'fit→edge mm':>11} {'chord mm':>9}"
     )
     for label, part, cad, truth, length in CASES:
+        if part not in parts:
+            continue
         for kind, tolerance in (("step", 0.005), ("stl", 0.02)):
             if kind == "stl" and "bottom chain" in label:
                 continue  # a mesh run is the whole outline: no edge ends at the fillets

@@ -1,5 +1,7 @@
 """Regenerate the demo STEP part in cells/data (committed; run only to change it).
 
+Run: ``python scripts/make_cad_demo.py [--out FOLDER]`` (default: cells/data).
+
 seal_plate.step: a 400 x 300 x 8 mm plate in the part frame P of the seal demos (P at
 the centre of its underside, z up into the plate), its vertical corners rounded R30
 and the rim of its underside chamfered 3 mm x 45°. cells/cad_seal_kr16.yaml seals the
@@ -7,6 +9,7 @@ underside's outer loop and runs a bead along the chamfer of one long side and it
 corners, the nozzle square to the chamfer.
 """
 
+import argparse
 from pathlib import Path
 
 from OCP.BRepAdaptor import BRepAdaptor_Curve
@@ -53,10 +56,17 @@ def seal_plate():
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--out", type=Path, default=DATA, help="folder for seal_plate.step (cells/data)"
+    )
+    out = parser.parse_args().out
+    out.mkdir(parents=True, exist_ok=True)
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     writer = STEPControl_Writer()
     writer.Transfer(seal_plate(), STEPControl_AsIs)
-    assert writer.Write(str(DATA / "seal_plate.step")) == IFSelect_RetDone
+    if writer.Write(str(out / "seal_plate.step")) != IFSelect_RetDone:
+        raise SystemExit(f"error: {out / 'seal_plate.step'}: the STEP writer failed")
 
 
 if __name__ == "__main__":

@@ -13,9 +13,9 @@ then the cycle times of both plans and report.json's ``quality.timing_bound`` fi
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import re
-import sys
 import tempfile
 from pathlib import Path
 
@@ -97,8 +97,13 @@ def main(cell: Path) -> None:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 1:
-        main(Path(sys.argv[1]))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "cell", nargs="?", type=Path, help="a job cell with a bead model (default: the demo)"
+    )
+    cell = parser.parse_args().cell
+    if cell is not None:
+        main(cell)
     else:
         with tempfile.TemporaryDirectory() as folder:
             main(demo_cell(Path(folder)))

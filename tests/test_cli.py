@@ -212,3 +212,32 @@ def test_the_command_collects_garbage_after_its_imports():
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
     code, enabled, frozen = done.stdout.split()[-3:]
     assert (code, enabled) == ("0", "True") and int(frozen) > 100_000, done.stdout
+
+
+def test_version_is_the_packages_one(capsys):
+    import tomllib
+
+    import offline_prog
+
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out.strip() == f"offline-prog {offline_prog.__version__}"
+    project = tomllib.loads((CELLS.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    assert project["project"]["dynamic"] == ["version"]  # one source: offline_prog.__version__
+    dynamic = project["tool"]["setuptools"]["dynamic"]["version"]
+    assert dynamic == {"attr": "offline_prog.__version__"}
+
+
+def test_the_help_names_every_command_and_robots_subcommand(capsys):
+    """``offline-prog --help`` lists each command with what it does; ``robots``' line
+    names each of its subcommands (import was missing)."""
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for command in ("plan", "preview", "session", "place", "seams", "robots", "export"):
+        assert f" {command} " in text
+    robots_line = text[text.index(" robots robot descriptions") :]
+    robots_line = robots_line[: robots_line.index(" export ")]
+    for subcommand in ("list", "import", "self-collision"):
+        assert subcommand in robots_line, robots_line

@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 import offline_prog.forked as forked
+from offline_prog.errors import Failure, InputError, PlanFailure
 from offline_prog.forked import forked_map, reachable
+from offline_prog.joints.joint_plan import JointPlanError
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
@@ -60,6 +62,51 @@ def test_an_outcome_that_cannot_travel_is_computed_here():
 
     outcomes = forked_map(item, list(range(6)), shared=[])
     assert {o.result()[1] for o in outcomes} == {os.getpid()}
+
+
+@needs_two
+def test_the_packages_errors_come_back_from_the_child_intact():
+    """An InputError or a PlanFailedError raised in the child is the parent's: class,
+    file, key, reason, failure record (it was exit 3 on two cores, exit 2 on one)."""
+    failure = PlanFailure(Failure.COLLISION, 0.25, 2.0, "tool_body hits the floor")
+
+    def item(i: int):
+        time.sleep(0.02)  # both processes take items
+        if i % 2:
+            raise InputError(f"cell{i}.yaml", f"seams[{i}].cad", "two edges")
+        raise JointPlanError(0.25, 2.0, "tool_body hits the floor", Failure.COLLISION)
+
+    outcomes = forked_map(item, list(range(8)), shared=[])
+    for i, outcome in enumerate(outcomes):
+        if i % 2:
+            assert type(outcome.error) is InputError
+            assert (outcome.error.file, outcome.error.key, outcome.error.reason) == (
+                f"cell{i}.yaml",
+                f"seams[{i}].cad",
+                "two edges",
+            )
+        else:
+            assert type(outcome.error) is JointPlanError and outcome.error.failure == failure
+
+
+@needs_two
+def test_an_outcome_this_process_cannot_read_back_is_computed_here():
+    def item(i: int):
+        time.sleep(0.02)  # both processes take items
+        return Unreadable(os.getpid())
+
+    outcomes = forked_map(item, list(range(6)), shared=[])
+    assert {o.result().pid for o in outcomes} == {os.getpid()}
+
+
+class Unreadable:
+    """Pickles, but its ``__init__`` needs what the pickle does not give back."""
+
+    def __init__(self, pid: int):
+        self.pid = pid
+
+    def __reduce__(self):
+        return Unreadable, ()
 
 
 def test_reachable_enters_containers_and_objects_not_arrays():

@@ -62,7 +62,7 @@ def step_catalog(file: Path) -> Catalog:
     """The faces, loops and G1 chains of a STEP model (read exactly)."""
     from offline_prog.cad.step_geometry import sample_edge, tessellate
     from offline_prog.cad.step_model import read_step
-    from offline_prog.cad.step_seams import face_label, outer_loop, sample_run
+    from offline_prog.cad.step_seams import around_itself, face_label, outer_loop, sample_run
 
     model = read_step(file)
     vertices, triangles, face_of = tessellate(model.shape, faces=model.faces)
@@ -87,7 +87,7 @@ def step_catalog(file: Path) -> Catalog:
             )
         )
         run = outer_loop(model, k)
-        if run:
+        if run and not around_itself(run):  # a cylinder's side has no one contour
             loop = sample_run(model, run, k, closed=True, offset_mm=0.0)
             entries.append(
                 Entry(
@@ -166,12 +166,13 @@ def g1_chains(model) -> list[list[tuple[int, bool]]]:
     return chains
 
 
-def mesh_catalog(file: Path, mm_per_unit: float) -> Catalog:
-    """The regions ("faces"), their outer loops and the feature-edge runs of a mesh."""
+def mesh_catalog(file: Path, mm_per_unit: float, *, set_units: str) -> Catalog:
+    """The regions ("faces"), their outer loops and the feature-edge runs of a mesh
+    (``set_units``: how the user gives the file's unit, see ``mesh_model.read_mesh``)."""
     from offline_prog.cad.mesh_model import read_mesh
     from offline_prog.cad.mesh_seams import region_loops
 
-    model = read_mesh(file, mm_per_unit)
+    model = read_mesh(file, mm_per_unit, set_units=set_units)
     mesh = model.mesh
     v = mesh.vertices
     entries = []

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.cad.step_model import ModelError
+from offline_prog.config.unit_slips import MM, large_mesh
 
 FEATURE_DEG = 30.0  # dihedral angle above which a mesh edge is a feature (sharp) edge
 CORNER_DEG = 20.0  # a run of feature edges ends where it turns more than this
@@ -44,11 +45,18 @@ class MeshModel:
     edge_lengths: np.ndarray
 
 
-def read_mesh(file: Path, mm_per_unit: float) -> MeshModel:
+def read_mesh(
+    file: Path, mm_per_unit: float, *, set_units: str = "set mesh_units: mm"
+) -> MeshModel:
     """Read a mesh file and find its regions and feature-edge runs.
 
+    Args:
+        mm_per_unit: the file's unit [mm].
+        set_units: how the user gives the unit (the hint for a file that looks like mm).
+
     Raises:
-        ModelError: not a readable mesh, or no triangles.
+        ModelError: not a readable mesh, no triangles, or larger than a cell (the rule
+            of ``config.unit_slips``, as for every mesh of a cell).
     """
     import trimesh
 
@@ -60,6 +68,9 @@ def read_mesh(file: Path, mm_per_unit: float) -> MeshModel:
         reason = (str(error).splitlines() or [""])[0] or type(error).__name__
         raise ModelError(f"not a readable mesh ({reason})") from None
     mesh.apply_scale(mm_per_unit)
+    too_large = large_mesh(float(max(mesh.extents)) * MM, set_units=set_units)
+    if too_large:
+        raise ModelError(too_large)
     mesh.merge_vertices()
     return model_of(mesh)
 

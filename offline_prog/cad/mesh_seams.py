@@ -13,6 +13,7 @@ import numpy as np
 
 from offline_prog.cad.edge_chain import chain
 from offline_prog.cad.mesh_model import CORNER_DEG, MeshModel
+from offline_prog.cad.offset_depth import check_offset
 from offline_prog.cad.picking import PickError, pick
 from offline_prog.cad.seam_samples import (
     FIT_SPACING_MM,
@@ -75,7 +76,10 @@ def region_vertex_normals(model: MeshModel, region: int, vertices: np.ndarray) -
 
 
 def region_loops(model: MeshModel, region: int) -> list[np.ndarray]:
-    """The region's boundary as closed vertex loops (first vertex repeated at the end)."""
+    """The region's boundary as closed vertex loops (first vertex repeated at the end),
+    each with the region on its left seen from outside the part: along its edges as the
+    region's triangles run them (counter-clockwise seen from outside), as a STEP face's
+    outer wire runs."""
     mesh = model.mesh
     inside = model.face_region == region
     pairs = mesh.face_adjacency
@@ -105,8 +109,23 @@ def region_loops(model: MeshModel, region: int) -> list[np.ndarray]:
             loop.append(step)
         seen.update(loop)
         if loop[-1] == start:
-            loops.append(np.array(loop))
+            loops.append(_region_on_the_left(mesh, inside, np.array(loop)))
     return loops
+
+
+def _region_on_the_left(mesh, inside: np.ndarray, loop: np.ndarray) -> np.ndarray:
+    """The loop (first vertex repeated at the end) reversed unless its first edge runs
+    as the region's triangle on it runs that edge (triangles wound counter-clockwise
+    seen from outside: the region is then on the loop's left)."""
+    a, b = int(loop[0]), int(loop[1])
+    for face in mesh.vertex_faces[a]:
+        if face < 0 or not inside[face]:
+            continue
+        corners = [int(v) for v in mesh.faces[face]]
+        if b in corners:
+            i = corners.index(a)
+            return loop if corners[(i + 1) % 3] == b else loop[::-1]
+    return loop
 
 
 def _resample(p: np.ndarray, n: np.ndarray, spacing: float):
@@ -180,7 +199,10 @@ def loop_seam(model: MeshModel, face_near_mm, normal_near_mm, *, offset_mm: floa
     normal_region = region
     if normal_near_mm is not None:
         normal_region = pick_region(model, normal_near_mm, f"{key}.normal.face_near_mm")
-    return _samples(model, [loop], normal_region, closed=True, offset_mm=offset_mm, edges=())
+    samples = _samples(model, [loop], normal_region, closed=True, offset_mm=offset_mm, edges=())
+    mesh = model.mesh
+    check_offset(mesh.vertices, mesh.faces, samples, offset_mm, key=key)
+    return samples
 
 
 def chain_seam(
@@ -203,6 +225,8 @@ def chain_seam(
             "or end at (a mesh keeps no tangent edge ends): set closed: true, or use the "
             "STEP model",
         )
-    return _samples(
+    samples = _samples(
         model, vertex_runs, region, closed=closed, offset_mm=offset_mm, edges=[e for e, _ in run]
     )
+    check_offset(model.mesh.vertices, model.mesh.faces, samples, offset_mm, key=key)
+    return samples

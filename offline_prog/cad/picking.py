@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from offline_prog.errors import TravellingError
+
 # Two candidates nearer than this to equal distance are ambiguous [mm] ...
 AMBIGUOUS_MM = 0.5
 # ... and a point farther than this from every candidate is off the model [mm].
 FAR_MM = 5.0
 
 
-class PickError(ValueError):
+class PickError(TravellingError, ValueError):
     """A point that picks nothing, or two things; ``key`` is the cell-file key's tail
     below the seam (``cad.loop.face_near_mm``), str() is one line."""
 

@@ -16,6 +16,7 @@ from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.TopAbs import TopAbs_REVERSED
 
 from offline_prog.cad.edge_chain import chain
+from offline_prog.cad.offset_depth import check_offset
 from offline_prog.cad.picking import PickError, pick
 from offline_prog.cad.seam_samples import (
     FIT_END_SPACING_MM,
@@ -26,10 +27,12 @@ from offline_prog.cad.seam_samples import (
     join_pieces,
 )
 from offline_prog.cad.step_geometry import (
+    TESSELLATION_TOLERANCE_MM,
     distance,
     outward_normals,
     point_at_abscissa,
     sample_edge,
+    tessellate,
 )
 from offline_prog.cad.step_model import StepModel
 
@@ -150,14 +153,53 @@ def _smallest_radius(model: StepModel, run) -> float:
     return smallest
 
 
+def around_itself(run: list[tuple[int, bool]]) -> list[int]:
+    """The edges a face's loop runs twice: the seam edge of a face closed around itself
+    (a cylinder's or cone's side), along which its boundary goes there and back."""
+    numbers = [e for e, _ in run]
+    return sorted({e for e in numbers if numbers.count(e) > 1})
+
+
+def _offset_checked(model: StepModel, samples: SeamSamples, offset_mm: float, key: str):
+    """``samples``, once :func:`offset_depth.check_offset` allows the offset."""
+    if offset_mm > 0.0:
+        vertices, triangles, _ = tessellate(model.shape)
+        check_offset(
+            vertices,
+            triangles,
+            samples,
+            offset_mm,
+            key=key,
+            tolerance_mm=TESSELLATION_TOLERANCE_MM,
+        )
+    return samples
+
+
 def loop_seam(model: StepModel, face_near_mm, normal_near_mm, *, offset_mm: float, key: str):
     """The outer loop of the face nearest ``face_near_mm``, normals from the face nearest
-    ``normal_near_mm`` (default: the loop's face)."""
+    ``normal_near_mm`` (default: the loop's face). The loop runs as Open CASCADE's outer
+    wire does: with its face on the left seen from outside the part (counter-clockwise
+    about the face's outward normal), as a mesh's loop does (``mesh_seams``).
+
+    Raises:
+        PickError: a face closed around itself (its boundary is not one contour), an
+            offset deeper than the part, or a point that picks nothing or two faces.
+    """
     face = pick_face(model, face_near_mm, f"{key}.loop.face_near_mm")
+    run = outer_loop(model, face)
+    twice = around_itself(run)
+    if twice:
+        raise PickError(
+            f"{key}.loop.face_near_mm",
+            f"{face_label(model, face)} closes around itself: its boundary runs along "
+            f"its seam edge {twice[0]} and back, not round one contour; pick one of its "
+            "rims as a chain (cad.chain, closed: true)",
+        )
     normal_face = face
     if normal_near_mm is not None:
         normal_face = pick_face(model, normal_near_mm, f"{key}.normal.face_near_mm")
-    return sample_run(model, outer_loop(model, face), normal_face, closed=True, offset_mm=offset_mm)
+    samples = sample_run(model, run, normal_face, closed=True, offset_mm=offset_mm)
+    return _offset_checked(model, samples, offset_mm, key)
 
 
 def chain_seam(
@@ -171,4 +213,5 @@ def chain_seam(
     last = model.edge_ends[run[-1][0]][0 if run[-1][1] else 1]
     if closed and first != last:
         raise PickError(f"{key}.closed", "true, but the chain's ends do not meet")
-    return sample_run(model, run, normal_face, closed=closed, offset_mm=offset_mm)
+    samples = sample_run(model, run, normal_face, closed=closed, offset_mm=offset_mm)
+    return _offset_checked(model, samples, offset_mm, key)

@@ -86,7 +86,8 @@ def check_part_model(file, cell, check_data_file) -> None:
 
 def check_cad(file, key: str, path, cell, check_data_file) -> None:
     """A seam's ``cad:`` block: one of loop or chain, points of 3 numbers, a model file
-    of a known kind, units that fit it. A loop is a closed seam: sets ``path.closed``."""
+    of a known kind, units that fit it. A loop is a closed seam: ``closed: false`` on it
+    is refused (``load_cell`` makes a loop closed when the key is not given)."""
     cad, where = path.cad, f"{key}.cad"
     if (cad.loop is None) == (cad.chain is None):
         raise InputError(file, where, "give exactly one of loop or chain")
@@ -127,5 +128,10 @@ def check_cad(file, key: str, path, cell, check_data_file) -> None:
         raise InputError(
             file, f"{key}.units", "a STEP model is read in mm (its own units are converted)"
         )
-    if cad.loop is not None:
-        path.closed = True
+    if cad.loop is not None and path.closed is False:
+        raise InputError(
+            file,
+            f"{key}.closed",
+            "false, but a loop comes back to its start (leave closed out; an open run of "
+            "edges is a chain)",
+        )

@@ -140,7 +140,10 @@ class AnalyticPath:
 @dataclasses.dataclass
 class PathConfig:
     units: str | None = None  # m | mm; required except for cad: (config.cad_keys)
-    closed: bool = False  # a closed contour (periodic spline); its ends: path.closing
+    # A closed contour (periodic spline; its ends: path.closing). Not given: true for a
+    # cad: loop, false otherwise (load_cell decides, so a cell reads the same checked or
+    # not); false on a cad: loop is refused (config.cad_keys).
+    closed: bool | None = None
     points: str | None = None  # CSV x,y,z[,nx,ny,nz], relative to the cell file
     dxf: str | None = None
     dxf_layer: str | None = None
@@ -295,10 +298,14 @@ def load_cell(file: str | os.PathLike) -> Cell:
     try:
         # Drake's loader reads YAML 1.1 (on, off, yes, no are booleans): it gets the
         # data our YAML 1.2 loader read, written out by Drake's own dumper.
-        return yaml_load_typed(schema=Cell, data=safe_yaml.drake_text(raw))
+        cell = yaml_load_typed(schema=Cell, data=safe_yaml.drake_text(raw))
     except Exception as error:  # Drake's message is multi-line; keep its first line.
         first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
         raise InputError(file, "", first_line) from None
+    for seam in ([cell.path] if cell.path is not None else []) + cell.seams:
+        if seam.closed is None:  # not given: a loop comes back to its start
+            seam.closed = seam.cad is not None and seam.cad.loop is not None
+    return cell
 
 
 def transform(value: Transform) -> RigidTransform:

@@ -263,11 +263,15 @@ def save_cell(original: Path, initial: CellValues, state: CellValues, cell: Cell
             break
         except FileExistsError:  # taken since free_name looked: the next one
             continue
-    try:
-        same = yaml_dump_typed(load_cell(target)) == yaml_dump_typed(cell)
-    except Exception:
-        same = False
-    if not same:
+    if not loads_to(target, cell):
         os.unlink(target)
         raise RuntimeError(f"{target}: the edited file did not load to the session's cell")
     return target
+
+
+def loads_to(file: Path, cell: Cell) -> bool:
+    """Whether the cell file ``file`` loads to ``cell`` (False if it does not load)."""
+    try:
+        return yaml_dump_typed(load_cell(file)) == yaml_dump_typed(cell)
+    except Exception:
+        return False

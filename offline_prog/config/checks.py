@@ -12,10 +12,11 @@ import numpy as np
 
 from offline_prog.config.cad_keys import check_cad, check_part_model
 from offline_prog.config.calibration_keys import check_calibration, check_controller_frames
-from offline_prog.config.cell import Cell, PathConfig
+from offline_prog.config.cell import Cell, PathConfig, transform
 from offline_prog.config.job_checks import check_job
 from offline_prog.config.process_keys import check_process
 from offline_prog.config.robot_search import find_robot, robots_in, search_path
+from offline_prog.config.unit_slips import far_translation
 from offline_prog.constants import (
     MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
@@ -64,6 +65,12 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             f"{cell.robot.model!r} is not a robot folder in "
             f"{os.pathsep.join(map(str, folders))} (have: {', '.join(have) or 'none'})",
         )
+    for key, pose in (
+        ("robot.X_IB", cell.robot.X_IB),
+        ("tool.X_IT", cell.tool.X_IT),
+        ("part.X_PE", cell.part.X_PE),
+    ):
+        _check_translation(file, key, pose)
     motion = cell.motion
     if cell.part.mesh_units not in UNIT_SCALE:
         raise _error(
@@ -196,6 +203,13 @@ def _check_data_file(file: Path, key: str, data_file: Path) -> None:
         raise _error(file, key, f"{data_file}: {size:,} bytes, more than {MAX_DATA_FILE_BYTES:,}")
 
 
+def _check_translation(file: Path, key: str, pose) -> None:
+    """A pose's translation [m] within a cell (a pose typed in mm: the unit hint)."""
+    too_far = far_translation(transform(pose).translation())
+    if too_far:
+        raise _error(file, f"{key}.translation", too_far)
+
+
 def _check_shapes(file: Path, cell: Cell) -> None:
     """Shape names unique, mesh files present, allowed contacts naming known shapes."""
     owners = [
@@ -210,6 +224,7 @@ def _check_shapes(file: Path, cell: Cell) -> None:
             if shape.name in names:
                 raise _error(file, f"{where}.name", f"{shape.name!r} is used twice")
             names.add(shape.name)
+            _check_translation(file, f"{where}.pose", shape.pose)
             if shape.shape not in ("box", "cylinder", "sphere", "capsule", "mesh"):
                 raise _error(
                     file,

@@ -106,12 +106,15 @@ def check_job(file: Path, cell: Cell) -> None:
 
 # The process outputs each controller family can have (its own numbering):
 # KUKA KSS 8: $OUT[1..4096], $ANOUT[1..32]; UR e-Series: standard digital out 0..7,
-# standard analog out 0..1; ABB: signals named do<n> / ao<n> in the I/O configuration.
+# standard analog out 0..1; ABB: signals named do<n> / ao<n> in the I/O configuration;
+# FANUC: DO[n], AO[n], logical numbers from 1 (the I/O assignment maps them onto racks
+# and slots; DO[0] and AO[0] do not exist), the upper end set by that assignment.
 IO_PARTS = ("on", "off", "flow")  # tool.process_io's outputs
 OUTPUT_RANGES = {
     "krl": {"digital_output": (1, 4096), "analog_output": (1, 32)},
     "urscript": {"digital_output": (0, 7), "analog_output": (0, 1)},
     "rapid": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
+    "fanuc": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
 }
 
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from offline_prog.config.cell import ProcessIoConfig
 from offline_prog.config.process_keys import ProcessConfig
+from offline_prog.errors import TravellingError
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import JobSamples
 from offline_prog.process.model import process_model, speed_output
@@ -42,7 +43,7 @@ class IoColumns:
         return [e for e in self.events if e.signal is Signal.DIGITAL]
 
 
-class IoPlacementError(ValueError):
+class IoPlacementError(TravellingError, ValueError):
     """The switches of a seam are out of order or outside its approach, seam and retract."""
 
     def __init__(self, key: str, reason: str):

@@ -26,7 +26,7 @@ MM = 1e-3  # metres per millimetre
 
 
 @functools.lru_cache(maxsize=4)
-def _model(file: str, kind: str, mm_per_unit: float, _stamp: tuple):
+def _model(file: str, kind: str, mm_per_unit: float, set_units: str, _stamp: tuple):
     """The model of a file, read once per content stamp (a job's seams share it)."""
     if kind == "step":
         from offline_prog.cad.step_model import read_step
@@ -34,17 +34,21 @@ def _model(file: str, kind: str, mm_per_unit: float, _stamp: tuple):
         return read_step(Path(file))
     from offline_prog.cad.mesh_model import read_mesh
 
-    return read_mesh(Path(file), mm_per_unit)
+    return read_mesh(Path(file), mm_per_unit, set_units=set_units)
 
 
-def load_model(file: Path, kind: str, mm_per_unit: float = 1.0):
-    """A STEP (``kind="step"``) or mesh model of a file [mm], cached while unchanged.
+def load_model(
+    file: Path, kind: str, mm_per_unit: float = 1.0, *, set_units: str = "set mesh_units: mm"
+):
+    """A STEP (``kind="step"``) or mesh model of a file [mm], cached while unchanged
+    (``set_units``: how the user gives a mesh's unit, for the hint of a mesh too large).
 
     Raises:
-        cad.step_model.ModelError: unreadable, or not a solid (one line).
+        cad.step_model.ModelError: unreadable, not a solid, or a mesh larger than a
+            cell (one line).
     """
     stat = Path(file).stat()
-    return _model(str(file), kind, mm_per_unit, (stat.st_mtime_ns, stat.st_size))
+    return _model(str(file), kind, mm_per_unit, set_units, (stat.st_mtime_ns, stat.st_size))
 
 
 def model_units(cell: Cell, cad, units: str | None) -> float:
@@ -72,7 +76,13 @@ def cad_samples(file: Path, cell: Cell, key: str = "path"):
     kind = model_kind(name)
     normal = None if cad.normal is None else cad.normal.face_near_mm
     try:
-        model = load_model(file.parent / name, kind, model_units(cell, cad, path.units))
+        units_key = f"{key}.units" if path.units else "part.mesh_units"
+        model = load_model(
+            file.parent / name,
+            kind,
+            model_units(cell, cad, path.units),
+            set_units=f"set {units_key}: mm",
+        )
         if kind == "step":
             from offline_prog.cad import step_seams as seams
         else:

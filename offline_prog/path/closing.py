@@ -15,12 +15,13 @@ from __future__ import annotations
 import numpy as np
 
 from offline_prog.constants import CLOSING_GAP_STEP_RATIO
+from offline_prog.errors import TravellingError
 
 # Consecutive points closer than this are one point [m].
 DUPLICATE_POINT_M = 1e-9
 
 
-class OpenEndsError(ValueError):
+class OpenEndsError(TravellingError, ValueError):
     """A closed contour whose ends are too far apart to close: gap_m [m], and the
     spacing at the ends, first_step_m and last_step_m [m]."""
 

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from offline_prog.constants import MIN_NORMAL_TANGENT_ANGLE_RAD
+from offline_prog.errors import TravellingError
 from offline_prog.path.arc_length import ArcLengthPath, compose_derivatives
 from offline_prog.path.bspline_fit import fit_on_knots
 
@@ -21,7 +22,7 @@ NormalField = Callable[[np.ndarray], list[np.ndarray]]
 """s (N,) ↦ [n_raw, dn_raw/ds, d²n_raw/ds²], each (N, 3) in P (not yet unit/orthogonal)."""
 
 
-class NormalTangentError(ValueError):
+class NormalTangentError(TravellingError, ValueError):
     """The surface normal is (anti)parallel to the tangent; the frame is undefined."""
 
     def __init__(self, s: float, angle_rad: float):

@@ -22,7 +22,8 @@ from pydrake.math import RigidTransform
 
 from offline_prog.config.cell import Cell, transform
 from offline_prog.config.safe_yaml import short_repr
-from offline_prog.constants import MAX_MESH_EXTENT_M
+from offline_prog.config.unit_slips import large_mesh
+from offline_prog.errors import TravellingError
 from offline_prog.scene.mesh_cache import as_obj, convex_pieces
 
 if TYPE_CHECKING:  # trimesh costs ~0.5 s to import; loaded where a mesh is used
@@ -32,7 +33,7 @@ KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
 MESH_SCALES = {"m": 1.0, "mm": 1e-3}
 
 
-class ShapeError(ValueError):
+class ShapeError(TravellingError, ValueError):
     """A bad shape entry; str() is one line ``key: reason`` (``key`` like ``obstacles[2]``)."""
 
     def __init__(self, key: str, reason: str):
@@ -148,13 +149,10 @@ def mesh_shape(
         reason = (str(error).splitlines() or [""])[0] or type(error).__name__
         raise ShapeError(key, f"cannot read {str(file)!r} for {name!r} ({reason})") from None
     mesh, extent = kept
-    if extent > MAX_MESH_EXTENT_M:  # before CoACD, which would take minutes on it
-        hint = " (the file looks like mm: set mesh_units: mm)" if extent / 1000 < 5 else ""
-        raise ShapeError(
-            key,
-            f"{str(file)!r} for {name!r} is {extent:.4g} m across, more than "
-            f"{MAX_MESH_EXTENT_M:g} m{hint}",
-        )
+    units_key = key.rsplit(".", 1)[0] + ".mesh_units"  # part.model -> part.mesh_units
+    too_large = large_mesh(extent, set_units=f"set {units_key}: mm")
+    if too_large:  # before CoACD, which would take minutes on it
+        raise ShapeError(key, f"{str(file)!r} for {name!r} is {too_large}")
     visual = as_obj(file, scale)
     pieces = (visual,) if mesh.is_convex else convex_pieces(file, scale, mesh)
     _meshes[cache_key] = kept

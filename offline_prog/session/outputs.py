@@ -1,10 +1,11 @@
 """Export of a session: the plan folder of the saved cell file.
 
-Save (``config.cell_text.save_cell``) writes ``<stem>-<n>.yaml`` next to the original.
-Export saves the cell first (the plan folder names it) and writes the folder exactly
-as ``offline-prog plan`` does, with the
-same writer: the whole job (a ``path:`` cell is a one-seam job: home, approach, seam,
-retract, home), planned from the saved file.
+Save (``config.cell_text.save_cell``) writes ``<stem>-<n>.yaml`` next to the original
+(where its data files' relative paths hold). Export of the values as loaded plans the
+cell file itself into ``out/<stem>``, writing nothing beside it; of edited values it
+saves the cell first (the plan folder names it) into ``out/<stem>-<n>``. Either way the
+folder is written exactly as ``offline-prog plan`` writes it, with the same writer: the
+whole job (a ``path:`` cell is a one-seam job: home, approach, seam, retract, home).
 """
 
 from __future__ import annotations

@@ -82,7 +82,8 @@ def seams_page_of(cell_file) -> bytes | None:
     if cell.part.model is None:
         return None
     model = Path(cell_file).parent / cell.part.model
-    return seams_html(model_catalog(model, cell.part.mesh_units)).encode()
+    catalog = model_catalog(model, cell.part.mesh_units, set_units="set part.mesh_units: mm")
+    return seams_html(catalog).encode()
 
 
 class _Handler(BaseHTTPRequestHandler):

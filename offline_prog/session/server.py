@@ -235,6 +235,8 @@ class Session:
         if kind == "calibrate":  # state: the checked (inputs, touches)
             progress("calibrating")
             return calibration.solve(*state)
+        if kind == "export" and self._unchanged(state):  # the file as it is: no copy
+            return self.file, *outputs.export(self.file, self.out_root / self.file.stem, progress)
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
             planner = self.replanner
@@ -244,6 +246,14 @@ class Session:
             return saved
         out = self.out_root / saved.stem
         return saved, *outputs.export(saved, out, progress)
+
+    def _unchanged(self, state) -> bool:
+        """Whether ``state`` makes the cell of the file as it is on disk (the values as
+        loaded, whichever seam is active, and the file not edited since)."""
+        planner = self.replanner
+        if dataclasses.replace(state, seam=planner.initial.seam) != planner.initial:
+            return False
+        return cell_text.loads_to(self.file, planner.cell(state))
 
     # --- the main thread: MeshCat -------------------------------------------------------
 
@@ -296,9 +306,11 @@ class Session:
                 self.message = ("info", f"saved {answer}")
             return
         if kind == "export":
-            saved, folder, line = answer
+            cell_file, folder, line = answer
             with self.lock:
-                self.last_saved, self.last_exported = saved, folder
+                if cell_file != self.file:  # the edited values, saved for the folder
+                    self.last_saved = cell_file
+                self.last_exported = folder
                 self.message = ("info", line)
             return
         if kind == "calibrate":

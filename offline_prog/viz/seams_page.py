@@ -8,16 +8,21 @@ sprite that always faces the camera and is never hidden behind the part.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
+from offline_prog.atomic import write_atomic
 from offline_prog.config.cad_keys import model_kind
 from offline_prog.constants import UNIT_SCALE
 from offline_prog.errors import InputError
 from offline_prog.viz.static_scene import StaticScene
 
 MM = 1e-3
+# The page says who wrote it: ``seams`` replaces its own page and no other file.
+PAGE_MARK = '<meta name="generator" content="offline-prog seams">'
+PAGE_HEAD_BYTES = 8192  # the mark is in the page's head, before the inlined viewer
 MODEL_RGBA = (0.75, 0.75, 0.78, 1.0)
 LINE_RGBA = {"loop": (0.1, 0.35, 0.9, 1.0), "chain": (0.95, 0.45, 0.05, 1.0)}
 PREFIX = {"face": "F", "loop": "L", "chain": "C"}
@@ -85,14 +90,17 @@ def seams_html(catalog) -> str:
     scene.set_camera(centre + extent * np.array([0.45, -0.6, 0.5]), centre)
     scene.set_property("/Grid", "visible", False)
     scene.set_property("/Axes", "visible", False)
-    return scene.html(f"seams of {Path(catalog.file).name}")
+    page = scene.html(f"seams of {Path(catalog.file).name}")
+    return page.replace("</title>", f"</title>\n  {PAGE_MARK}", 1)
 
 
-def model_catalog(part: Path, mesh_units: str = "m"):
-    """The :class:`~offline_prog.cad.catalog.Catalog` of a STEP or mesh file.
+def model_catalog(part: Path, mesh_units: str = "m", *, set_units: str = "set mesh_units: mm"):
+    """The :class:`~offline_prog.cad.catalog.Catalog` of a STEP or mesh file
+    (``set_units``: how the user gives a mesh's unit, the hint for one too large).
 
     Raises:
-        InputError: not a model file, unreadable, or not a solid (one line).
+        InputError: not a model file, unreadable, not a solid, or a mesh larger than a
+            cell (one line).
     """
     from offline_prog.cad.catalog import mesh_catalog, step_catalog
     from offline_prog.cad.step_model import ModelError
@@ -106,19 +114,51 @@ def model_catalog(part: Path, mesh_units: str = "m"):
     try:
         if kind == "step":
             return step_catalog(part)
-        return mesh_catalog(part, UNIT_SCALE[mesh_units] / MM)
+        return mesh_catalog(part, UNIT_SCALE[mesh_units] / MM, set_units=set_units)
     except ModelError as error:
         raise InputError(part, "", str(error)) from None
 
 
-def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
-    """``offline-prog seams``: list the model's faces, loops and chains (numbers, sizes,
-    the cell-file keys that pick each) through ``say`` and write the page.
+def page_file(part: Path, out: Path | None) -> Path:
+    """Where ``seams`` writes its page: ``out``, or ``out/<part stem>_seams.html``.
 
     Raises:
-        InputError: not a model file, unreadable, or not a solid (one line).
+        InputError: the file is the part model (an input), a folder, not named .html,
+            or a file this command did not write (nothing is replaced but its own page).
     """
-    catalog = model_catalog(part, mesh_units)
+    target = Path(out) if out is not None else Path("out") / f"{Path(part).stem}_seams.html"
+    if target.exists() and Path(part).exists() and os.path.samefile(target, part):
+        raise InputError(target, "--out", "is the part model itself (an input)")
+    if target.is_dir():
+        raise InputError(target, "--out", "is a folder: give the page's file name (.html)")
+    if target.suffix.lower() not in (".html", ".htm"):
+        raise InputError(target, "--out", "the page is HTML: give a file name ending in .html")
+    if not target.exists():
+        return target
+    try:
+        with open(target, "rb") as stream:
+            head = stream.read(PAGE_HEAD_BYTES)
+    except OSError as error:
+        raise InputError(target, "--out", f"cannot read ({error.strerror})") from None
+    if PAGE_MARK.encode() not in head:
+        raise InputError(
+            target, "--out", "exists and is not a page offline-prog seams wrote (not replaced)"
+        )
+    return target
+
+
+def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
+    """``offline-prog seams``: list the model's faces, loops and chains (numbers, sizes,
+    the cell-file keys that pick each) through ``say`` and write the page (``out``, by
+    default ``out/<part stem>_seams.html``: :func:`page_file`).
+
+    Raises:
+        InputError: not a model file, unreadable, not a solid, a mesh larger than a
+            cell, or an ``out`` that :func:`page_file` refuses (one line; nothing
+            written).
+    """
+    target = page_file(part, out)
+    catalog = model_catalog(part, mesh_units, set_units="give --mesh-units mm")
     unit = {"face": "mm²", "loop": "mm", "chain": "mm"}
     for entry in catalog.entries:
         name = f"{PREFIX[entry.kind]}{entry.number}"
@@ -128,8 +168,6 @@ def run_seams(part: Path, out: Path | None, mesh_units: str, say) -> Path:
             f"{entry.description:<40} cad: {keys}",
             highlight=False,
         )
-    part = Path(part)
-    out = Path(out) if out is not None else part.with_name(f"{part.stem}_seams.html")
-    out.write_text(seams_html(catalog), encoding="utf-8")
-    say(f"page      {out}", highlight=False)
-    return out
+    write_atomic(target, seams_html(catalog))
+    say(f"page      {target}", highlight=False)
+    return target

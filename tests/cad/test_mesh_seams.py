@@ -4,13 +4,17 @@ model, within the tessellation's chord error the mesh seam reports."""
 import numpy as np
 import pytest
 import trimesh
-from cad_parts import cad_cell, filleted_plate, l_bracket, write_step, write_stl
-from test_step_seams import (
+from cad_parts import (
     PLATE,
     angle_deg,
     bracket_profile,
+    cad_cell,
+    filleted_plate,
+    l_bracket,
     rounded_rectangle,
     sampled,
+    write_step,
+    write_stl,
 )
 
 from offline_prog.errors import InputError
@@ -110,3 +114,26 @@ def test_a_chain_on_a_closed_run_of_a_mesh_asks_for_closed(parts):
     assert exact.closed and fit.path.length * 1e3 == pytest.approx(perimeter, rel=1e-4)
     p, _ = sampled(fit)
     assert rounded_rectangle(p, 0.0)[0].max() < exact.tolerance_m * 1e3 + FIT_MM
+
+
+def _turn_about(p: np.ndarray, n: np.ndarray) -> float:
+    """The sign of a closed polyline's (N, 3) turning about the direction n: +1
+    counter-clockwise seen from where n points (right-hand rule), -1 clockwise."""
+    centre = p.mean(axis=0)
+    area = np.cross(p - centre, np.roll(p, -1, axis=0) - centre).sum(axis=0)
+    return float(np.sign(area @ n))
+
+
+def test_a_loop_runs_the_same_way_on_the_step_model_and_its_mesh(parts):
+    """One direction rule for both model kinds: a loop runs with its face on its left
+    seen from outside the part (counter-clockwise about the face's outward normal, as a
+    STEP face's outer wire runs). The mesh's loops ran the other way."""
+    from offline_prog.cad import mesh_seams, step_seams
+    from offline_prog.cad.mesh_model import read_mesh
+    from offline_prog.cad.step_model import read_step
+
+    step, mesh = read_step(parts / "plate.step"), read_mesh(parts / "plate.stl", 1.0)
+    for point, outward in (([150, 100, 10], [0, 0, 1]), ([150, 100, 0], [0, 0, -1])):
+        for model, seams in ((step, step_seams), (mesh, mesh_seams)):
+            loop = seams.loop_seam(model, point, None, offset_mm=0.0, key="k")
+            assert _turn_about(loop.p, np.array(outward, float)) == 1.0, (seams, point)

@@ -9,6 +9,7 @@ from offline_prog.cad.catalog import step_catalog
 from offline_prog.cad.step_model import read_step
 from offline_prog.cad.step_seams import pick_edge, pick_face
 from offline_prog.cli import main
+from offline_prog.errors import InputError
 from offline_prog.job.seams import seam_inputs
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
@@ -96,3 +97,59 @@ def test_the_seams_page_shows_the_numbered_model(tmp_path, capsys):
     assert model > 0.05, "the part is not in view"
     text = (grey < 40).mean()  # black label glyphs
     assert text > 0.001, "no numbers drawn"
+
+
+def test_a_mesh_in_mm_read_as_metres_is_refused_as_plan_refuses_it(plate, capsys, tmp_path):
+    """One size rule for ``seams`` and ``plan`` (config.unit_slips): the plate's STL in mm
+    without --mesh-units is a 300 m part; ``seams`` listed it (its face_near_mm keys
+    1000× too large) where ``plan`` refused it. Both now refuse, with the unit hint."""
+    stl = plate.with_suffix(".stl")
+    code = main(["seams", str(stl), "--out", str(tmp_path / "mesh.html")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "300 m across, more than a cell's 20 m" in err[0]
+    assert err[0].endswith("(the file looks like mm: give --mesh-units mm)")
+    assert not (tmp_path / "mesh.html").exists()
+    file = cad_cell(tmp_path, str(stl), [{"cad": {"loop": {"face_near_mm": [150, 100, 10]}}}])
+    code = main(["plan", str(file), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "300 m across, more than a cell's 20 m" in err[0] and "mesh_units: mm" in err[0]
+
+
+def test_the_seams_of_a_mesh_model_in_mm_name_the_units_key(plate, tmp_path):
+    """The seam's own reading of the model (before the scene) says it as well."""
+    stl = plate.with_suffix(".stl")
+    file = cad_cell(tmp_path, str(stl), [{"cad": {"loop": {"face_near_mm": [150, 100, 10]}}}])
+    with pytest.raises(InputError) as error:
+        seam_inputs(load_inputs(file, ROBOTS_DIR), 0)
+    assert error.value.key == "part.model"
+    assert error.value.reason.endswith("(the file looks like mm: set part.mesh_units: mm)")
+
+
+def test_the_page_goes_to_out_by_default_and_never_over_an_input(
+    plate, capsys, tmp_path, monkeypatch
+):
+    """Default: out/<part stem>_seams.html under the current folder, not beside the model
+    (it landed in cells/data/); an --out that is the model, a folder or a file the
+    command did not write is refused, nothing written; its own page is replaced."""
+    monkeypatch.chdir(tmp_path)
+    before = plate.read_bytes()
+    assert main(["seams", str(plate)]) == 0
+    page = tmp_path / "out" / "plate_seams.html"
+    assert page.is_file() and not plate.with_name("plate_seams.html").exists()
+    assert main(["seams", str(plate)]) == 0  # its own page: replaced
+    (tmp_path / "notes.html").write_text("my notes", encoding="utf-8")
+    for out, reason in (
+        (plate, "--out: is the part model itself (an input)"),
+        (tmp_path / "notes.html", "--out: exists and is not a page offline-prog seams wrote"),
+        (tmp_path / "out", "--out: is a folder"),
+        (tmp_path / "page.step", "--out: the page is HTML"),
+    ):
+        capsys.readouterr()
+        assert main(["seams", str(plate), "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and reason in err[0], err
+    assert plate.read_bytes() == before
+    assert (tmp_path / "notes.html").read_text(encoding="utf-8") == "my notes"
+    assert not (tmp_path / "page.step").exists()

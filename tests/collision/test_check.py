@@ -346,6 +346,6 @@ def test_a_mesh_in_mm_declared_as_metres_is_refused_at_once(tmp_path):
     with pytest.raises(ShapeError) as error:
         mesh_shape("shell", DATA / "data" / "cylinder_shell.stl", 1.0, key="part.mesh")
     message = str(error.value)
-    assert message.startswith("part.mesh: ") and "set mesh_units: mm" in message
+    assert message.startswith("part.mesh: ") and "set part.mesh_units: mm" in message
     assert "\n" not in message
     assert mesh_shape("shell", DATA / "data" / "cylinder_shell.stl", 1e-3).kind == "mesh"

@@ -126,6 +126,29 @@ CASES = [  # (replace, with, key in message, reason fragment)
     ),
     ("max_jerk: 10.0", "max_jerk: 10.0\n  process: glue", "motion.process", "constant_speed"),
     ("  closed: false", "  closed: false\n  dxf: a.dxf", "path", "exactly one of"),
+    # A pose typed in mm gets the unit hint motion.speed: 100 gets (it was only "out of
+    # reach" once planned).
+    (
+        "[1.0, 0, 0.5]",
+        "[1000, 0, 500]",
+        "tool.X_IT.translation",
+        "1118 m from the origin, more than a cell's 20 m (the unit is m: [1000, 0, 500] mm "
+        "is [1, 0, 0.5])",
+    ),
+    ("[0, 0, 0.1]", "[0, 0, 100]", "part.X_PE.translation", "[0, 0, 100] mm is [0, 0, 0.1]"),
+    (
+        "X_IB: {translation: [0, 0, 0]",
+        "X_IB: {translation: [0, 0, 30]",
+        "robot.X_IB.translation",
+        "30 m",
+    ),
+    (
+        "name: test",
+        "name: test\nobstacles: [{name: a, shape: box, size_mm: [1, 1, 1], "
+        "pose: {translation: [1000, 0, 150]}}]",
+        "obstacles[0].pose.translation",
+        "[1000, 0, 150] mm is [1, 0, 0.15]",
+    ),
     ("path:\n", "path:\n  analytic: {kind: spiral}\n", "path", "exactly one of"),
 ]
 

@@ -189,3 +189,37 @@ def test_a_lag_that_leads_before_the_approach_is_refused():
     with pytest.raises(IoPlacementError, match=r"flow.lag_s: 0.5 s before seam s's output"):
         io_columns(samples, io_config(5.0, 2.0, lag_s=0.5), {"s": 0.1}, speed)
     io_columns(samples, io_config(5.0, 2.0, lag_s=0.2), {"s": 0.1}, speed)  # 20 of 25 mm
+
+
+@pytest.mark.parametrize(
+    ("io", "key"),
+    [
+        ("on: {digital_output: 0}", "tool.process_io.on.digital_output"),
+        ("off: {digital_output: 0}", "tool.process_io.off.digital_output"),
+        ("flow: {analog_output: 0, per_mps: 40.0}", "tool.process_io.flow.analog_output"),
+    ],
+)
+def test_fanuc_ports_start_at_1(tmp_path, io, key):
+    """FANUC's DO[n] and AO[n] count from 1: DO[0] or AO[0] in a program is refused by
+    the controller, so the cell check refuses it (one line naming the key)."""
+    from offline_prog.config.cell import load_cell
+    from offline_prog.config.job_checks import check_process_io
+    from offline_prog.errors import InputError
+
+    text = with_own_io(
+        (CELLS / "seal_plate_kr16.yaml").read_text(), f"tool:\n  process_io:\n    {io}\n"
+    )
+    file = tmp_path / "cell.yaml"
+    file.write_text(text)
+    cell = load_cell(file)
+    with pytest.raises(InputError) as error:
+        check_process_io(file, cell, "fanuc")
+    assert error.value.key == key and "use 1..9999" in error.value.reason
+    check_process_io(file, load_cell(file), "urscript")  # UR counts from 0
+
+
+def test_every_controller_language_numbers_its_outputs():
+    from offline_prog.config.job_checks import OUTPUT_RANGES
+    from offline_prog.robot.model import LANGUAGES
+
+    assert set(OUTPUT_RANGES) == set(LANGUAGES)

@@ -44,6 +44,9 @@ def test_the_printed_url_carries_a_secret_token(live):
     assert code == 403 and "open the URL the session printed" in text
     code, text = live.send("GET", f"/?token={live.token}", headers={"X-Session-Token": None})
     assert code == 200 and "<title>offline_prog session</title>" in text
+    # Its icon is inline: a browser asks no /favicon.ico, which would be refused
+    # without the token (a 403 in the console on every load).
+    assert '<link rel="icon" href="data:,">' in text
 
 
 @pytest.mark.parametrize(

@@ -147,7 +147,9 @@ def test_a_job_plans_the_active_seam_and_exports_the_whole_job(tmp_path):
 @pytest.mark.slow
 def test_a_path_cell_exports_its_one_seam_job(tmp_path):
     """A path: cell's Export writes the folder `plan` writes: the one-seam job, home to
-    home, with the job's files (issue 24: one pipeline whatever the caller)."""
+    home, with the job's files (issue 24: one pipeline whatever the caller). Its values
+    unchanged, it plans the cell file itself into out/<stem>: nothing is written beside
+    the cell (a tape-1.yaml copy landed in cells/ before)."""
     import json
     import shutil
 
@@ -159,9 +161,12 @@ def test_a_path_cell_exports_its_one_seam_job(tmp_path):
     assert session.snapshot()["status"]["line"].startswith("feasible")
     session.action("export")
     run_until(session, lambda: session.snapshot()["exported"] is not None)
-    folder = tmp_path / "out" / "tape-1"
+    folder = tmp_path / "out" / "tape"
     assert (folder / "job.npz").exists() and (folder / "clearance.csv").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["data", "out", "tape.yaml"]
+    assert session.snapshot()["saved"] is None
     report = json.loads((folder / "report.json").read_text())
+    assert report["cell"] == str(cell)
     kinds = [s["segment"] for s in report["job"]["segments"]]
     assert kinds == ["link", "approach:seam", "process:seam", "retract:seam", "link"]
     assert report["trajectory"]["duration_s"] < report["job"]["cycle_time_s"]

@@ -3,8 +3,11 @@ real browser (software WebGL), an animation as long as the plan, and the preview
 command; plus a plan that fails its collision check."""
 
 import json
+import os
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -15,6 +18,7 @@ from offline_prog.viz.preview import show_plan
 
 from browser import WEBGL_ARGS, keep_artifact, require_chromium, screenshot
 from conftest import CELLS, REPO
+from live_session import free_port_pair
 
 
 @pytest.fixture(scope="module")
@@ -113,6 +117,41 @@ def test_preview_command_serves_and_exits(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert "MeshCat preview at http://localhost:7077" in done.stdout
+
+
+@pytest.mark.slow
+def test_ctrl_c_ends_the_preview_with_130():
+    """Ctrl-C ends ``preview`` as it ends every other command: exit 130, one line (it
+    was exit 0, so a script could not tell a stopped preview from a finished one)."""
+    port = free_port_pair()
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "offline_prog",
+            "preview",
+            str(CELLS / "tape_cylinder_ur10e.yaml"),
+            "--port",
+            str(port),
+        ],
+        cwd=REPO,
+        env={**os.environ, "PYTHONPATH": str(REPO), "PYTHONUNBUFFERED": "1"},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        line = process.stdout.readline()
+        assert f"MeshCat preview at http://localhost:{port}" in line, process.stderr.read()
+        time.sleep(1.0)  # serving: Ctrl-C as a user presses it, not during the print
+        process.send_signal(signal.SIGINT)
+        code = process.wait(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert code == 130
+    assert process.stderr.read().strip().splitlines() == ["interrupted"]
 
 
 @pytest.mark.slow

@@ -1,7 +1,9 @@
-"""STEP parts built with Open CASCADE in the tests, with their exact seams.
+"""STEP parts built with Open CASCADE, with their exact seams: for the tests (tests/cad)
+and scripts/cad_accuracy.py.
 
 Each builder returns the solid; the tests write it to STEP, read it back through the
-cell file and compare the planned seam with the analytic edge. Lengths in mm.
+cell file and compare the planned seam with the analytic edge (the ``*_profile`` and
+``rounded_rectangle`` truths below). Lengths in mm.
 """
 
 from __future__ import annotations
@@ -138,3 +140,52 @@ def cad_cell(tmp_path: Path, model: str, seams: list[dict], **part) -> Path:
     file = tmp_path / "cell.yaml"
     file.write_text(text)
     return file
+
+
+def sampled(fit, spacing_m=2e-4):
+    """Points [mm] and unit normals of the fitted seam every 0.2 mm."""
+    s = np.linspace(0.0, fit.path.length, int(fit.path.length / spacing_m) + 1)
+    n = fit.normal(s)[0]
+    return fit.path(s, 0)[0] * 1e3, n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def angle_deg(a, b):
+    return np.rad2deg(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.sum(a * b, axis=1)))
+
+
+def rounded_rectangle(p_mm, z):
+    """Distance [mm] to the plate's rounded outline at height z, and the outline's
+    outward normal (horizontal) at the nearest point."""
+    half = np.array(PLATE[:2]) / 2
+    q = np.abs(p_mm[:, :2] - half) - (half - PLATE_R)
+    outside = np.maximum(q, 0.0)
+    sdf = np.linalg.norm(outside, axis=1) + np.minimum(q.max(axis=1), 0.0) - PLATE_R
+    grad = np.where(
+        (q > 0).all(axis=1)[:, None],
+        outside / np.linalg.norm(outside, axis=1, keepdims=True).clip(1e-12),
+        np.eye(2)[np.argmax(q, axis=1)],
+    ) * np.sign(p_mm[:, :2] - half)
+    normal = np.column_stack([grad, np.zeros(len(grad))])
+    return np.hypot(sdf, p_mm[:, 2] - z), normal
+
+
+def bracket_profile(p_mm):
+    """Distance [mm] to the bracket's inner profile at y = 0 (top of the horizontal leg,
+    the R10 fillet, the inside of the vertical leg) and its outward normal there."""
+    x, z = p_mm[:, 0], p_mm[:, 2]
+    centre = 10.0 + BRACKET_R
+    on_line_h = np.hypot(np.hypot(np.clip(x, centre, None) - x, z - 10.0), p_mm[:, 1])
+    on_line_v = np.hypot(np.hypot(x - 10.0, np.clip(z, centre, None) - z), p_mm[:, 1])
+    radial = np.column_stack([x - centre, z - centre])
+    r = np.linalg.norm(radial, axis=1)
+    in_arc = (x <= centre) & (z <= centre)
+    on_arc = np.where(in_arc, np.hypot(r - BRACKET_R, p_mm[:, 1]), np.inf)
+    d = np.min([on_line_h, on_line_v, on_arc], axis=0)
+    which = np.argmin([on_line_h, on_line_v, on_arc], axis=0)
+    towards_centre = -radial / r[:, None]
+    normal = np.select(
+        [which[:, None] == 0, which[:, None] == 1],
+        [np.array([[0.0, 0.0, 1.0]]), np.array([[1.0, 0.0, 0.0]])],
+        np.column_stack([towards_centre[:, 0], np.zeros(len(r)), towards_centre[:, 1]]),
+    )
+    return d, normal
