@@ -31,7 +31,7 @@ from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, n
 from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn, smooth_turn_of
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model

@@ -13,7 +13,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from offline_prog.plan import StageTimer, plan_loaded_job
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 from offline_prog.results.timing_bound import timing_bound_report
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
