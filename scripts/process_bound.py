@@ -61,7 +61,7 @@ def bead_figures(job) -> dict[str, tuple[float, float]]:
         v, e = job.tcp_speed[rows], error[rows]
         length = v * np.gradient(samples.t[rows])
         within = np.nan_to_num(e, nan=np.inf) <= model.tolerance
-        worst = float(e[v >= CRUISE_SHARE * option.plan.cell.motion.speed].max())
+        worst = float(e[v >= CRUISE_SHARE * option.plan.process_speed.v_m_s].max())
         out[option.name] = (worst, float(length[within].sum() / length.sum()))
     return out
 

@@ -52,7 +52,7 @@ def worst_bead_error(job) -> dict[str, float]:
     for option in job.chosen:
         segment = next(g for g in samples.segments if g.kind == "process" and g.seam == option.name)
         rows = slice(segment.start, segment.stop)
-        cruising = job.tcp_speed[rows] >= CRUISE_SHARE * option.plan.cell.motion.speed
+        cruising = job.tcp_speed[rows] >= CRUISE_SHARE * option.plan.process_speed.v_m_s
         worst[option.name] = float(error[rows][cruising].max())
     return worst
 
