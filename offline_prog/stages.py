@@ -20,6 +20,7 @@ from offline_prog.config.calibration_keys import check_controller_frames
 from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
+from offline_prog.config.process_speed import ProcessSpeed, process_speed
 from offline_prog.config.robot_search import find_robot, search_path
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
 from offline_prog.errors import InputError
@@ -32,12 +33,12 @@ from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, n
 from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn, smooth_turn_of
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.time_law import Sin2TimeLaw, sin2_time_law
+from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
 # Grid spacing for the checks of the fitted path [m] and the largest tangent turn
@@ -60,6 +61,8 @@ class Inputs:
     X_IB: RigidTransform  # robot base B in I
     X_IT: RigidTransform  # fixed tool T in I
     X_PE: RigidTransform  # flange E in the part P
+    # The seam's process speed (config.process_speed); None for a job's (seams:) inputs.
+    speed: ProcessSpeed | None = None
     # The process model's caps on the process stretch's time law (process.timing_bound);
     # False plans under the user's caps alone (the trade-off's comparison).
     process_bound: bool = True
@@ -104,6 +107,7 @@ def load_inputs(file: Path, robots_dir: Path) -> Inputs:
         transform(cell.robot.X_IB),
         transform(cell.tool.X_IT),
         transform(cell.part.X_PE),
+        process_speed(cell, 0) if cell.path is not None else None,
     )
 
 
@@ -235,29 +239,31 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         inputs.X_IB,
         run.flange,
         run.parameter,
-        run.nominal,
+        run.limits,
         rate_hz=motion.sample_rate_hz,
         branch=branch,
         time_law=motion.time_law,
         process=motion.process,
         process_caps=run.caps,
     )
-    return Attempt(rotation, run.flange, run.nominal, joints, None)
+    return Attempt(rotation, run.flange, run.limits, joints, None)
 
 
 @dataclasses.dataclass(frozen=True)
 class MotionSetup:
     """What :func:`plan_motion` runs on: the flange path as run (cusps smoothed when
-    ``motion.cusp_smoothing_mm`` is set), σ ↦ s, the path caps and the nominal law."""
+    ``motion.cusp_smoothing_mm`` is set), σ ↦ s, the process model's caps and the
+    path's limits (the seam's process speed, the caps, the robot's joint limits; their
+    nominal law is built once, ``PathLimits.nominal``)."""
 
     flange: FlangePath | SmoothedFlangePath
     parameter: TimeLawParameter
     caps: ProcessCaps
-    nominal: Sin2TimeLaw
+    limits: PathLimits
 
 
 def motion_setup(inputs: Inputs, flange) -> MotionSetup:
-    """The flange path as run, its parameter, caps and nominal law (:class:`MotionSetup`).
+    """The flange path as run, its parameter, caps and limits (:class:`MotionSetup`).
 
     Raises:
         InputError: ``motion.cusp_smoothing_mm`` that does not fit the path, or a plan of
@@ -270,25 +276,27 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
         except ValueError as error:
             raise InputError(inputs.file, "motion.cusp_smoothing_mm", str(error)) from None
     parameter = TimeLawParameter(flange, motion.speed_reference)
+    speed = inputs.speed.v_m_s
     caps = process_caps(
         process_model(inputs.cell.process) if inputs.process_bound else None,
-        v_process=motion.speed,
+        v_process=speed,
         a_max=motion.max_acceleration,
         j_max=motion.max_jerk,
     )
-    nominal = sin2_time_law(
-        parameter.length, v_max=motion.speed, a_max=caps.a_max, j_max=caps.j_max
+    limits = PathLimits.of(
+        inputs.robot, parameter.length, v_process=speed, a_max=caps.a_max, j_max=caps.j_max
     )
+    nominal = limits.nominal
     samples = nominal.duration * max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ)
     if samples > MAX_SAMPLES:  # memory: every sample holds poses, joints, distances
         raise InputError(
             inputs.file,
             "motion",
             f"{nominal.duration:.0f} s at {max(motion.sample_rate_hz, LIMIT_CHECK_RATE_HZ):g} Hz"
-            f" is {samples:,.0f} samples, more than {MAX_SAMPLES:,}; raise motion.speed or "
-            "lower motion.sample_rate_hz",
+            f" is {samples:,.0f} samples, more than {MAX_SAMPLES:,}; raise "
+            f"{inputs.speed.key} or lower motion.sample_rate_hz",
         )
-    return MotionSetup(flange, parameter, caps, nominal)
+    return MotionSetup(flange, parameter, caps, limits)
 
 
 def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:

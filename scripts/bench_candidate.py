@@ -30,8 +30,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_table
 
 from bench_table import place_batch  # noqa: E402
 
-from offline_prog.joints import path_timing  # noqa: E402
 from offline_prog.placement.engine import SerialEngine  # noqa: E402
+from offline_prog.timing import path_timing  # noqa: E402
 
 # (label, module path suffix, function): the stages of a job candidate, nested as
 # they call each other (``plan.plan_loaded_job``), then what runs inside several.

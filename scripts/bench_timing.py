@@ -12,7 +12,7 @@ cell (both intents), and TOPP-RA's own duration without the jerk stage. Prints
   of the commanded speed (≥ 90 % where the speed is feasible);
 - the largest joint velocity, acceleration and jerk use on trajectory.csv, by finite
   differences of its qd columns (≤ 1.01);
-- the solve time of the whole time-optimal law (``joints.path_timing``: TOPP-RA, the
+- the solve time of the whole time-optimal law (``timing.path_timing``: TOPP-RA, the
   jerk stage, the averaged profile where it may win) on a 5,000-sample path, per
   intent (< 100 ms), and of TOPP-RA alone.
 """
@@ -69,7 +69,7 @@ def csv_limit_use(plan) -> tuple[float, float, float]:
 def held_share(plan) -> float:
     """Share of the path length where the TCP speed is within ±HOLD of the command."""
     tr = plan.trajectory
-    v = plan.cell.motion.speed
+    v = plan.process_speed.v_m_s
     held = np.abs(tr.tcp_speed - v) <= HOLD * v
     ds = np.abs(np.diff(tr.s))
     return float(np.sum(ds * (held[1:] & held[:-1])) / np.sum(ds))
@@ -82,7 +82,7 @@ def held_where_feasible(plan) -> tuple[float, float]:
     robot, tr, motion = plan.robot, plan.trajectory, plan.cell.motion
     hold = SpeedHold(
         path_rates(plan, 5000),
-        v_process=motion.speed,
+        v_process=plan.process_speed.v_m_s,
         a_max=motion.max_acceleration,
         j_max=motion.max_jerk,
         limits=(robot.qd_max, robot.qdd_max, robot.jerk_limits),
@@ -109,22 +109,25 @@ def path_rates(plan, n: int) -> JointRates:
 
 def solve_time_5000(plan) -> tuple[float, float, float]:
     """(best wall time [s] of TOPP-RA alone, of the whole time-optimal law for
-    constant_speed, for cycle_time): ``path_timing`` as the plan runs it (TOPP-RA,
+    constant_speed, for cycle_time): ``time_path`` as the plan runs it (TOPP-RA,
     the jerk stage, the averaged profile where it may win) on rates resampled to
     5,000 samples of the plan's path; best of 5."""
-    from offline_prog.joints.path_timing import PathLimits, time_path
-    from offline_prog.timing.time_law import sin2_time_law
+    from offline_prog.timing.path_timing import PathLimits, time_path
 
     robot, motion = plan.robot, plan.cell.motion
     rates = path_rates(plan, 5000)
-    nominal = sin2_time_law(
-        rates.sigma[-1], v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+    limits = PathLimits.of(
+        robot,
+        rates.sigma[-1],
+        v_process=plan.process_speed.v_m_s,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
     )
     best = {}
     for _ in range(5):
         for process in ("constant_speed", "cycle_time"):
             start = time.perf_counter()
-            timing = time_path(rates, PathLimits.of(robot, nominal), "time_optimal", process)
+            timing = time_path(rates, limits, "time_optimal", process)
             elapsed = time.perf_counter() - start
             best[process] = min(best.get(process, np.inf), elapsed)
             assert timing.feasible
@@ -132,7 +135,7 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
             rates,
             qd_max=robot.qd_max,
             qdd_max=robot.qdd_max,
-            v_cap=motion.speed,
+            v_cap=plan.process_speed.v_m_s,
             a_path=motion.max_acceleration,
         )
         best["topp"] = min(best.get("topp", np.inf), profile.solve_s)
@@ -166,7 +169,7 @@ def bench_timing(cells: list[str] = ONE_SEAM_CELLS) -> None:
         fast = plan_with(inputs, scene, time_law="time_optimal", process="cycle_time")
         topp = held.joints.retiming.topp_plain_s
         topp_jerk = held.joints.retiming.topp.duration  # with the steady jerk limit
-        print(f"\n{name}: path {held.path.length * 1e3:.0f} mm at {inputs.cell.motion.speed} m/s")
+        print(f"\n{name}: path {held.path.length * 1e3:.0f} mm at {inputs.speed.v_m_s} m/s")
         print(
             f"  {'law':<28} {'cycle [s]':>9} {'/TOPP-RA':>9} {'/sin²':>7} {'held ±0.5%':>11} "
             f"{'vel use':>8} {'acc use':>8} {'jerk use':>8}"

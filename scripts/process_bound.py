@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.plan import StageTimer, plan_loaded_job
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 from offline_prog.results.timing_bound import timing_bound_report
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
@@ -61,7 +61,7 @@ def bead_figures(job) -> dict[str, tuple[float, float]]:
         v, e = job.tcp_speed[rows], error[rows]
         length = v * np.gradient(samples.t[rows])
         within = np.nan_to_num(e, nan=np.inf) <= model.tolerance
-        worst = float(e[v >= CRUISE_SHARE * option.plan.cell.motion.speed].max())
+        worst = float(e[v >= CRUISE_SHARE * option.plan.process_speed.v_m_s].max())
         out[option.name] = (worst, float(length[within].sum() / length.sum()))
     return out
 

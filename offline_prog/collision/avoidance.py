@@ -25,7 +25,7 @@ from offline_prog.joints.joint_plan import JointTrajectory
 from offline_prog.path.bspline_fit import fit_on_knots, open_knots
 from offline_prog.path.cusps import SmoothedFlangePath
 from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.timing.time_law import Sin2TimeLaw
+from offline_prog.timing.path_timing import PathLimits
 
 GRID_POINTS = 80  # IK samples along the path
 CLEARANCE_MARGIN_M = 2e-3  # asked of the IK beyond the clearance
@@ -169,7 +169,7 @@ class Attempt:
 
     rotation: float  # the tool's turn about its symmetry axis [rad]
     flange: FlangePath | SmoothedFlangePath
-    nominal: Sin2TimeLaw  # the process law without joint limits
+    limits: PathLimits  # the process speed, caps and joint limits (their nominal law)
     joints: JointTrajectory
     collisions: CollisionResult | None
 

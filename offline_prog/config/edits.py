@@ -17,6 +17,7 @@ from pydrake.common.schema import Rotation, Transform
 from pydrake.math import RollPitchYaw
 
 from offline_prog.config.cell import Cell, transform
+from offline_prog.config.process_speed import chosen_speed
 
 ROUND_DEG = 9  # decimals kept of angles read from a rotation that is not an Rpy
 
@@ -49,9 +50,8 @@ class CellValues:
 
     @property
     def speed(self) -> float:
-        """The active seam's process speed [m/s]."""
-        own = self.seam_speeds[self.seam]
-        return self.motion_speed if own is None else own
+        """The active seam's process speed [m/s] (config.process_speed's choice)."""
+        return chosen_speed(self.motion_speed, self.seam_speeds, self.seam).v_m_s
 
 
 def rpy_deg_of(value: Transform) -> tuple[float, float, float]:

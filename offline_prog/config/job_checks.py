@@ -10,6 +10,7 @@ from offline_prog.config.cell import Cell, JobConfig, SeamConfig
 from offline_prog.config.names import name_pattern
 from offline_prog.constants import MAX_SPEED_M_S
 from offline_prog.errors import InputError
+from offline_prog.process.registry import MODELS
 
 DIRECTIONS = ("forward", "reverse", "auto")
 APPROACH_KINDS = ("normal", "tangent", "none")
@@ -83,12 +84,13 @@ def check_job(file: Path, cell: Cell) -> None:
             raise _error(file, "tool.process_io.off.digital_output", "must equal on's")
         if io.flow is not None and not io.flow.min < io.flow.max:
             raise _error(file, "tool.process_io.flow", "needs min < max")
-        bead = cell.process is not None and cell.process.model == "bead"
-        if io.flow is not None and io.flow.per_mps is None and not bead:
+        model = None if cell.process is None else MODELS.get(cell.process.model)
+        if io.flow is not None and io.flow.per_mps is None and not (model and model.sets_flow):
+            setters = " or ".join(f"process.{name}" for name, m in MODELS.items() if m.sets_flow)
             raise _error(
                 file,
                 "tool.process_io.flow.per_mps",
-                "missing: the flow's V per m/s (or a process.bead model that sets it)",
+                f"missing: the flow's V per m/s (or a {setters} model that sets it)",
             )
         if io.flow is not None and io.flow.per_mps is not None and not io.flow.per_mps > 0:
             raise _error(
@@ -145,12 +147,13 @@ def _check_leads(file: Path, cell: Cell, io) -> None:
 
 def check_process_io(file: Path, cell: Cell, language: str | None) -> None:
     """The process output numbers exist on the robot's controller (``OUTPUT_RANGES``):
-    ``tool.process_io``'s and the tape heater's ``power_output``."""
+    ``tool.process_io``'s and those the process model's keys name (the tape heater's
+    ``power_output``)."""
     io = cell.tool.process_io
     outputs = [] if io is None else [(f"tool.process_io.{n}", getattr(io, n)) for n in IO_PARTS]
-    tape = cell.process.tape_heating if cell.process is not None else None
-    if tape is not None and cell.process.model == "tape_heating":
-        outputs.append(("process.tape_heating.power_output", tape.power_output))
+    if cell.process is not None:
+        model = MODELS[cell.process.model]
+        outputs += model.controller_outputs(getattr(cell.process, model.name))
     ranges = OUTPUT_RANGES.get(language, {"digital_output": (0, 9999), "analog_output": (0, 9999)})
     for key, part in outputs:
         if part is None:

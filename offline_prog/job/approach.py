@@ -184,7 +184,7 @@ def seam_ends(
                 R_PE=R_PE,
                 q_seam=q_ends[i],
                 branch=branch,
-                speed=motion.speed,
+                speed=inputs.speed.v_m_s,
                 a_max=motion.max_acceleration,
                 j_max=motion.max_jerk,
                 rate_hz=motion.sample_rate_hz,

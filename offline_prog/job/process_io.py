@@ -17,11 +17,10 @@ import dataclasses
 import numpy as np
 
 from offline_prog.config.cell import ProcessIoConfig
-from offline_prog.config.process_keys import ProcessConfig
 from offline_prog.errors import TravellingError
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import JobSamples
-from offline_prog.process.model import process_model, speed_output
+from offline_prog.process.protocol import ProcessModel
 
 POSITION_TOL_M = 1e-6  # a switch this close to the approach's start or retract's end
 
@@ -51,11 +50,13 @@ class IoPlacementError(TravellingError, ValueError):
         super().__init__(f"{key}: {reason}")
 
 
-def process_io_settings(io: ProcessIoConfig | None, process=None) -> ProcessIo | None:
+def process_io_settings(
+    io: ProcessIoConfig | None, model: ProcessModel | None = None
+) -> ProcessIo | None:
     """The cell's ``tool.process_io`` in SI units, with the speed-following output the
-    process model sets (``process:``, process.model.speed_output: the bead's flow gain
-    and lead, the tape heater's power output); None: no process I/O."""
-    fields = speed_output(process_model(process), process)
+    process model sets (its ``speed_output``: the bead's flow gain and lead, the tape
+    heater's power output); None: no process I/O."""
+    fields = {} if model is None else model.speed_output()
     if io is None and not fields:
         return None
     flow = None if io is None else io.flow
@@ -81,7 +82,7 @@ def io_columns(
     io: ProcessIoConfig | None,
     lengths_m: dict[str, float],
     tcp_speed,
-    process: ProcessConfig | None = None,
+    model: ProcessModel | None = None,
 ) -> IoColumns:
     """The process output's state and the flow command on every row, and the events.
 
@@ -90,7 +91,7 @@ def io_columns(
         io: ``tool.process_io`` (None: no I/O).
         lengths_m: each seam's path length L [m] by name.
         tcp_speed: (N,) speed of the tool along the part [m/s].
-        process: the cell's ``process:`` (its model may set the speed-following output).
+        model: the cell's process model (it may set the speed-following output).
 
     Raises:
         IoPlacementError: on a seam, the output goes off before it goes on, either
@@ -98,7 +99,7 @@ def io_columns(
             is never on while the seam runs (one line naming the seam and both
             positions); or the flow's lag leads its start before the approach.
     """
-    settings = process_io_settings(io, process)
+    settings = process_io_settings(io, model)
     if settings is None:
         return IoColumns(None, None, [])
     t = samples.t
@@ -134,7 +135,7 @@ def io_columns(
         if flowing:
             if times[0] - lag < t_seam[0] - 1e-9:  # a program sets it on the approach
                 raise IoPlacementError(
-                    _lag_key(process),
+                    _lag_key(model),
                     f"{lag:g} s before seam {seam}'s output goes on is before its approach "
                     f"starts ({times[0] - t_seam[0]:.3f} s earlier): a longer approach or "
                     "on.lead_mm leaves the flow room to lead",
@@ -167,10 +168,11 @@ def io_columns(
     return IoColumns(digital, analog, events, settings)
 
 
-def _lag_key(process: ProcessConfig | None) -> str:
-    """The key that sets the flow's lead: the bead model's lag, else the flow's own."""
-    bead = process is not None and process.model == "bead"
-    return "process.bead.lag_s" if bead else "tool.process_io.flow.lag_s"
+def _lag_key(model: ProcessModel | None) -> str:
+    """The key that sets the flow's lead: the process model's (a bead's lag), else the
+    flow's own."""
+    own = None if model is None else model.lag_key
+    return own or "tool.process_io.flow.lag_s"
 
 
 def _check_gate(seam: str, gate: tuple[float, float], path: np.ndarray, length: float) -> None:

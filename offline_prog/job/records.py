@@ -15,6 +15,7 @@ import numpy as np
 from offline_prog.collision.avoidance import Attempt
 from offline_prog.collision.check import CollisionResult
 from offline_prog.config.cell import Cell
+from offline_prog.config.process_speed import ProcessSpeed
 from offline_prog.errors import Failure
 from offline_prog.job.approach import CartesianMove
 from offline_prog.job.assemble import JobSamples
@@ -22,7 +23,6 @@ from offline_prog.job.links import LinkMotion
 from offline_prog.job.order import JobOrder
 from offline_prog.job.process_io import IoColumns
 from offline_prog.joints.joint_plan import JointTrajectory
-from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
@@ -32,6 +32,7 @@ from offline_prog.path.sources import PathPoints
 from offline_prog.process.quality import ProcessQuality
 from offline_prog.robot.model import RobotModel
 from offline_prog.stages import FittedPath, FlangePaths, Inputs
+from offline_prog.timing.path_timing import without_joint_limits
 from offline_prog.timing.trajectory import WorkspaceTrajectory
 
 
@@ -57,6 +58,9 @@ class Plan:
     # (t_k, {pair group: smallest distance [m]}) for the distance-over-time plot.
     clearance_profile: tuple | None = None
     normal_fit: NormalFit | None = None  # given normals vs the fitted normal field
+    # The seam's process speed, as its time law ran it (the seam's cell keeps the
+    # cell's motion.speed: a seam's own speed is here alone).
+    process_speed: ProcessSpeed | None = None
 
     @classmethod
     def of_attempt(
@@ -83,12 +87,13 @@ class Plan:
             timings_s,
             inputs.robot,
             chosen.joints,
-            without_joint_limits(chosen.nominal, inputs.cell.motion.time_law)[0],
+            without_joint_limits(chosen.limits.nominal, inputs.cell.motion.time_law)[0],
             chosen.rotation,
             chosen.collisions,
             avoidance,
             clearance_profile,
             fit.normal_fit,
+            inputs.speed,
         )
 
     @property

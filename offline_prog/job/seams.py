@@ -4,8 +4,10 @@ A cell gives either ``path:`` (one seam, the shorthand) or ``seams:``; each seam
 processing path (every key of ``path:``) with a name, a direction, an optional own
 speed, and its approach and retract. :func:`seam_inputs` turns seam k into the
 :class:`~offline_prog.stages.Inputs` of the single-seam stages (paper §§2–4): the cell
-with ``path`` set to the seam and ``motion.speed`` to the seam's speed, its points in
-the direction asked. Errors those stages raise about ``path.*`` name ``seams[k].*``.
+with ``path`` set to the seam, its points in the direction asked, and its process speed
+(``config.process_speed``: the one choice of ``seams[k].speed`` or ``motion.speed``;
+the seam's cell keeps ``motion.speed`` as the cell gives it). Errors those stages raise
+about ``path.*`` name ``seams[k].*``.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.config.cell import Cell, JobConfig, PathConfig, SeamConfig
+from offline_prog.config.process_speed import process_speed
 from offline_prog.errors import InputError
 from offline_prog.path.inputs import load_points
 from offline_prog.path.sources import PathPoints
@@ -78,18 +81,12 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
     fields = {f.name: getattr(seam, f.name) for f in dataclasses.fields(PathConfig)}
     if cell.seams and seam.points and seam.csv_seam is None and _has_seam_column(job.file, seam):
         fields["csv_seam"] = seam.name  # a CSV of several seams: this seam's rows
-    speed = seam.speed if seam.speed is not None else cell.motion.speed
-    seam_cell = dataclasses.replace(
-        cell,
-        path=PathConfig(**fields),
-        seams=[],
-        motion=dataclasses.replace(cell.motion, speed=speed),
-    )
+    seam_cell = dataclasses.replace(cell, path=PathConfig(**fields), seams=[])
     with errors_named_for(seam_key(cell, k)):
         points = load_points(job.file, seam_cell)
     if reverse:
         points = reversed_points(points)
-    return dataclasses.replace(job, cell=seam_cell, points=points)
+    return dataclasses.replace(job, cell=seam_cell, points=points, speed=process_speed(cell, k))
 
 
 def _has_seam_column(file, seam: SeamConfig) -> bool:

@@ -20,7 +20,6 @@ from offline_prog.job.approach import other_branches, plan_ends
 from offline_prog.job.assemble import JobSamples, Piece, lay_out
 from offline_prog.job.links import LinkMotion, plan_link, timed_polyline
 from offline_prog.job.process_io import IoColumns, IoPlacementError, io_columns
-from offline_prog.job.process_speed import check_speed_bands
 from offline_prog.job.records import SeamOption
 from offline_prog.job.seams import (
     errors_named_for,
@@ -29,14 +28,15 @@ from offline_prog.job.seams import (
     seam_inputs,
     seam_key,
 )
+from offline_prog.job.speed_band import check_speed_bands
 from offline_prog.job.untimed import (
     MAX_OTHER_BRANCHES,
     SeamChoices,
     TimedOrder,
     untimed_options,
 )
-from offline_prog.process.model import process_model
 from offline_prog.process.quality import ProcessQuality, process_quality
+from offline_prog.process.registry import process_model
 from offline_prog.progress import Step
 from offline_prog.scene.drake_cell import DrakeCell
 from offline_prog.stages import Inputs, attempt_motion
@@ -55,7 +55,7 @@ def seam_options(inputs: Inputs, scene: DrakeCell, plan_seam, progress) -> SeamC
 
     Raises:
         InputError: naming ``seams[k].<key>`` (a process speed outside the process
-            model's speed band: ``job.process_speed``).
+            model's speed band: ``job.speed_band``).
         PlanFailedError: a seam cannot be done in any direction (its reason, named).
     """
     check_speed_bands(inputs)
@@ -268,7 +268,11 @@ def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
     process_io = inputs.cell.tool.process_io
     try:
         return io_columns(
-            linked.samples, process_io, lengths, linked.tcp_speed, inputs.cell.process
+            linked.samples,
+            process_io,
+            lengths,
+            linked.tcp_speed,
+            process_model(inputs.cell.process),
         )
     except IoPlacementError as error:
         raise InputError(inputs.file, error.key, error.reason) from None

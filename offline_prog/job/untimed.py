@@ -135,7 +135,7 @@ def _untimed(
     verdict = check_trajectory(
         scene,
         chosen.q,
-        grid / motion.speed,  # only labels the verdict's stretches
+        grid / inputs.speed.v_m_s,  # only labels the verdict's stretches
         grid,
         clearance=motion.clearance,
         self_clearance=motion.self_clearance,
@@ -258,7 +258,7 @@ def _time_pending(inputs, scene, seam_planner, options, errors, pending, progres
 def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
     """Seam k's ``options`` with option j timed: (the options, whether they are the same
     ones as before). Another branch is timed on its direction's first flange path as
-    run, and its plan holds that path and nominal law as the first's does."""
+    run, and its plan holds that path and its limits as the first's does."""
     option = options[j]
     first = next(i for i, o in enumerate(options) if o.reverse == option.reverse)
     if j == first:
@@ -276,7 +276,7 @@ def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
         return options[:j] + options[j + 1 :], False
     if options[first].plan is None:
         run = motion_setup(u.inputs, options[first].untimed.flange)  # the first's, as run
-        as_first = dataclasses.replace(attempt, flange=run.flange, nominal=run.nominal)
+        as_first = dataclasses.replace(attempt, flange=run.flange, limits=run.limits)
         plan = Plan.of_attempt(u.inputs, u.fit, u.frames, as_first, timings_s=timer.timings_s)
     else:
         plan = dataclasses.replace(

@@ -28,12 +28,12 @@ from offline_prog.joints.path_ik import (
     choose_branch,
     singularity_distances,
 )
-from offline_prog.joints.path_timing import PathLimits, PathTiming, time_path
 from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.robot.jacobian import joint_path_rates, urdf_chain
 from offline_prog.robot.kinematics_opw import wrap_to_pi
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.path_timing import PathLimits, PathTiming, time_path
 from offline_prog.timing.time_law import Sin2TimeLaw
 from offline_prog.timing.trajectory import (
     TimeLawParameter,
@@ -229,7 +229,7 @@ def plan_joint_trajectory(
     X_IB,
     flange,
     parameter: TimeLawParameter,
-    nominal: Sin2TimeLaw,
+    limits: PathLimits,
     *,
     rate_hz: float,
     branch: int | None = None,
@@ -244,27 +244,28 @@ def plan_joint_trajectory(
         X_IB: robot base in I.
         flange: the flange path X_IE(s).
         parameter: σ ↦ s for the time law's speed reference.
-        nominal: the process time law (before joint limits).
+        limits: the path's process speed and caps and the robot's joint limits (its
+            ``nominal`` law: the process time law before joint limits).
         rate_hz: output sample rate.
         branch: use this analytic branch (if feasible) instead of the best one.
         time_law: TimeLaw.TIME_OPTIMAL (TOPP-RA, then the jerk stage) or TimeLaw.SIN2
             (the paper's law, plateaus lowered where the joints need it).
         process: the time-optimal intent (ProcessIntent).
-        process_caps: the caps ``nominal`` runs under (``process.timing_bound``); where
+        process_caps: the caps ``limits`` hold (``process.timing_bound``); where
             they are below the user's, the same path is timed under the user's caps
             too, for the trade-off in cycle time (``JointTrajectory.unbounded_s``).
     """
     grid, results, chosen, path = path_branches(robot, X_IB, flange, parameter, branch)
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
-        raise JointPlanError(sigma, _time_at(nominal, sigma), chosen.reason, chosen.kind)
+        raise JointPlanError(sigma, _time_at(limits.nominal, sigma), chosen.reason, chosen.kind)
     rates = path.rates(grid, chosen.q)
     # Speed and acceleration limits hold for the controller's joints (a linear map).
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
     retiming, controller = verified_timing(
-        lambda rates: time_path(rates, PathLimits.of(robot, nominal), time_law, process),
+        lambda rates: time_path(rates, limits, time_law, process),
         controller,
         path,
         robot,
@@ -284,7 +285,7 @@ def plan_joint_trajectory(
     unbounded_s = None
     if process_caps is not None and process_caps.bounded:
         unbounded = dataclasses.replace(
-            PathLimits.of(robot, nominal),
+            limits,
             a_max=process_caps.user_a_max,
             j_max=process_caps.user_j_max,
         )

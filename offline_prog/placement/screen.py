@@ -101,5 +101,5 @@ def speed_limited_time(seam: SeamView, q: np.ndarray) -> float:
     with np.errstate(divide="ignore"):
         by_speed = np.min(robot.qd_max / np.abs(d1), axis=1)
         by_acceleration = np.min(np.sqrt(robot.qdd_max / np.abs(d2)), axis=1)
-    v = np.minimum(seam.inputs.cell.motion.speed, np.minimum(by_speed, by_acceleration))
+    v = np.minimum(seam.inputs.speed.v_m_s, np.minimum(by_speed, by_acceleration))
     return float(np.sum(ds / v))

@@ -1,7 +1,10 @@
 """What the part gets along the path (the paper's outlook: process quality from a model
 of the process): the bead's cross-section, the weld's heat input, the tape's nip
 temperature, each predicted from the planned speed and the outputs as the programs set
-them. ``model.process_model(cell)`` is the one factory."""
+them. Every model keeps one protocol (``protocol.ProcessModel``: its cell keys and their
+bounds, the quality column, the band, the output schedule, the timing bound);
+``registry.MODELS`` lists them and ``registry.process_model(process)`` is the one
+factory."""
 
 import numpy as np
 

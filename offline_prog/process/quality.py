@@ -1,7 +1,7 @@
 """The process quality along a job: what the part gets on every row, and where it
 leaves the band, with why.
 
-The model (``process.model.process_model``) predicts the quality from the planned TCP
+The model (``process.registry.process_model``) predicts the quality from the planned TCP
 speed and the output as the programs set it (the plan's analog column: for the bead the
 flow command leading by the dispenser's lag, for the tape the heater's power). What is
 dispensed is gated by the process output: the bead's flow and the heater's power reach
@@ -44,16 +44,10 @@ import numpy as np
 
 from offline_prog.constants import STANDSTILL_SPEED_M_S
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
-from offline_prog.process.bead import BeadModel
-from offline_prog.process.heat_input import HeatInputModel
-from offline_prog.process.lag import first_order_response
-from offline_prog.process.tape_heating import TapeHeatingModel
+from offline_prog.process.protocol import SATURATION_TOL, ProcessModel
 
 RAMP_SHARE = 0.99  # of the seam's top speed: below it before the first / after the last time
-SATURATION_TOL = 1e-9  # [output unit]: a clipped output differs from its law by more
 MAX_STRETCHES = 200  # listed in the report per job (the count is always given)
-NAMES = {BeadModel: "bead", HeatInputModel: "heat_input", TapeHeatingModel: "tape_heating"}
-UNITS = {BeadModel: "mm²", HeatInputModel: "kJ/mm", TapeHeatingModel: "°C"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,7 +85,7 @@ class ProcessQuality:
     standstill; the summary of the job and of each seam (by name, in run order); for
     the bead ``uncompensated`` (N,) the same with compensation off (else None)."""
 
-    model: BeadModel | HeatInputModel | TapeHeatingModel
+    model: ProcessModel
     values: np.ndarray
     job: QualitySummary
     seams: dict[str, QualitySummary]
@@ -106,17 +100,16 @@ class ProcessQuality:
         """report.json's ``quality`` (values in ``unit``; positions in m, times in s)."""
         model, scale = self.model, self.model.unit_scale
         low, high = model.band
-        target = model.area_m2 if isinstance(model, BeadModel) else 0.5 * (low + high)
         out = {
-            "model": NAMES[type(model)],
+            "model": model.name,
             "column": model.column,
-            "unit": UNITS[type(model)],
+            "unit": model.unit,
             "band": [low * scale, high * scale],
-            "target": target * scale,
+            "target": model.target * scale,
             **_summary_dict(self.job, scale, stretches=True),
             "seams": {name: _summary_dict(s, scale) for name, s in self.seams.items()},
         }
-        if not isinstance(model, BeadModel):
+        if not model.compares_uncompensated:
             del out["share_within_band_uncompensated"]
             for seam in out["seams"].values():
                 del seam["share_within_band_uncompensated"]
@@ -145,7 +138,7 @@ def _summary_dict(summary: QualitySummary, scale: float, *, stretches: bool = Fa
 
 
 def process_quality(
-    model,
+    model: ProcessModel,
     *,
     t: np.ndarray,
     v_tcp: np.ndarray,
@@ -159,7 +152,7 @@ def process_quality(
     """The quality on every row of a job, per job and per seam.
 
     Args:
-        model: a process model (process.model.process_model).
+        model: a process model (process.registry.process_model).
         t: (N,) job times [s]; v_tcp: (N,) TCP speed along the part [m/s];
             path_m: (N,) position along each seam's path [m] (job.assemble).
         segments: the job's segments (``kind``, ``seam``, ``start``, ``stop``).
@@ -182,7 +175,7 @@ def process_quality(
     low, high = model.band
     inside = dispensing & (values >= low) & (values <= high)
     uncompensated, off_shown = None, None
-    if isinstance(model, BeadModel):
+    if model.compares_uncompensated:
         u_off = _uncompensated_command(t, v, settings, events)
         off_values, off_dispensing = _values(model, t, v, u_off, gate & (seam_of >= 0), settings)
         off_inside = off_dispensing & (off_values >= low) & (off_values <= high)
@@ -203,25 +196,16 @@ def process_quality(
     return ProcessQuality(model, shown, summary(seam_of >= 0), seams, off_shown)
 
 
-def _values(model, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]:
+def _values(model: ProcessModel, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]:
     """(N,) quality [SI] (inf at a standstill) and (N,) dispensing rows among ``on``.
 
     Below the least defined speed a row counts only if the output gives more than its
     law gives at that speed (the bead's lagged flow, the arc): the part then gets it
     without the tool moving. An output that follows the speed to rest (the heater)
     gives a vanishing amount there: not dispensing."""
-    if isinstance(model, HeatInputModel):
-        amount, at_rest = np.ones(len(t)), 0.0
-        values = model.predict(t, v)
-    else:
-        if command is None:
-            raise ValueError(f"process model {NAMES[type(model)]} needs its output's command")
-        values = model.predict(t, v, command)
-        at_rest = float(settings.flow(STANDSTILL_SPEED_M_S))
-        if isinstance(model, BeadModel):
-            amount = first_order_response(t, command, model.lag_s)
-        else:
-            amount = np.asarray(command, float)
+    amount = model.delivered(t, command)
+    values = model.predict(t, v, command)
+    at_rest = model.delivered_at_rest(settings)
     slow = v < STANDSTILL_SPEED_M_S
     dispensing = on & (amount > 0) & ~(slow & (amount <= at_rest + SATURATION_TOL))
     values = np.where(dispensing & slow, np.inf, values)
@@ -245,7 +229,7 @@ def _row_weights(path: np.ndarray, seam_of: np.ndarray) -> np.ndarray:
     return 0.5 * (np.append(ds, 0.0) + np.insert(ds, 0, 0.0))
 
 
-def _cause_rows(model, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
+def _cause_rows(model: ProcessModel, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
     """Per row, the masks the causes are decided from (see the module)."""
     index = np.arange(len(v))
     on = seam_of >= 0
@@ -269,19 +253,12 @@ def _cause_rows(model, v, seam_of, n_seams, settings) -> dict[str, np.ndarray]:
     at_rest = (1.0 - RAMP_SHARE) * top
     from_rest = v[np.minimum(first, len(v) - 1)] <= at_rest
     to_rest = v[np.maximum(last, 0)] <= at_rest
-    saturated = np.zeros(len(v), bool)
-    if not isinstance(model, HeatInputModel):
-        law = settings.offset + settings.per_mps * v
-        limit = settings.max
-        if isinstance(model, TapeHeatingModel):
-            limit = min(limit, model.max_command)
-        saturated = (law > limit + SATURATION_TOL) | (law < settings.min - SATURATION_TOL)
     return {
         "standstill": v < STANDSTILL_SPEED_M_S,
-        "output saturated": saturated,
+        "output saturated": model.saturated(v, settings),
         "start ramp": on & from_rest[seam] & (index < ramp_up_end[seam]),
         "end ramp": on & to_rest[seam] & (index > ramp_down_start[seam]),
-        "lag": np.full(len(v), isinstance(model, BeadModel) and model.lag_s > 0),
+        "lag": np.full(len(v), model.output_lag_s > 0),
         "slowdown": ~at_top,
         "process speed": np.ones(len(v), bool),
     }

@@ -18,19 +18,86 @@ bound; losses lower it.
 To hold the target T*, the power follows the speed, P = ρ c w h v (T* − T_0) / η,
 within [0, P_max]: at the heater's saturation the tape runs cold, and the speed
 above which that happens is :meth:`TapeHeatingModel.speed_band`'s upper end.
+
+The cell keys (``process.tape_heating``) and their bounds: ``width_mm`` (0, 1000] mm
+(tapes are 3–300 mm wide), ``thickness_mm`` (0, 5] mm (the model's thin tape: tapes
+are 0.1–0.3 mm), ``density_kg_m3`` [100, 22600] kg/m³ (osmium, the densest element, is
+22,590; below 100 the unit is likely g/cm³), ``specific_heat_j_kg_k``
+[100, 15000] J/(kg·K) (no solid is below about 110, lead's 129; hydrogen's 14,300 is
+the highest of any substance; below 100 the unit is likely kJ/(kg·K)),
+``absorbed_fraction`` (0, 1], ``ambient_c`` from absolute zero, −273.15 °C,
+``target_c`` a band above ``ambient_c`` up to 1000 °C (thermoplastic tapes are laid at
+200–450 °C; every polymer matrix has burnt long before), ``max_power_w`` (0, 100] kW
+(tape-laying heaters are 1–12 kW), ``power_output.w_per_unit`` (0, 100] kW.
 """
 
-from __future__ import annotations
-
+# No ``from __future__ import annotations``: Drake's typed loader reads the keys'
+# field types as written.
 import dataclasses
+from typing import Self
 
 import numpy as np
 
+from offline_prog.errors import InputError
 from offline_prog.process import per_metre
+from offline_prog.process.key_bounds import at_least, at_most, band, positive
+from offline_prog.process.protocol import SpeedFollowingModel, required_key
+
+ABSOLUTE_ZERO_C = -273.15
+# (low, high, unit, why) of each key with physical bounds beyond being positive.
+BOUNDS = {
+    "width_mm": (None, 1000.0, "mm", "tapes are 3–300 mm wide (is the unit mm?)"),
+    "thickness_mm": (
+        None,
+        5.0,
+        "mm",
+        "the model heats a thin tape through its thickness; tapes are 0.1–0.3 mm (is the unit mm?)",
+    ),
+    "density_kg_m3": (
+        100.0,
+        22600.0,
+        "kg/m³",
+        "osmium, the densest element, is 22,590 kg/m³; a tape is 900–2,000 "
+        "(is the unit kg/m³? 1.55 g/cm³ is 1550 kg/m³)",
+    ),
+    "specific_heat_j_kg_k": (
+        100.0,
+        15000.0,
+        "J/(kg·K)",
+        "no solid is below about 110 J/(kg·K) (lead: 129) and no substance above "
+        "hydrogen's 14,300 (is the unit J/(kg·K)? 1.2 kJ/(kg·K) is 1200)",
+    ),
+    "max_power_w": (None, 1e5, "W", "tape-laying heaters are 1–12 kW (is the unit W?)"),
+}
+MAX_TARGET_C = 1000.0  # thermoplastic tapes are laid at 200–450 °C
+MAX_W_PER_UNIT = 1e5  # [W] per unit of the output: no tape heater is larger
+
+
+@dataclasses.dataclass
+class PowerOutput:
+    analog_output: int = required_key()  # the heater's power command on the controller
+    w_per_unit: float = required_key()  # heater power per unit of the output [W]
+
+
+@dataclasses.dataclass
+class TapeHeatingConfig:
+    """``process.tape_heating``: the cell's keys."""
+
+    width_mm: float = required_key()
+    thickness_mm: float = required_key()
+    density_kg_m3: float = required_key()
+    specific_heat_j_kg_k: float = required_key()
+    absorbed_fraction: float = required_key()  # share of the heater power the tape takes up
+    ambient_c: float = 20.0  # the tape's temperature before the heater
+    target_c: list[float] = required_key()  # nip temperature band [low, high]
+    max_power_w: float = required_key()
+    power_output: PowerOutput = dataclasses.field(
+        default_factory=PowerOutput, metadata={"required": True}
+    )
 
 
 @dataclasses.dataclass(frozen=True)
-class TapeHeatingModel:
+class TapeHeatingModel(SpeedFollowingModel):
     """``process.tape_heating`` in SI units (temperatures in °C).
 
     Attributes:
@@ -41,6 +108,7 @@ class TapeHeatingModel:
         band_c: [low, high] nip temperature [°C]; the target T* is its middle.
         max_power_w: P_max [W].
         w_per_unit: heater power per unit of the output [W].
+        analog_output: the heater's power output on the controller (None: not named).
     """
 
     heat_capacity_j_k_m: float
@@ -49,9 +117,102 @@ class TapeHeatingModel:
     band_c: tuple[float, float]
     max_power_w: float
     w_per_unit: float
+    analog_output: int | None = None
 
+    name = "tape_heating"
+    Keys = TapeHeatingConfig
     column = "nip_temp_c"
+    unit = "°C"
     unit_scale = 1.0
+
+    @classmethod
+    def check_keys(cls, file, keys: TapeHeatingConfig, flow) -> None:
+        key = f"process.{cls.name}"
+        for name in (
+            "width_mm",
+            "thickness_mm",
+            "density_kg_m3",
+            "specific_heat_j_kg_k",
+            "absorbed_fraction",
+            "max_power_w",
+        ):
+            positive(file, f"{key}.{name}", getattr(keys, name))
+        if keys.absorbed_fraction > 1:
+            raise InputError(
+                file,
+                f"{key}.absorbed_fraction",
+                f"must be at most 1, got {keys.absorbed_fraction:g}",
+            )
+        for name, (low, high, unit, why) in BOUNDS.items():
+            if low is not None:
+                at_least(file, f"{key}.{name}", getattr(keys, name), low, unit, why)
+            at_most(file, f"{key}.{name}", getattr(keys, name), high, unit, why)
+        at_least(
+            file,
+            f"{key}.ambient_c",
+            keys.ambient_c,
+            ABSOLUTE_ZERO_C,
+            "°C",
+            "nothing is colder than absolute zero",
+        )
+        band(file, f"{key}.target_c", keys.target_c, positive=False)
+        if not keys.target_c[0] > keys.ambient_c:
+            raise InputError(
+                file, f"{key}.target_c", f"must lie above ambient_c {keys.ambient_c:g} °C"
+            )
+        at_most(
+            file,
+            f"{key}.target_c",
+            keys.target_c[1],
+            MAX_TARGET_C,
+            "°C",
+            "thermoplastic tapes are laid at 200–450 °C; every polymer matrix has burnt "
+            "long before 1000 °C",
+        )
+        output = keys.power_output
+        if output is None or output.analog_output is None:
+            raise InputError(file, f"{key}.power_output", "missing: the heater's power output")
+        positive(file, f"{key}.power_output.w_per_unit", output.w_per_unit)
+        at_most(
+            file,
+            f"{key}.power_output.w_per_unit",
+            output.w_per_unit,
+            MAX_W_PER_UNIT,
+            "W",
+            "no tape heater gives 100 kW per unit of its output (is the unit W?)",
+        )
+        if flow is not None:
+            raise InputError(
+                file,
+                "tool.process_io.flow",
+                "process.model tape_heating drives the heater's power_output along the "
+                "speed: a tape cell has no flow output",
+            )
+
+    @classmethod
+    def from_keys(cls, keys: TapeHeatingConfig) -> Self:
+        capacity = (
+            keys.density_kg_m3
+            * keys.specific_heat_j_kg_k
+            * keys.width_mm
+            * 1e-3
+            * keys.thickness_mm
+            * 1e-3
+        )
+        return cls(
+            heat_capacity_j_k_m=capacity,
+            absorbed_fraction=keys.absorbed_fraction,
+            ambient_c=keys.ambient_c,
+            band_c=(keys.target_c[0], keys.target_c[1]),
+            max_power_w=keys.max_power_w,
+            w_per_unit=keys.power_output.w_per_unit,
+            analog_output=keys.power_output.analog_output,
+        )
+
+    @classmethod
+    def controller_outputs(cls, keys: TapeHeatingConfig) -> list[tuple[str, object]]:
+        """The heater's power output."""
+        return [(f"process.{cls.name}.power_output", keys.power_output)]
 
     @property
     def band(self) -> tuple[float, float]:
@@ -60,6 +221,18 @@ class TapeHeatingModel:
     @property
     def target_c(self) -> float:
         return 0.5 * (self.band_c[0] + self.band_c[1])
+
+    def speed_output(self) -> dict:
+        """The heater's power output: gain ρcwh(T*−T_0)/(η·W per unit), within
+        [0, P_max], following at once."""
+        return {
+            "analog_output": self.analog_output,
+            "per_mps": self.per_mps,
+            "offset": 0.0,
+            "min": 0.0,
+            "max": self.max_command,
+            "lag_s": 0.0,
+        }
 
     @property
     def per_mps(self) -> float:
@@ -87,3 +260,15 @@ class TapeHeatingModel:
             self.max_power_w if u_max is None else min(u_max * self.w_per_unit, self.max_power_w)
         )
         return (0.0, self.absorbed_fraction * power / (self.heat_capacity_j_k_m * rise))
+
+    def speed_band_reason(
+        self, v: float, *, u_min: float = 0.0, u_max: float | None = None
+    ) -> str | None:
+        high = self.speed_band(u_min, u_max)[1]
+        if v > high:
+            return (
+                f"{v:g} m/s is above the {high:.4g} m/s at which the heater "
+                f"(process.tape_heating.max_power_w {self.max_power_w:g} W) reaches "
+                f"target_c's low end {self.band_c[0]:g} °C"
+            )
+        return None

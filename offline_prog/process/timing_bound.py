@@ -5,15 +5,16 @@ dispenser can follow.
 **Speed band.** A model's ``speed_band(u_min, u_max)`` is the TCP speeds at which the
 target is reachable with its output within its limits (the bead's flow, the tape
 heater's power; the arc's fixed U·I for heat input). A seam's process speed outside it
-cannot be held by any output: :func:`speed_band_reason` says why, with the figures,
-and the cell is refused. The process speed is the time law's cap, so a speed within the
-band is never exceeded; a minimum speed is not something a time law can impose against
-a joint limit (the joints slow the path where they must), so a slowdown below the
-band's low end is reported (``results.timing_bound``), not planned away.
+cannot be held by any output: the model's ``speed_band_reason`` says why, with the
+figures, and the cell is refused (``job.speed_band``). The process speed is the time
+law's cap, so a speed within the band is never exceeded; a minimum speed is not
+something a time law can impose against a joint limit (the joints slow the path where
+they must), so a slowdown below the band's low end is reported
+(``results.timing_bound``), not planned away.
 
 **The dispenser's jerk.** The flow Q = k·y follows its command u through the lag
 τ·y' + y = u, and the command leads the speed by τ, u(t) = (A*/k)·v(t + τ)
-(``process.model.speed_output``). In Laplace terms the flow relative to what the
+(``BeadModel.speed_output``). In Laplace terms the flow relative to what the
 speed needs is the operator
 
     e^{τs} / (1 + τs) = 1 + τ²s²/2 − τ³s³/3 + …
@@ -36,8 +37,8 @@ at the process speed v_p asks for the path jerk cap
 
     J_bead = 2·t·v_p / τ²,
 
-which :func:`process_caps` feeds into the time law of the process stretch (and only
-there: approach, retract and links keep the user's caps) where it is below
+(``BeadModel.jerk_cap``), which :func:`process_caps` feeds into the time law of the
+process stretch (and only there: approach, retract and links keep the user's caps) where it is below
 ``motion.max_jerk``; the acceleration needs no cap (the lead cancels it). Where the
 speed falls below v_p (the start and stop ramps, a joint slowdown) the same jerk gives
 a larger relative error (∝ 1/v): at the ramps from rest no jerk holds the bead
@@ -50,11 +51,8 @@ the bound is then approximate where the two speeds differ (the path turns).
 from __future__ import annotations
 
 import dataclasses
-import math
 
-from offline_prog.process.bead import BeadModel
-from offline_prog.process.heat_input import HeatInputModel
-from offline_prog.process.tape_heating import TapeHeatingModel
+from offline_prog.process.protocol import ProcessModel
 
 
 @dataclasses.dataclass(frozen=True)
@@ -78,73 +76,14 @@ class ProcessCaps:
         return self.j_max < self.user_j_max or self.a_max < self.user_a_max
 
 
-def bead_jerk_cap(model: BeadModel, v_process: float) -> float:
-    """J_bead = 2·t·v_p/τ² [m/s³]: the path jerk at which the lead-compensated
-    dispenser keeps the bead within its tolerance t at the speed v_p [m/s] (module
-    docstring); inf without a lag."""
-    if model.lag_s**2 <= 0.0:  # no lag (or one so small its square underflows)
-        return math.inf
-    return 2.0 * model.tolerance * v_process / model.lag_s**2
-
-
-def process_caps(model, *, v_process: float, a_max: float, j_max: float) -> ProcessCaps:
-    """The user's caps, lowered where the model needs it (a bead with a lag: the jerk
-    cap :func:`bead_jerk_cap`); a model without dynamics (heat input, tape heating: the
-    heater follows at once) keeps them."""
-    if isinstance(model, BeadModel):
-        cap = bead_jerk_cap(model, v_process)
+def process_caps(
+    model: ProcessModel | None, *, v_process: float, a_max: float, j_max: float
+) -> ProcessCaps:
+    """The user's caps, lowered where the model needs it (``model.jerk_cap``: a bead
+    with a lag caps the path jerk at J_bead = 2·t·v_p/τ²); a model without dynamics
+    (heat input, tape heating: the heater follows at once) and no model keep them."""
+    if model is not None:
+        cap, reason = model.jerk_cap(v_process)
         if cap < j_max:
-            reason = (
-                f"the dispenser's lag {model.lag_s:g} s holds the bead within "
-                f"±{100 * model.tolerance:g} % at {v_process:g} m/s up to a path jerk of "
-                f"2·tol·v/τ² = {cap:.4g} m/s³"
-            )
             return ProcessCaps(a_max, cap, a_max, j_max, reason)
     return ProcessCaps(a_max, j_max, a_max, j_max)
-
-
-def speed_band_reason(model, v: float, *, u_min: float, u_max: float) -> str | None:
-    """Why the process speed v [m/s] cannot hold the model's target with its output in
-    [u_min, u_max] (its unit), with the figures; None when it can.
-
-    Args:
-        model: a process model (process.model.process_model).
-        v: the seam's process speed [m/s].
-        u_min, u_max: the output's limits (job.process_io.process_io_settings).
-    """
-    low, high = model.speed_band(u_min, u_max)
-    if isinstance(model, BeadModel):
-        what = f"process.bead.area_mm2 {model.area_m2 * 1e6:g} mm²"
-        k = model.flow_m3_s_per_unit * 1e9
-        if v > high:
-            return (
-                f"{v:g} m/s is above the {high:.4g} m/s at which the flow output at its max "
-                f"{u_max:g} (tool.process_io.flow.max; {k:g} mm³/s per unit) lays {what}"
-            )
-        if v < low:
-            return (
-                f"{v:g} m/s is below the {low:.4g} m/s at which the flow output at its min "
-                f"{u_min:g} (tool.process_io.flow.min) lays {what}: the bead is too large"
-            )
-    elif isinstance(model, TapeHeatingModel):
-        if v > high:
-            return (
-                f"{v:g} m/s is above the {high:.4g} m/s at which the heater "
-                f"(process.tape_heating.max_power_w {model.max_power_w:g} W) reaches "
-                f"target_c's low end {model.band_c[0]:g} °C"
-            )
-    elif isinstance(model, HeatInputModel):
-        h_low, h_high = (x * 1e-6 for x in model.band_j_m)
-        if v > high:
-            return (
-                f"{v:g} m/s is above the {high:.4g} m/s at which the heat input "
-                f"k·U·I/v = {model.arc_power_w:g} W / v falls to "
-                f"process.heat_input.target_kj_mm's low end {h_low:g} kJ/mm"
-            )
-        if v < low:
-            return (
-                f"{v:g} m/s is below the {low:.4g} m/s under which the heat input "
-                f"k·U·I/v = {model.arc_power_w:g} W / v exceeds "
-                f"process.heat_input.target_kj_mm's high end {h_high:g} kJ/mm"
-            )
-    return None

@@ -141,7 +141,8 @@ def program_data(plan: Plan, summary: dict) -> ProgramData:
         plan.robot, traj.s, traj.t, joints.q, joints.qd, X_BE, s_dense, X_BE_grid
     )
     return ProgramData(
-        **program_names(cell, plan.cell_file, plan.robot, summary),
+        **program_names(cell, plan.cell_file, plan.robot, summary)
+        | {"process_speed_m_s": plan.process_speed.v_m_s},
         speed_reference=traj.reference,
         cycle_time_s=traj.duration,
         time_law=time_law_name(cell.motion),

@@ -15,8 +15,8 @@ from offline_prog import __version__
 from offline_prog.constants import TimeLaw
 from offline_prog.export.payload import payload, payload_note, payload_record
 from offline_prog.job.records import Plan
-from offline_prog.joints.path_timing import without_joint_limits
 from offline_prog.robot.record import robot_source
+from offline_prog.timing.path_timing import without_joint_limits
 from offline_prog.timing.speed_hold import HOLD
 
 
@@ -73,7 +73,7 @@ def tool_turn_range_deg(plan: Plan) -> list[float]:
 def robot_report(plan: Plan) -> dict:
     """Branch, joint-limit margins, joint steps, singularities and speed reductions."""
     robot, joints = plan.robot, plan.joints
-    retiming, top = joints.retiming, plan.cell.motion.speed
+    retiming, top = joints.retiming, plan.process_speed.v_m_s
     joint, sigma, step = joints.largest_step
     use_speed = np.abs(robot.controller_joints(joints.qd)) / robot.qd_max
     use_accel = np.abs(robot.controller_joints(joints.qdd)) / robot.qdd_max

@@ -19,7 +19,7 @@ import numpy as np
 
 from offline_prog.arrays import true_runs
 from offline_prog.job.records import JobPlan
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 
 
 def timing_bound_report(job: JobPlan) -> dict | None:

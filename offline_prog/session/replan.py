@@ -21,6 +21,7 @@ from pathlib import Path
 from offline_prog.config.cell import Cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.edits import CellValues, apply, initial_values
+from offline_prog.config.process_speed import process_speed
 from offline_prog.errors import InputError, PlanFailedError, PlanFailure
 from offline_prog.job.records import Plan
 from offline_prog.job.seams import job_seams, seam_inputs
@@ -95,9 +96,10 @@ class Replanner:
         if k not in self._seams:  # the seam's points are read once
             self._seams[k] = seam_inputs(self.base, k)
         seam = self._seams[k]
-        motion = dataclasses.replace(cell.motion, speed=state.speed)
-        seam_cell = dataclasses.replace(seam.cell, tool=cell.tool, part=cell.part, motion=motion)
-        return dataclasses.replace(seam, cell=seam_cell, **poses)
+        seam_cell = dataclasses.replace(
+            seam.cell, tool=cell.tool, part=cell.part, motion=cell.motion
+        )
+        return dataclasses.replace(seam, cell=seam_cell, speed=process_speed(cell, k), **poses)
 
     def plan(
         self, state: CellValues, progress: Callable[[str], None] = lambda stage: None

@@ -10,7 +10,7 @@ from offline_prog.joints.joint_plan import plan_joint_trajectory
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.plan import plan_cell
 from offline_prog.scene.drake_cell import build_cell_model
-from offline_prog.timing.time_law import sin2_time_law
+from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
 from conftest import CELLS
@@ -59,15 +59,19 @@ def test_turn_profile_holds_the_process_and_the_clearance(weld):
     flange = FlangePath(plan.path, plan.flange.normal, X_IT=X_IT, X_PE=X_PE, tool_turn=turn)
     parameter = TimeLawParameter(flange, "tcp")
     motion = cell.motion
-    nominal = sin2_time_law(
-        parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+    limits = PathLimits.of(
+        plan.robot,
+        parameter.length,
+        v_process=motion.speed,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
     )
     joints = plan_joint_trajectory(
         plan.robot,
         transform(cell.robot.X_IB),
         flange,
         parameter,
-        nominal,
+        limits,
         rate_hz=motion.sample_rate_hz,
     )
     traj = joints.trajectory

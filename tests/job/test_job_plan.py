@@ -219,3 +219,22 @@ def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp
     assert failed and failed[0]["name"] in line
     assert (out / "trajectory.csv").is_file() and (out / "collisions.json").is_file()
     assert not (out / "programs").exists()
+
+
+def test_each_seam_runs_at_its_process_speed_record(job):
+    """Each seam's plan holds the speed the cell gives it (config.process_speed: the
+    stripe's own 0.15 m/s, the others' motion.speed); its time law caps and reaches it,
+    and the program record the writers read carries it (issue 41: decided once)."""
+    from offline_prog.config.process_speed import process_speed
+    from offline_prog.export.job_program import JobProgramData
+
+    plan, folder = job
+    data = JobProgramData.load(folder)
+    for option in plan.chosen:
+        speed = process_speed(plan.cell, option.seam)
+        assert option.plan.process_speed == speed
+        law = option.plan.joints.retiming.law
+        assert law.v_max == speed.v_m_s and law.v_peak <= speed.v_m_s
+        seam = data.seams[data.seam_names.index(option.name)]
+        assert seam.process_speed_m_s == speed.v_m_s
+    assert {o.plan.process_speed.v_m_s for o in plan.chosen} == {0.1, 0.15}

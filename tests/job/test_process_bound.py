@@ -13,7 +13,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from offline_prog.plan import StageTimer, plan_loaded_job
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 from offline_prog.results.timing_bound import timing_bound_report
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
@@ -52,7 +52,7 @@ def worst_bead_error(job) -> dict[str, float]:
     for option in job.chosen:
         segment = next(g for g in samples.segments if g.kind == "process" and g.seam == option.name)
         rows = slice(segment.start, segment.stop)
-        cruising = job.tcp_speed[rows] >= CRUISE_SHARE * option.plan.cell.motion.speed
+        cruising = job.tcp_speed[rows] >= CRUISE_SHARE * option.plan.process_speed.v_m_s
         worst[option.name] = float(error[rows][cruising].max())
     return worst
 

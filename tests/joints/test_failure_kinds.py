@@ -16,9 +16,9 @@ from offline_prog.cli import exit_code
 from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError
 from offline_prog.joints.path_ik import branch_results
-from offline_prog.joints.path_timing import PathLimits, time_path
 from offline_prog.robot.model import load_robot
 from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.path_timing import PathLimits, time_path
 from offline_prog.timing.time_law import sin2_time_law
 from offline_prog.timing.time_optimal import topp_profile
 
@@ -37,11 +37,12 @@ def test_a_failed_topp_ra_solve_is_a_plan_failure_with_where_and_why():
     is feasible everywhere); acceleration limits no robot has make it fail for real."""
     robot = load_robot("kuka_kr16_2")
     impossible = dataclasses.replace(robot, qdd_max=-robot.qdd_max)
+    limits = PathLimits.of(impossible, LENGTH_M, v_process=0.1, a_max=1.0, j_max=10.0)
     nominal = sin2_time_law(LENGTH_M, v_max=0.1, a_max=1.0, j_max=10.0)
     with pytest.raises(PlanFailedError) as raised:
         time_path(
             straight_rates(),
-            PathLimits.of(impossible, nominal),
+            limits,
             TimeLaw.TIME_OPTIMAL,
             ProcessIntent.CONSTANT_SPEED,
         )

@@ -96,22 +96,26 @@ def test_drake_ik_fallback_matches_the_analytic_plan():
 
     from offline_prog.config.cell import transform
     from offline_prog.joints.joint_plan import plan_joint_trajectory
-    from offline_prog.timing.time_law import sin2_time_law
+    from offline_prog.timing.path_timing import PathLimits
     from offline_prog.timing.trajectory import TimeLawParameter
 
     analytic = plan_cell(CELLS / "tape_cylinder_ur10e.yaml")
     robot = dataclasses.replace(analytic.robot, family="drake")
     parameter = TimeLawParameter(analytic.flange, "tcp")
     motion = analytic.cell.motion
-    nominal = sin2_time_law(
-        parameter.length, v_max=motion.speed, a_max=motion.max_acceleration, j_max=motion.max_jerk
+    limits = PathLimits.of(
+        robot,
+        parameter.length,
+        v_process=motion.speed,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
     )
     drake = plan_joint_trajectory(
         robot,
         transform(analytic.cell.robot.X_IB),
         analytic.flange,
         parameter,
-        nominal,
+        limits,
         rate_hz=motion.sample_rate_hz,
     )
     # Same poses: Drake FK of the Drake-route joints is the planned flange path.

@@ -1,7 +1,9 @@
 """Bad ``process:`` input ends with one line naming the file and the key, exit 2, and
 nothing written (issue 28's acceptance): a negative or zero parameter, an inverted
-band, a model without its section, a bead without its flow output; and a bead lag the
-approach leaves no room for names ``process.bead.lag_s`` (the key that sets it)."""
+band, a model without its section, a bead without its flow output, and (issue 36)
+physics no process has, each named by its key where the speed band check named only
+the speed before, or planned to a report of 100 % in band; and a bead lag the approach
+leaves no room for names ``process.bead.lag_s`` (the key that sets it)."""
 
 import re
 
@@ -56,14 +58,62 @@ BAD = [
     (SEAL, "model: bead", "model: heat_input", "process.heat_input"),
     (SEAL, "area_mm2: 12.0", "area_mm2: .nan", "process.bead.area_mm2"),
 ]
+# Physical bounds (issue 36: a 1 m² bead, an 864 MW arc, ambient −300 °C, a band up to
+# 10⁷ °C were planned; units slipped by 1000 too).
+PHYSICS = [
+    (SEAL, "area_mm2: 12.0", "area_mm2: 1000000.0", "process.bead.area_mm2"),
+    (
+        SEAL,
+        "flow_mm3_s_per_unit: 250.0",
+        "flow_mm3_s_per_unit: 2.5e+08",
+        "process.bead.flow_mm3_s_per_unit",
+    ),
+    (WELD, "current_a: 120.0", "current_a: 1.2e+08", "process.heat_input.current_a"),
+    (WELD, "voltage_v: 12.0", "voltage_v: 12000.0", "process.heat_input.voltage_v"),
+    (WELD, "[0.095, 0.125]", "[95.0, 125.0]", "process.heat_input.target_kj_mm"),
+    (TAPE, "ambient_c: 20", "ambient_c: -300", "process.tape_heating.ambient_c"),
+    (TAPE, "[380, 420]", "[380, 1.0e+07]", "process.tape_heating.target_c"),
+    (TAPE, "width_mm: 25.0", "width_mm: 25000.0", "process.tape_heating.width_mm"),
+    (TAPE, "thickness_mm: 0.2", "thickness_mm: 200.0", "process.tape_heating.thickness_mm"),
+    (TAPE, "density_kg_m3: 1550", "density_kg_m3: 1.55", "process.tape_heating.density_kg_m3"),
+    (TAPE, "density_kg_m3: 1550", "density_kg_m3: 1.55e+05", "process.tape_heating.density_kg_m3"),
+    (
+        TAPE,
+        "specific_heat_j_kg_k: 1200",
+        "specific_heat_j_kg_k: 1.2",
+        "process.tape_heating.specific_heat_j_kg_k",
+    ),
+    (
+        TAPE,
+        "specific_heat_j_kg_k: 1200",
+        "specific_heat_j_kg_k: 1.2e+05",
+        "process.tape_heating.specific_heat_j_kg_k",
+    ),
+    (TAPE, "max_power_w: 3000", "max_power_w: 3.0e+06", "process.tape_heating.max_power_w"),
+    (
+        TAPE,
+        "w_per_unit: 300",
+        "w_per_unit: 3.0e+06",
+        "process.tape_heating.power_output.w_per_unit",
+    ),
+]
 
 
-@pytest.mark.parametrize(("text", "old", "new", "key"), BAD, ids=[b[3] + ":" + b[2] for b in BAD])
-def test_a_bad_parameter_is_one_line_naming_its_key(capsys, tmp_path, text, old, new, key):
+CASES = [(*case, False) for case in BAD] + [(*case, True) for case in PHYSICS]
+
+
+@pytest.mark.parametrize(
+    ("text", "old", "new", "key", "physics"), CASES, ids=[c[3] + ":" + c[2] for c in CASES]
+)
+def test_a_bad_parameter_is_one_line_naming_its_key(capsys, tmp_path, text, old, new, key, physics):
+    """A physical bound's line names the key, the value, the bound and why (the
+    physics, or the unit that likely slipped)."""
     assert old in text
     code, err = plan(capsys, tmp_path, text.replace(old, new, 1))
     assert code == 2 and len(err) == 1, err
     assert "cell.yaml" in err[0] and f": {key}: " in err[0], err
+    if physics:
+        assert " is above " in err[0] or " is below " in err[0], err
     assert not (tmp_path / "out").exists()
 
 

@@ -10,17 +10,14 @@ band by path length, the stretches outside and their causes.
 import numpy as np
 import pytest
 
-from offline_prog.config.process_keys import (
-    BeadConfig,
-    HeatInputConfig,
-    PowerOutput,
-    ProcessConfig,
-    TapeHeatingConfig,
-)
+from offline_prog.config.process_keys import ProcessConfig
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import Segment
-from offline_prog.process.model import process_model, speed_output
+from offline_prog.process.bead import BeadConfig
+from offline_prog.process.heat_input import HeatInputConfig
 from offline_prog.process.quality import process_quality
+from offline_prog.process.registry import process_model
+from offline_prog.process.tape_heating import PowerOutput, TapeHeatingConfig
 
 DT = 1e-3  # [s] sample spacing of the synthetic profiles
 BEAD = ProcessConfig(
@@ -49,8 +46,9 @@ TAPE = ProcessConfig(
 
 
 def settings_of(process: ProcessConfig) -> ProcessIo | None:
-    fields = speed_output(process_model(process), process)
-    if process.model == "bead":
+    model = process_model(process)
+    fields = model.speed_output()
+    if model.sets_flow:  # the flow output's number and limits are the cell's
         fields |= {"analog_output": 1, "min": 0.0, "max": 10.0}
     return ProcessIo(**fields) if fields else None
 

@@ -16,7 +16,7 @@ import re
 import numpy as np
 import pytest
 
-from offline_prog.process.model import process_model
+from offline_prog.process.registry import process_model
 
 from conftest import CELLS, with_own_io
 

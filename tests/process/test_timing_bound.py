@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from offline_prog.process.bead import BeadModel
 from offline_prog.process.heat_input import HeatInputModel
 from offline_prog.process.tape_heating import TapeHeatingModel
-from offline_prog.process.timing_bound import bead_jerk_cap, process_caps
+from offline_prog.process.timing_bound import process_caps
 from offline_prog.timing.time_law import sin2_time_law
 
 RATE_HZ = 2000.0  # samples of the speed profiles below
@@ -45,21 +45,21 @@ def cruise(law, t):
 def test_caps_only_lower_the_users(tolerance, lag_s, v, a_max, j_max):
     """Whatever the model, the caps are the user's or lower, and lowered only with a
     reason; a model without dynamics (heat input, tape) keeps the user's."""
-    models = [
+    caps = process_caps(bead(tolerance, lag_s), v_process=v, a_max=a_max, j_max=j_max)
+    assert caps.j_max == min(j_max, 2.0 * tolerance * v / lag_s**2 if lag_s**2 > 0 else math.inf)
+    for model in (
         bead(tolerance, lag_s),
         HeatInputModel(3456.0, (0.5e6, 0.7e6)),
         TapeHeatingModel(9.3, 0.6, 20.0, (380.0, 420.0), 3000.0, 300.0),
-    ]
-    for model in models:
+        None,
+    ):
         caps = process_caps(model, v_process=v, a_max=a_max, j_max=j_max)
         assert caps.a_max <= a_max and caps.j_max <= j_max
         assert (caps.user_a_max, caps.user_j_max) == (a_max, j_max)
         assert caps.bounded == (caps.reason is not None)
-        if isinstance(model, BeadModel):
-            assert caps.j_max == min(j_max, bead_jerk_cap(model, v))
-        else:
+        if model is None or model.output_lag_s == 0.0:  # no lag to lead: nothing asked
             assert not caps.bounded
-    assert math.isinf(bead_jerk_cap(bead(tolerance, 0.0), v))
+    assert math.isinf(bead(tolerance, 0.0).jerk_cap(v)[0])
 
 
 def test_jerk_cap_is_the_exact_worst_case():
@@ -73,7 +73,7 @@ def test_jerk_cap_is_the_exact_worst_case():
     steady = (t > 1.0) & (t < 2.0)  # the lag's transient gone; the lead within the data
     expected = model.lag_s**2 * jerk / (2 * v[steady])
     np.testing.assert_allclose(error[steady], expected, rtol=1e-3)
-    cap = bead_jerk_cap(model, 0.1)
+    cap = model.jerk_cap(0.1)[0]
     assert abs(model.lag_s**2 * cap / (2 * 0.1) - model.tolerance) < 1e-12
 
 
@@ -92,7 +92,7 @@ def test_a_law_within_the_cap_holds_the_bead_at_its_top_speed(
     it) lays a bead within tolerance wherever it runs at its top speed, measured by the
     model's exact lag (test_jerk_cap_is_the_exact_worst_case: no higher cap would)."""
     model = bead(tolerance, lag_s)
-    cap = bead_jerk_cap(model, v)
+    cap = model.jerk_cap(v)[0]
     law = sin2_time_law(length, v_max=v, a_max=1e3, j_max=jerk_share * cap)
     t = np.arange(0.0, law.duration, 1.0 / RATE_HZ)
     error = bead_error(model, t, law(t)[1])

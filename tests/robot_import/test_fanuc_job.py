@@ -333,7 +333,7 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     dispenser's lag) at the plan's speed, give the report's cross-section within 1 %."""
     import json
 
-    from offline_prog.process.model import process_model
+    from offline_prog.process.registry import process_model
 
     data, folder, robot, job = bead_stripe
     write_fanuc_job(data, tmp_path)

@@ -289,7 +289,7 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
         # trajectory.csv's TCP speed agrees (held length ≥ that share of the path).
         share, room = plan.joints.retiming.speed_held
         assert share >= 0.9 and 0.5 < room < 1.0, (share, room)
-        v = plan.cell.motion.speed
+        v = plan.process_speed.v_m_s
         held = np.abs(table["tcp_speed"] - v) <= 0.005 * v
         ds = np.abs(np.diff(table["sigma"]))
         on_csv = np.sum(ds * (held[1:] & held[:-1])) / np.sum(ds)
@@ -301,14 +301,13 @@ def test_demo_cell_trajectory_csv_keeps_joint_limits(tmp_path, process):
 def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, process):
     """Where path_timing skips the averaged profile by its bounds, running it would not
     have given a shorter law (cycle_time) nor one holding the speed longer."""
-    from offline_prog.joints.path_timing import HELD_TIE, SKIP_SHARE, _cannot_win
+    from offline_prog.timing.path_timing import HELD_TIE, SKIP_SHARE, PathLimits, _cannot_win
     from offline_prog.timing.speed_hold import SpeedHold
-    from offline_prog.timing.time_law import sin2_time_law
 
     rates = bump_rates(gain=gain)
     limits = (QD_MAX, QDD_MAX, QDDD_MAX)
     path = dict(v_process=speed, a_max=2.0, j_max=20.0)
-    nominal = sin2_time_law(LENGTH, v_max=speed, a_max=2.0, j_max=20.0)
+    path_limits = PathLimits(LENGTH, speed, 2.0, 20.0, QD_MAX, QDD_MAX, QDDD_MAX)
     profile = topp_profile(
         rates,
         qd_max=QD_MAX,
@@ -320,7 +319,7 @@ def test_skipping_the_averaged_profile_never_loses_a_better_law(speed, gain, pro
     staircase = jerk_limited_law(rates, profile, limits=limits, process=process, **path)
     averaged = filtered_timing(rates, profile, limits=limits, **path)
     held = SpeedHold(rates, limits=limits, **path)
-    skipped = _cannot_win(staircase, held(staircase.law), profile, nominal, process, held)
+    skipped = _cannot_win(staircase, held(staircase.law), profile, path_limits, process, held)
     # A slow process on a smooth path skips it; a fast one on a steep path cannot.
     assert skipped == (gain == 0.0)
     if skipped:
@@ -334,7 +333,7 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
     """time_optimal's cycle time without joint limits is the constant-jerk rest-to-rest
     motion under the path's v, a, j (L/v + v/a + a/j on a long path), below sin²'s;
     the demo seal's law (no joint limit binds) reaches it within 0.1 %."""
-    from offline_prog.joints.path_timing import without_joint_limits
+    from offline_prog.timing.path_timing import without_joint_limits
     from offline_prog.timing.time_law import sin2_time_law
 
     nominal = sin2_time_law(1.2, v_max=0.1, a_max=1.0, j_max=10.0)
@@ -354,7 +353,7 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
         motion = plan.cell.motion
         user = sin2_time_law(
             plan.path.length,
-            v_max=motion.speed,
+            v_max=plan.process_speed.v_m_s,
             a_max=motion.max_acceleration,
             j_max=motion.max_jerk,
         )

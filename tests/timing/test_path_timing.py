@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from offline_prog.constants import PROCESS_INTENTS, TIME_LAWS, ProcessIntent, TimeLaw
-from offline_prog.joints.path_timing import PathLimits, PathTiming, time_path
 from offline_prog.robot.model import load_robot
 from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.path_timing import PathLimits, PathTiming, time_path
 from offline_prog.timing.time_law import sin2_time_law
 
 LENGTH_M = 0.2
@@ -27,7 +27,9 @@ def slow_rates() -> JointRates:
 def test_both_laws_return_one_record_with_the_documented_fields(intent):
     robot = load_robot("kuka_kr16_2")
     nominal = sin2_time_law(LENGTH_M, v_max=SPEED, a_max=1.0, j_max=10.0)
-    limits = PathLimits.of(robot, nominal)
+    limits = PathLimits.of(robot, LENGTH_M, v_process=SPEED, a_max=1.0, j_max=10.0)
+    assert limits.nominal.duration == nominal.duration  # the same law, built once:
+    assert limits.nominal is limits.nominal
     sin2 = time_path(slow_rates(), limits, TimeLaw.SIN2, intent)
     optimal = time_path(slow_rates(), limits, TimeLaw.TIME_OPTIMAL, intent)
     assert type(sin2) is type(optimal) is PathTiming

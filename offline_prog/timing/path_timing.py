@@ -19,6 +19,7 @@ HELD_TIE of the held length.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 import numpy as np
@@ -26,12 +27,14 @@ import numpy as np
 from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.robot.model import RobotModel
+from offline_prog.timing.filtered_law import FilteredTimeLaw
 from offline_prog.timing.filtered_stage import filtered_timing
 from offline_prog.timing.jerk_stage import jerk_limited_law, steady_jerk_limit
 from offline_prog.timing.joint_timing import JointRates, retime
+from offline_prog.timing.limit_use import Slowdown
 from offline_prog.timing.speed_hold import SpeedHold
 from offline_prog.timing.time_law import Sin2TimeLaw, sin2_time_law
-from offline_prog.timing.time_optimal import topp_profile
+from offline_prog.timing.time_optimal import ToppProfile, topp_profile
 
 HELD_TIE = 1e-3  # held shares closer than this tie
 # The averaged profile is skipped when it cannot cut the staircase's cycle time by more
@@ -63,20 +66,18 @@ class PathLimits:
     jerk_max: np.ndarray
 
     @classmethod
-    def of(cls, robot: RobotModel, nominal: Sin2TimeLaw) -> PathLimits:
-        """The limits of the path the nominal law runs, on this robot."""
-        return cls(
-            nominal.length,
-            nominal.v_max,
-            nominal.a_max,
-            nominal.j_max,
-            robot.qd_max,
-            robot.qdd_max,
-            robot.jerk_limits,
-        )
+    def of(
+        cls, robot: RobotModel, length: float, *, v_process: float, a_max: float, j_max: float
+    ) -> PathLimits:
+        """The limits of a path of ``length`` [m] run at the process speed ``v_process``
+        [m/s] under the path caps ``a_max``, ``j_max`` [m/s², m/s³], on this robot."""
+        return cls(length, v_process, a_max, j_max, robot.qd_max, robot.qdd_max, robot.jerk_limits)
 
+    @functools.cached_property
     def nominal(self) -> Sin2TimeLaw:
-        """The process sin² law over the path before any joint limit (paper §4)."""
+        """The process sin² law over the path before any joint limit (paper §4), built
+        once per limits: the sample count, the sin² plateaus and the times of failures
+        read it."""
         return sin2_time_law(self.length, v_max=self.v_process, a_max=self.a_max, j_max=self.j_max)
 
 
@@ -104,15 +105,15 @@ class PathTiming:
         solve_s: wall time of the time-optimal solve [s] (time_optimal; None for sin2).
     """
 
-    law: object  # Sin2TimeLaw | FilteredTimeLaw: both σ(t) laws with .duration
+    law: Sin2TimeLaw | FilteredTimeLaw
     law_kind: TimeLaw
     intent: ProcessIntent | None
     reductions: tuple[tuple[float, float, float], ...]
     a_scale: float
     feasible: bool
     worst: tuple[int, float, float]
-    slowdowns: tuple = ()
-    topp: object | None = None
+    slowdowns: tuple[Slowdown, ...] = ()
+    topp: ToppProfile | None = None
     topp_plain_s: float | None = None
     speed_held: tuple[float, float] | None = None
     solve_s: float | None = None
@@ -131,11 +132,10 @@ def time_path(
         law, intent: motion.time_law and motion.process (enums, config/checks.py).
     """
     law, intent = TimeLaw(law), ProcessIntent(intent)
-    nominal = limits.nominal()
     if law is TimeLaw.SIN2:
-        r = retime(rates, nominal, qd_max=limits.qd_max, qdd_max=limits.qdd_max)
+        r = retime(rates, limits.nominal, qd_max=limits.qd_max, qdd_max=limits.qdd_max)
         return PathTiming(r.law, law, None, r.reductions, r.a_scale, r.feasible, r.worst)
-    t = _time_optimal(rates, limits, nominal, intent)
+    t = _time_optimal(rates, limits, intent)
     return PathTiming(
         t.law,
         law,
@@ -152,12 +152,12 @@ def time_path(
     )
 
 
-def _time_optimal(rates: JointRates, limits: PathLimits, nominal: Sin2TimeLaw, process):
+def _time_optimal(rates: JointRates, limits: PathLimits, process: ProcessIntent):
     """TOPP-RA, the jerk stage and the averaged profile (module docstring)."""
     start = time.perf_counter()
     joint = (limits.qd_max, limits.qdd_max, limits.jerk_max)
     topp = dict(
-        qd_max=limits.qd_max, qdd_max=limits.qdd_max, v_cap=nominal.v_max, a_path=nominal.a_max
+        qd_max=limits.qd_max, qdd_max=limits.qdd_max, v_cap=limits.v_process, a_path=limits.a_max
     )
     plain = topp_profile(rates, **topp)
     steady = steady_jerk_limit(rates, joint)
@@ -171,15 +171,16 @@ def _time_optimal(rates: JointRates, limits: PathLimits, nominal: Sin2TimeLaw, p
         reason = (
             f"joint speed/acceleration limits: TOPP-RA found no parameterization ({profile.reason})"
         )
+        nominal = limits.nominal
         t_grid = np.linspace(0.0, nominal.duration, TIME_INVERSION_POINTS)
         t = float(np.interp(sigma, nominal(t_grid)[0], t_grid))  # on the nominal law
         raise PlanFailedError(PlanFailure(Failure.JOINT_RATE_LIMIT, sigma, t, reason))
-    path = dict(v_process=nominal.v_max, a_max=nominal.a_max, j_max=nominal.j_max)
+    path = dict(v_process=limits.v_process, a_max=limits.a_max, j_max=limits.j_max)
 
     held = SpeedHold(rates, limits=joint, **path)
     timing = jerk_limited_law(rates, profile, limits=joint, process=process, **path)
     speed_held = held(timing.law)  # measured once per law: the choice and the report
-    if not (timing.feasible and _cannot_win(timing, speed_held, profile, nominal, process, held)):
+    if not (timing.feasible and _cannot_win(timing, speed_held, profile, limits, process, held)):
         filtered = filtered_timing(rates, profile, limits=joint, **path)
         if filtered is not None:
             filtered_held = held(filtered.law)
@@ -215,18 +216,20 @@ def without_joint_limits(law, time_law: TimeLaw) -> tuple[float, bool]:
     return float(trajectory.duration), bool(top >= law.v_max * (1.0 - 1e-9))
 
 
-def _cannot_win(staircase, staircase_held, profile, nominal, process: str, held: SpeedHold) -> bool:
+def _cannot_win(
+    staircase, staircase_held, profile, limits: PathLimits, process: str, held: SpeedHold
+) -> bool:
     """The averaged profile (``filtered_stage``) cannot beat the staircase, by bounds:
     its profile is TOPP-RA's under tighter limits, so never above ``profile``, and it
     runs the profile's duration plus its window T = a/j. Its speed is an average of
     the profile's over T, so it can hold the process speed only within v·T of where
     the profile does (``held.upper_bound``; staircase_held: ``held`` of the staircase)."""
-    window = nominal.a_max / nominal.j_max
+    window = limits.a_max / limits.j_max
     if staircase.law.duration > (profile.duration + window) * (1.0 + SKIP_SHARE):
         return False
     if process == ProcessIntent.CYCLE_TIME:
         return True
-    bound = held.upper_bound(profile.sigma, profile.speed, reach=nominal.v_max * window)
+    bound = held.upper_bound(profile.sigma, profile.speed, reach=limits.v_process * window)
     return staircase_held[0] >= bound - HELD_TIE
 
 
