@@ -18,16 +18,17 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(REPO), str(REPO / "tests"), str(REPO / "tests" / "calibration")]
+sys.path[:0] = [str(REPO), str(Path(__file__).resolve().parent / "support")]
 
 from synthetic_touches import (  # noqa: E402
     calibration_cell,
+    errors,
     import_fanuc,
     nominal_truth,
+    solve,
     start_pose,
     synthetic_touches,
 )
-from test_estimate import errors, solve  # noqa: E402
 
 TOLERANCES = {"tip_mm": 0.1, "axis_deg": 0.1, "pointer_mm": 0.1, "grasp_mm": 0.1, "grasp_deg": 0.05}
 DEMOS = ["seal_plate_kr16", "weld_seam_irb2400", "tape_cylinder_ur10e"]

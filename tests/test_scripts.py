@@ -134,6 +134,7 @@ SMOKE = [
         [str(CELLS / "seal_plate_kr16.yaml"), "--runs", "1", "--baseline"],
         "same points and deviations: True",
     ),
+    ("calibration_accuracy.py", ["--draws", "1"], "tip_mm"),
     ("cad_accuracy.py", ["--parts", "plate", "--stl-chord-mm", "0.1"], "plate top loop"),
     ("process_bound.py", [], "report.json quality.timing_bound"),
 ]
@@ -173,6 +174,11 @@ def test_the_demo_data_scripts_write_the_committed_files(tmp_path):
     cells/data, even for --help) what cells/data holds, up to the writers' time stamps."""
     run_script("make_cad_demo.py", ["--out", str(tmp_path)], tmp_path)
     run_script("make_demo_paths.py", ["--out", str(tmp_path)], tmp_path)
+    run_script("make_demo_touches.py", ["--out", str(tmp_path)], tmp_path)
+    touches = "seal_plate_kr16_touches.csv"
+    assert (tmp_path / touches).read_text(encoding="utf-8") == (
+        CELLS / "calibration" / touches
+    ).read_text(encoding="utf-8")
 
     def without_stamps(file: Path) -> list[str]:
         lines = file.read_text(encoding="utf-8").splitlines()

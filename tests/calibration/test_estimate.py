@@ -11,17 +11,16 @@ import pytest
 from scipy.spatial.transform import Rotation
 from synthetic_touches import (
     SHARED_FANUC,
-    TrueCell,
     calibration_cell,
+    errors,
     import_fanuc,
     nominal_truth,
+    solve,
     start_pose,
     synthetic_touches,
 )
 
-from offline_prog.calibration.estimate import fit
 from offline_prog.calibration.outputs import estimates
-from offline_prog.calibration.run import touch_problem
 from offline_prog.calibration.touches import parse_touches
 from offline_prog.errors import InputError
 
@@ -34,24 +33,6 @@ def cells(tmp_path_factory):
     """name ↦ (inputs, the first seam's start pose X_IE0) of each demo with a block."""
     folder = tmp_path_factory.mktemp("cells")
     return {name: start_pose(calibration_cell(folder, name)) for name in DEMOS}
-
-
-def solve(inputs, text: str):
-    touches = parse_touches("t.csv", text, inputs.robot, inputs.cell.calibration)
-    return fit(touch_problem(inputs, touches))
-
-
-def errors(estimate, true: TrueCell) -> dict[str, float]:
-    v = estimate.values
-    return {
-        "tip_mm": float(np.linalg.norm(v.p_IT - true.X_IT[:3, 3] * 1e3)),
-        "axis_deg": float(np.degrees(np.arccos(np.clip(v.R_IT[:, 2] @ true.X_IT[:3, 2], -1, 1)))),
-        "pointer_mm": float(np.linalg.norm(v.pointer - true.pointer_mm)),
-        "grasp_mm": float(np.linalg.norm(v.p_PE - true.X_PE[:3, 3] * 1e3)),
-        "grasp_deg": float(
-            np.degrees(Rotation.from_matrix(v.R_PE.T @ true.X_PE[:3, :3]).magnitude())
-        ),
-    }
 
 
 def assert_within_tolerances(inputs, X_IE0, seeds) -> None:

@@ -14,7 +14,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from offline_prog.calibration.touches import HEADER
+from offline_prog.calibration.estimate import fit
+from offline_prog.calibration.run import touch_problem
+from offline_prog.calibration.touches import HEADER, parse_touches
 from offline_prog.job.seams import seam_inputs
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.robot.model import ROBOTS_DIR
@@ -201,3 +203,21 @@ def nominal_truth(inputs, rng, *, mm: float = 2.0, deg: float = 0.5, pointer_mm=
     nominal = np.asarray(inputs.cell.calibration.pointer_mm or [0.0, 0.0, 0.0], dtype=float)
     pointer = nominal + rng.normal(scale=1.0, size=3) if pointer_mm is None else pointer_mm
     return TrueCell(X_IT, X_PE, np.asarray(pointer, dtype=float))
+
+
+def solve(inputs, text: str):
+    touches = parse_touches("t.csv", text, inputs.robot, inputs.cell.calibration)
+    return fit(touch_problem(inputs, touches))
+
+
+def errors(estimate, true: TrueCell) -> dict[str, float]:
+    v = estimate.values
+    return {
+        "tip_mm": float(np.linalg.norm(v.p_IT - true.X_IT[:3, 3] * 1e3)),
+        "axis_deg": float(np.degrees(np.arccos(np.clip(v.R_IT[:, 2] @ true.X_IT[:3, 2], -1, 1)))),
+        "pointer_mm": float(np.linalg.norm(v.pointer - true.pointer_mm)),
+        "grasp_mm": float(np.linalg.norm(v.p_PE - true.X_PE[:3, 3] * 1e3)),
+        "grasp_deg": float(
+            np.degrees(Rotation.from_matrix(v.R_PE.T @ true.X_PE[:3, :3]).magnitude())
+        ),
+    }
