@@ -29,7 +29,7 @@ from offline_prog.export.densify import densify
 from offline_prog.export.job_program import JobProgramData, JobSegment
 from offline_prog.export.points import PointRule, process_points
 from offline_prog.export.program import ProgramData
-from offline_prog.io_events import IoEvent, ProcessIo, Signal
+from offline_prog.io_events import IoEvent, Signal
 
 
 @dataclasses.dataclass(frozen=True)
@@ -113,16 +113,8 @@ class ProgramRecord:
     job: JobProgramData
     steps: tuple[JointMove | SeamRun, ...]
 
-    @property
-    def rows(self) -> ProgramData:
-        """Every row of the job (header fields included)."""
-        return self.job.job
-
-    @property
-    def io(self) -> ProcessIo | None:
-        return self.job.process_io
-
     def runs(self) -> list[SeamRun]:
+        """The seam runs, in run order."""
         return [step for step in self.steps if isinstance(step, SeamRun)]
 
 

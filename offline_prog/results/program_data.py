@@ -58,6 +58,30 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
     }
 
 
+def _header(plan: Plan | JobPlan, cell_file: Path, robot, summary: dict) -> dict:
+    """The header fields of a seam's or the job's ProgramData: names, limits, payload,
+    time law, and whether the plan passed its checks."""
+    cell = plan.cell
+    return {
+        **program_names(cell, cell_file, robot, summary),
+        "time_law": time_law_name(cell.motion),
+        "feasible": plan.feasible,
+        "failure": plan.failure,
+    }
+
+
+def _samples(t, path_m, q, qd, tcp_speed) -> dict:
+    """The per-row fields of a ProgramData: t (N,) [s], path_m (N,) [m], q, qd (N, 6)
+    [rad, rad/s], tcp_speed (N,) [m/s]."""
+    return {"t": t, "path_m": path_m, "q": q, "qd": qd, "tcp_speed": tcp_speed}
+
+
+def _frames(X_BT: np.ndarray, X_BE: np.ndarray, X_EP: np.ndarray) -> dict:
+    """The pose fields of a ProgramData: the flange X_BE (N, 4, 4), the tool in the part
+    X_PT (N, 4, 4), the tool X_BT and the part X_EP (4, 4)."""
+    return {"X_BE": X_BE, "X_PT": _tool_in_part(X_BT, X_BE, X_EP), "X_BT": X_BT, "X_EP": X_EP}
+
+
 def _tool_and_part(cell) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(X_BI, X_BT, X_EP) (4, 4) from the cell: the inertial frame and the physical tool
     in the robot base, the part in the flange."""
@@ -95,21 +119,11 @@ def seam_program_data(plan: Plan, summary: dict) -> ProgramData:
         plan.robot, traj.s, traj.t, joints.q, joints.qd, X_BE, path_dense_m, X_BE_grid
     )
     return ProgramData(
-        **program_names(cell, plan.cell_file, plan.robot, summary),
+        **_header(plan, plan.cell_file, plan.robot, summary),
         speed_reference=traj.reference,
         cycle_time_s=traj.duration,
-        time_law=time_law_name(cell.motion),
-        feasible=plan.feasible,
-        failure=plan.failure,
-        t=traj.t,
-        path_m=traj.s,
-        q=joints.q,
-        qd=joints.qd,
-        X_BE=X_BE,
-        X_PT=_tool_in_part(X_BT, X_BE, X_EP),
-        X_BT=X_BT,
-        X_EP=X_EP,
-        tcp_speed=traj.tcp_speed,
+        **_samples(traj.t, traj.s, joints.q, joints.qd, traj.tcp_speed),
+        **_frames(X_BT, X_BE, X_EP),
         path_dense_m=path_dense_m,
         X_PT_dense=X_PT_dense,
         q_dense=q_dense,
@@ -123,21 +137,11 @@ def job_program_data(job: JobPlan, summary: dict) -> JobProgramData:
     cell, s = job.cell, job.samples
     _, X_BT, X_EP = _tool_and_part(cell)
     rows = ProgramData(
-        **program_names(cell, job.cell_file, job.robot, summary),
+        **_header(job, job.cell_file, job.robot, summary),
         speed_reference=cell.motion.speed_reference,
         cycle_time_s=float(s.t[-1]),
-        time_law=time_law_name(cell.motion),
-        feasible=job.feasible,
-        failure=job.failure,
-        t=s.t,
-        path_m=s.path_m,
-        q=s.q,
-        qd=s.qd,
-        X_BE=job.X_BE,
-        X_PT=_tool_in_part(X_BT, job.X_BE, X_EP),
-        X_BT=X_BT,
-        X_EP=X_EP,
-        tcp_speed=job.tcp_speed,
+        **_samples(s.t, s.path_m, s.q, s.qd, job.tcp_speed),
+        **_frames(X_BT, job.X_BE, X_EP),
         whole_job=True,
     )
     return JobProgramData(

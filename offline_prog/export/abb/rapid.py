@@ -111,7 +111,7 @@ class RapidPost(CartesianPost):
         return PointRule("external_tcp", "X_PF", o.chord_tol_m, o.angle_tol_rad)
 
     def conventions(self, record: ProgramRecord) -> list[str]:
-        io, names = record.io, record.job.seam_names
+        io, names = record.job.process_io, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
             "Units: mm, deg; quaternions [w,x,y,z]. World = robot base. Stationary tool: "

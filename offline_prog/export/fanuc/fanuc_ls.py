@@ -125,7 +125,7 @@ class FanucPost(ControllerPost):
         return PointRule("flange", "X_TP", self.options.chord_tol_m, self.options.angle_tol_rad)
 
     def conventions(self, record: ProgramRecord) -> list[str]:
-        io, rows, names = record.io, record.rows, record.job.seam_names
+        io, rows, names = record.job.process_io, record.job.job, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
             *frame_conventions(self.robot, rows.X_EP),

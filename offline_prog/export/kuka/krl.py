@@ -92,7 +92,7 @@ class KrlPost(CartesianPost):
         return self.rule
 
     def conventions(self, record: ProgramRecord) -> list[str]:
-        io, names = record.io, record.job.seam_names
+        io, names = record.job.process_io, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
             "Style external_tcp: $BASE = fixed tool T in $WORLD (= base_link), $TOOL = part P "

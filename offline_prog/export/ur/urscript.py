@@ -67,7 +67,7 @@ class UrScriptPost(ControllerPost):
         self.lines: list[str] = []
 
     def conventions(self, record: ProgramRecord) -> list[str]:
-        io, rows, names = record.io, record.rows, record.job.seam_names
+        io, rows, names = record.job.process_io, record.job.job, record.job.seam_names
         lines = [
             "Units: m, rad, s. Joint order: " + ", ".join(rows.joint_names) + ".",
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
