@@ -155,7 +155,7 @@ class FanucPost(ControllerPost):
         io = self.job.process_io
         self.main.lines.append("  PAYLOAD[1]")
         if io is not None and io.analog_output is not None:  # idle until a seam's output
-            self.main.lines.append(self._ao(io.idle))
+            self.main.lines.append(self.ao_statement(io.idle))
 
     def move_joint(self, move: JointMove) -> None:
         for q in move.targets:
@@ -177,7 +177,7 @@ class FanucPost(ControllerPost):
     def follow_speed(self, switch: Switch) -> str:
         """The flow's value from the motion the statement precedes on (FANUC has no
         speed-following output: the plan's flow values are written as the tool moves)."""
-        return self._ao(switch.event.value)
+        return self.ao_statement(switch.event.value)
 
     def footer(self, out_dir: Path) -> list[Path]:
         limit = self.options.line_limit
@@ -191,7 +191,8 @@ class FanucPost(ControllerPost):
             write_atomic(files[-1], program.text())
         return files
 
-    def _ao(self, value_v: float) -> str:
+    def ao_statement(self, value_v: float) -> str:
+        """``AO[n]=value`` of the flow output [V]."""
         return f"  AO[{self.job.process_io.analog_output}]={value_v:.3f}"
 
     def _parts(self, name: str, lines: list) -> list[_Program]:
@@ -235,7 +236,7 @@ class _Chain:
         for m in motions:
             if m.flow is not None and f"{m.flow:.3f}" != f"{current:.3f}":
                 if m.flow_event is None:
-                    self.lines.append(post._ao(m.flow))
+                    self.lines.append(post.ao_statement(m.flow))
                 else:  # the flow's event, at the value the plan's flow has on the motion
                     event = dataclasses.replace(m.flow_event, value=m.flow)
                     self.lines.append(post.follow_speed(Switch(0, 0.0, event)))
@@ -246,7 +247,7 @@ class _Chain:
             entry = (samples.X_BP[m.end], configs[m.end])
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
         if current is not None and f"{current:.3f}" != f"{io.idle:.3f}":
-            self.lines.append(post._ao(io.idle))
+            self.lines.append(post.ao_statement(io.idle))
 
 
 def _samples(rows, run: SeamRun):
