@@ -86,6 +86,23 @@ def _run_robots(args, console: Console) -> None:
     run_robots(args, console)
 
 
+def _run_calibrate(args, console: Console) -> None:
+    """``calibrate``: the calibrated cell and calibration.json, one line per frame."""
+    from offline_prog.calibration.run import calibrate_controller, calibrate_touches
+    from offline_prog.errors import InputError
+
+    if args.controller_angles and args.touches is None:
+        raise InputError(args.from_controller, "--controller-angles", "applies to --touches")
+    if args.touches is not None:
+        run = calibrate_touches(
+            args.cell, args.touches, args.out, controller_angles=args.controller_angles
+        )
+    else:
+        run = calibrate_controller(args.cell, args.from_controller, args.out)
+    for line in run[1]:
+        console.print(line, highlight=False, markup=False)
+
+
 def _run_export(args, console: Console) -> None:
     from offline_prog.export.formats import check_export, export
     from offline_prog.export.job_program import JobProgramData
@@ -257,6 +274,9 @@ def main(argv: list[str] | None = None, *, own_process: bool = False) -> int:
             return 0
         if args.command == "robots":
             _run_robots(args, console)
+            return 0
+        if args.command == "calibrate":
+            _run_calibrate(args, console)
             return 0
         if args.command == "seams":
             from offline_prog.viz.seams_page import run_seams

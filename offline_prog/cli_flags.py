@@ -103,6 +103,7 @@ def parser() -> argparse.ArgumentParser:
     )
     _session_flags(commands)
     _place_flags(commands)
+    _calibrate_flags(commands)
     _seams_flags(commands)
     robots = commands.add_parser("robots", help="robot descriptions: list, self-collision matrix")
     robot_commands = robots.add_subparsers(
@@ -228,6 +229,38 @@ def _place_flags(commands) -> None:
     )
 
 
+def _calibrate_flags(commands) -> None:
+    """``calibrate CELL (--touches FILE [--controller-angles] | --from-controller FILE)
+    --out calibrated.yaml``."""
+    calibrate = commands.add_parser(
+        "calibrate",
+        help="the fixed tool's TCP and the grasp from touches, or from the controller's frames",
+    )
+    calibrate.add_argument("cell", type=Path, help="work-cell YAML file")
+    source = calibrate.add_mutually_exclusive_group(required=True)
+    source.add_argument(
+        "--touches",
+        type=Path,
+        help="CSV target,q1_deg..q6_deg: touches of the tool's tip, its axis, part points",
+    )
+    source.add_argument(
+        "--from-controller",
+        type=Path,
+        help="the controller's calibrated frames: KUKA $config.dat or an ABB RAPID module",
+    )
+    calibrate.add_argument(
+        "--controller-angles",
+        action="store_true",
+        help="the touches' angles as the controller shows them (e.g. ABB/FANUC axis 3)",
+    )
+    calibrate.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="the calibrated cell file (calibration.json is written beside it)",
+    )
+
+
 def _import_flags(robot_commands) -> None:
     """``robots import DESCRIPTION --name NAME ...``."""
     imp = robot_commands.add_parser(
@@ -257,7 +290,24 @@ def _import_flags(robot_commands) -> None:
         default=10_000,
         help="self-collision configurations (10000)",
     )
-    imp.add_argument("--force", action="store_true", help="replace an existing robot folder")
+    imp.add_argument(
+        "--force",
+        action="store_true",
+        help="replace a robot folder an earlier `robots import` wrote (no other folder)",
+    )
+    imp.add_argument(
+        "--allow-file-meshes",
+        action="store_true",
+        help="read file:// mesh names (anywhere on disk); default: only package:// and "
+        "relative names inside the --package-path folders",
+    )
+    imp.add_argument(
+        "--j23-coupled",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the controller counts axis 3 from the horizontal (ABB: required, model-"
+        "dependent, e.g. true for the IRB 2400; FANUC: always)",
+    )
 
 
 def _seams_flags(commands) -> None:

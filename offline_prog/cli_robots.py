@@ -14,10 +14,17 @@ def run_robots(args, console: Console) -> None:
     from offline_prog.robot.model import ROBOTS_DIR, load_robot
 
     if args.robots_command == "list":
+        from offline_prog.robot_import.folder import remark
+
         for name, folder, used in robots_in(search_path(ROBOTS_DIR)):
             where = "bundled" if folder == ROBOTS_DIR else f"{ENV_VAR}: {folder}"
-            hidden = "" if used else "  (hidden by the one above)"
-            console.print(f"{name:<24} {where}{hidden}", highlight=False)
+            notes = [] if used else ["hidden by the one above"]
+            notes += [note] if (note := remark(folder / name)) else []
+            console.print(
+                f"{name:<24} {where}" + "".join(f"  ({n})" for n in notes),
+                highlight=False,
+                markup=False,
+            )
         return
     if args.robots_command == "import":
         _run_import(args, console)
@@ -70,6 +77,8 @@ def _run_import(args, console: Console) -> None:
             tip=args.tip,
             samples=args.samples,
             force=args.force,
+            allow_file_meshes=args.allow_file_meshes,
+            j23_coupled=args.j23_coupled,
         )
     p = result.params
     if p is not None:

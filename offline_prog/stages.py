@@ -16,6 +16,7 @@ from pydrake.math import RigidTransform
 
 from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
 from offline_prog.collision.check import check_trajectory
+from offline_prog.config.calibration_keys import check_controller_frames
 from offline_prog.config.cell import Cell, load_cell, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
@@ -94,6 +95,7 @@ def load_inputs(file: Path, robots_dir: Path) -> Inputs:
     except ValueError as error:
         raise InputError(file, "robot.model", str(error)) from None
     check_process_io(file, cell, robot.language)
+    check_controller_frames(file, cell, robot.language)
     return Inputs(
         file,
         cell,

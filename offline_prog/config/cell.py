@@ -16,6 +16,7 @@ from pydrake.math import RigidTransform
 
 from offline_prog.config import safe_yaml
 from offline_prog.config.cad_keys import CadSeamConfig
+from offline_prog.config.calibration_keys import CalibrationConfig
 from offline_prog.config.process_keys import ProcessConfig
 from offline_prog.config.typed_check import check_mapping
 from offline_prog.errors import InputError
@@ -94,6 +95,8 @@ class ToolConfig:
     turn_smoothing_mm: float = 0.0
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in T
     process_io: ProcessIoConfig | None = None  # the process output (glue gun, torch)
+    # The controller's frame that holds T: KUKA BASE_DATA[n] (external TCP), FANUC UFRAME.
+    controller_frame: int | None = None
 
 
 @dataclasses.dataclass
@@ -106,6 +109,8 @@ class PartConfig:
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
     mass_kg: float | None = None  # payload: the part's mass ...
     center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
+    # The controller's frame that holds P on the flange: KUKA TOOL_DATA[m], FANUC UTOOL.
+    controller_frame: int | None = None
 
 
 @dataclasses.dataclass
@@ -273,6 +278,8 @@ class Cell:
     place: PlaceConfig | None = None
     # What the part gets along the path: bead, heat input or tape temperature.
     process: ProcessConfig | None = None
+    # What the touches of offline-prog calibrate refer to; plan ignores it.
+    calibration: CalibrationConfig | None = None
 
 
 def load_cell(file: str | os.PathLike) -> Cell:

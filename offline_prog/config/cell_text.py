@@ -1,12 +1,15 @@
 """Save: edited values written into the original cell file's text (session Save,
-placement's ``placed.yaml``), and the saved copy next to the original.
+placement's ``placed.yaml``, calibration's ``calibrated.yaml``), and the saved copy next
+to the original.
 
 Only the numbers that changed are replaced, each at its place in the text (the YAML
 node's marks), so comments, key order, flow or block style and every other value stay
 as the engineer wrote them. A key the file does not give (``motion.clearance`` left at
 its default) is added to its mapping; a transform whose rotation is not an ``!Rpy``
 is rewritten whole as ``{translation: [...], rotation: !Rpy {deg: [...]}}``. The
-result is loaded again and compared with the session's cell before it is written.
+result is loaded again and compared with the session's cell before it is written. A
+copy written into another folder (:func:`relocated_text`) names the same data files,
+relative to its new folder.
 """
 
 from __future__ import annotations
@@ -186,6 +189,49 @@ def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> 
         if node.value != value:  # unchanged text stays as written
             edits.replace(node, json.dumps(value))
     return edits.result()
+
+
+def data_file_keys(cell: Cell) -> dict[str, str]:
+    """{dotted key of the cell file: file name as written} of every data file the cell
+    names (path points, DXF, meshes, CAD models)."""
+    keys = {}
+    if cell.part.mesh:
+        keys["part.mesh"] = cell.part.mesh
+    if cell.part.model:  # STEP or mesh: seams, collision and visual geometry
+        keys["part.model"] = cell.part.model
+    paths = [("path", cell.path)] if cell.path else list(enumerate(cell.seams))
+    for key, path in paths:
+        key = key if isinstance(key, str) else f"seams.{key}"
+        for name in ("points", "dxf"):
+            if getattr(path, name):
+                keys[f"{key}.{name}"] = getattr(path, name)
+        if path.cad is not None and path.cad.file:
+            keys[f"{key}.cad.file"] = path.cad.file
+    for owner, shapes in (
+        ("obstacles", cell.obstacles),
+        ("part.geometry", cell.part.geometry),
+        ("tool.geometry", cell.tool.geometry),
+    ):
+        for i, shape in enumerate(shapes):
+            if shape.shape == "mesh" and shape.mesh:
+                keys[f"{owner}.{i}.mesh"] = shape.mesh
+    return keys
+
+
+def relocated_text(cell_file: Path, cell: Cell, out_dir: Path, poses: dict[str, tuple]) -> str:
+    """The cell file's text with ``poses`` written in (see :func:`with_values`), to be
+    written into ``out_dir``: its data files and ``robot.robots_dir`` re-pointed from
+    there (unchanged when ``out_dir`` is the cell file's own folder)."""
+    source, target = Path(cell_file).resolve().parent, Path(out_dir).resolve()
+    names = dict(data_file_keys(cell))
+    if cell.robot.robots_dir is not None:
+        names["robot.robots_dir"] = cell.robot.robots_dir
+    strings = {
+        key: os.path.relpath(source / name, target)
+        for key, name in names.items()
+        if source != target  # the same folder: every name stays as written
+    }
+    return with_values(Path(cell_file).read_text(encoding="utf-8"), poses, strings)
 
 
 MAX_SAVES = 10_000

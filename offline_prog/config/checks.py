@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cad_keys import check_cad, check_part_model
+from offline_prog.config.calibration_keys import check_calibration, check_controller_frames
 from offline_prog.config.cell import Cell, PathConfig
 from offline_prog.config.job_checks import check_job
 from offline_prog.config.process_keys import check_process
@@ -34,9 +35,27 @@ def _error(file, key, reason) -> InputError:
     return InputError(file, key, reason)
 
 
+def _check_robots_dir(file: Path, model: str, folder: Path) -> None:
+    """A cell's ``robot.robots_dir`` is a folder holding the robot: the robot is taken
+    from there, never from a folder searched after it (a mistyped folder would plan
+    with the bundled robot of the same name)."""
+    if not folder.is_dir():
+        raise _error(file, "robot.robots_dir", f"folder not found: {folder}")
+    if find_robot(model, [folder]) is None:
+        have = sorted({name for name, _, _ in robots_in([folder])})
+        raise _error(
+            file,
+            "robot.robots_dir",
+            f"{folder} holds no robot folder {model!r} (have: {', '.join(have) or 'none'}); "
+            "without robots_dir the robot comes from OFFLINE_PROG_ROBOTS or the bundled ones",
+        )
+
+
 def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     """Semantic checks the types alone cannot express."""
     folders = search_path(robots_dir, cell_file=file, robots_dir=cell.robot.robots_dir)
+    if cell.robot.robots_dir is not None:
+        _check_robots_dir(file, cell.robot.model, folders[0])
     if find_robot(cell.robot.model, folders) is None:
         have = sorted({name for name, _, _ in robots_in(folders)})
         raise _error(
@@ -111,6 +130,8 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
             raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
     _check_payload(file, cell)
     _check_shapes(file, cell)
+    check_calibration(file, cell.calibration)
+    check_controller_frames(file, cell, None)  # the robot's own ranges: stages.load_inputs
 
 
 def seam_keys(cell: Cell) -> list[tuple[str, PathConfig]]:

@@ -4,10 +4,10 @@ their types alone cannot express; every failure is an InputError naming the file
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from offline_prog.config.cell import Cell, JobConfig, SeamConfig
+from offline_prog.config.names import name_pattern
 from offline_prog.constants import MAX_SPEED_M_S
 from offline_prog.errors import InputError
 
@@ -17,7 +17,7 @@ MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
 MAX_LINK_TIME_S = 600.0  # planning time per link
 MAX_FLOW_LAG_S = 1.0  # a dispenser's lag: beyond this the path triggers cannot lead it
 MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
-SEAM_NAME = re.compile(rf"[A-Za-z][A-Za-z0-9_]{{0,{MAX_SEAM_NAME_CHARS - 1}}}")
+SEAM_NAME = name_pattern(MAX_SEAM_NAME_CHARS)
 
 
 def _error(file, key, reason) -> InputError:

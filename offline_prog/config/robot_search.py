@@ -1,6 +1,8 @@
 """Where a cell's robot is looked for: the folders holding robot folders, in order.
 
-1. the cell's ``robot: {robots_dir: DIR}`` (relative to the cell file), if given;
+1. the cell's ``robot: {robots_dir: DIR}`` (relative to the cell file), if given: it
+   must exist and hold the robot (``config.checks`` refuses it otherwise, so a mistyped
+   folder never falls back to a robot of the same name further down);
 2. each folder of the ``OFFLINE_PROG_ROBOTS`` environment variable (``os.pathsep``
    separated, like ``PATH``), e.g. where ``offline-prog robots import`` wrote robots;
 3. the bundled robots (``offline_prog/robots``).

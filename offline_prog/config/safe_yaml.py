@@ -82,23 +82,24 @@ def short_repr(value) -> str:
     return text if len(text) <= 2 * MAX_VALUE_CHARS else text[: 2 * MAX_VALUE_CHARS] + "..."
 
 
-def read_text(file: Path) -> str:
-    """The file's text: at most MAX_CELL_FILE_BYTES, UTF-8 (a BOM is dropped).
+def read_text(file: Path, *, what: str = "cell file", max_bytes: int = MAX_CELL_FILE_BYTES) -> str:
+    """The file's text: at most ``max_bytes``, UTF-8 (a BOM is dropped).
+
+    Args:
+        what: the kind of file, for the messages (a touches or controller file too).
 
     Raises:
         InputError: unreadable, too large, or not UTF-8 (naming the line).
     """
     try:
         size = file.stat().st_size
-        if size > MAX_CELL_FILE_BYTES:
-            raise InputError(
-                file, "", f"{size:,} bytes; a cell file has at most {MAX_CELL_FILE_BYTES:,}"
-            )
+        if size > max_bytes:
+            raise InputError(file, "", f"{size:,} bytes; a {what} has at most {max_bytes:,}")
         data = file.read_bytes()
     except OSError as error:
         raise InputError(file, "", f"cannot read ({error.strerror})") from None
     if data.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
-        raise InputError(file, "", "UTF-16 text; save the cell file as UTF-8")
+        raise InputError(file, "", f"UTF-16 text; save the {what} as UTF-8")
     try:
         return data.removeprefix(codecs.BOM_UTF8).decode("utf-8")
     except UnicodeDecodeError as error:
@@ -107,7 +108,7 @@ def read_text(file: Path) -> str:
         raise InputError(
             file,
             "",
-            f"line {line}: byte 0x{byte:02x} is not UTF-8 (Latin-1?); save the cell file as UTF-8",
+            f"line {line}: byte 0x{byte:02x} is not UTF-8 (Latin-1?); save the {what} as UTF-8",
         ) from None
 
 

@@ -65,6 +65,14 @@ def _check_value(file, key, raw, schema):
         return _check_transform(file, key, raw)
     if dataclasses.is_dataclass(schema):
         return check_mapping(file, key, raw, schema)
+    if origin is dict:  # {name: value}, names are text
+        if not isinstance(raw, dict) or "__tag__" in raw:
+            raise InputError(file, key, f"expected a mapping of names, got {short_repr(raw)}")
+        for name, item in raw.items():
+            if not isinstance(name, str):
+                raise InputError(file, f"{key}.{name}", "a name must be text")
+            _check_value(file, f"{key}.{name}", item, args[1])
+        return
     if (
         origin is list
         and args

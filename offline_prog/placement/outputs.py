@@ -18,13 +18,11 @@ from __future__ import annotations
 import collections
 import json
 import math
-import os
 from pathlib import Path
 
-from offline_prog.config.cell_text import with_values
+from offline_prog.config.cell_text import relocated_text
 from offline_prog.placement.context import Context, moved_obstacles
 from offline_prog.placement.objective import Evaluation
-from offline_prog.placement.payload import data_file_keys
 from offline_prog.placement.search import Placement
 from offline_prog.placement.space import Pose, SearchSpace
 
@@ -159,16 +157,10 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict, t
 
 def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) -> str:
     """The cell file's text with the best placement, to be written into ``out_dir``."""
-    text = cell_file.read_text(encoding="utf-8")
     poses = {"tool.X_IT": best.candidate.X_IT, "part.X_PE": best.candidate.X_PE}
     for i, pose in moved_obstacles(ctx, best.candidate).items():
         poses[f"obstacles.{i}.pose"] = pose
-    source = cell_file.resolve().parent
-    strings = {
-        key: os.path.relpath(source / name, Path(out_dir).resolve())
-        for key, name in data_file_keys(ctx.inputs.cell).items()
-    }
-    return with_values(text, poses, strings)
+    return relocated_text(cell_file, ctx.inputs.cell, out_dir, poses)
 
 
 def write_json(file: Path, data: dict) -> None:

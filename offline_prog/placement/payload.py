@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 from offline_prog.config.cell import Cell
-from offline_prog.config.cell_text import with_values
+from offline_prog.config.cell_text import data_file_keys, with_values
 
 
 @dataclasses.dataclass(frozen=True)
@@ -33,33 +33,6 @@ class CellPayload:
     cell_file: str
     files: tuple[tuple[str, bytes], ...]
     digest: str
-
-
-def data_file_keys(cell: Cell) -> dict[str, str]:
-    """{dotted key of the cell file: file name as written} of every data file the cell
-    names (path points, DXF, meshes, CAD models)."""
-    keys = {}
-    if cell.part.mesh:
-        keys["part.mesh"] = cell.part.mesh
-    if cell.part.model:  # STEP or mesh: seams, collision and visual geometry
-        keys["part.model"] = cell.part.model
-    paths = [("path", cell.path)] if cell.path else list(enumerate(cell.seams))
-    for key, path in paths:
-        key = key if isinstance(key, str) else f"seams.{key}"
-        for name in ("points", "dxf"):
-            if getattr(path, name):
-                keys[f"{key}.{name}"] = getattr(path, name)
-        if path.cad is not None and path.cad.file:
-            keys[f"{key}.cad.file"] = path.cad.file
-    for owner, shapes in (
-        ("obstacles", cell.obstacles),
-        ("part.geometry", cell.part.geometry),
-        ("tool.geometry", cell.tool.geometry),
-    ):
-        for i, shape in enumerate(shapes):
-            if shape.shape == "mesh" and shape.mesh:
-                keys[f"{owner}.{i}.mesh"] = shape.mesh
-    return keys
 
 
 def cell_payload(file: Path, cell: Cell) -> CellPayload:

@@ -14,6 +14,7 @@ from offline_prog.job.records import JobPlan
 from offline_prog.job.seams import job_config, job_seams
 from offline_prog.results.report import collision_summary, payload_summary, report
 from offline_prog.results.timing_bound import timing_bound_report
+from offline_prog.robot.record import robot_source
 
 
 def _segment_times(job: JobPlan) -> dict[str, float]:
@@ -72,6 +73,7 @@ def job_report(job: JobPlan) -> dict:
         "cell": str(job.cell_file),
         "name": job.cell.name,
         "robot": job.cell.robot.model,
+        **robot_source(job.robot),
         "tool": job.cell.tool.name,
         "part": job.cell.part.name,
         "payload": payload_summary(job.cell),

@@ -16,6 +16,7 @@ from offline_prog.constants import TimeLaw
 from offline_prog.export.payload import payload, payload_note, payload_record
 from offline_prog.job.records import Plan
 from offline_prog.joints.path_timing import without_joint_limits
+from offline_prog.robot.record import robot_source
 from offline_prog.timing.speed_hold import HOLD
 
 
@@ -249,6 +250,7 @@ def report(plan: Plan) -> dict:
         "cell": str(plan.cell_file),
         "name": cell.name,
         "robot": cell.robot.model,
+        **robot_source(plan.robot),
         "tool": cell.tool.name,
         "part": cell.part.name,
         "payload": payload_summary(cell),

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from offline_prog.config.names import MAX_ROBOT_NAME_CHARS, name_problem
 from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.robot import kinematics_opw, kinematics_ur
 from offline_prog.robot.kinematics_opw import OpwParameters
@@ -168,6 +169,11 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     if not name or Path(name).name != name or name in (".", "..") or not folder.is_dir():
         known = ", ".join(list_robots(robots_dir)) or "none"
         raise ValueError(f"{folder}: no robot folder named {name!r} (known robots: {known})")
+    problem = name_problem(name, max_chars=MAX_ROBOT_NAME_CHARS)
+    if problem:
+        raise ValueError(
+            f"{folder}: {problem}: a robot's name heads its programs; rename the folder"
+        )
     path = folder / PARAMS_FILE
     if not path.is_file():
         raise ValueError(f"{path}: file not found (each robot folder needs a {PARAMS_FILE})")
@@ -182,7 +188,11 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
     if family not in _KINEMATIC_KEYS:
         check.fail("family", family, f"one of {sorted(_KINEMATIC_KEYS)}")
     urdf_name = record.get("urdf", f"{name}.urdf")
-    if not isinstance(urdf_name, str) or not (folder / urdf_name).is_file():
+    if (
+        not isinstance(urdf_name, str)
+        or Path(urdf_name).name != urdf_name
+        or not (folder / urdf_name).is_file()
+    ):
         check.fail("urdf", urdf_name, f"the name of a URDF file in {folder}")
     names = record["joint_names"]
     if (
@@ -192,6 +202,9 @@ def load_robot(name: str, robots_dir: Path | None = None) -> RobotModel:
         or len(set(names)) != 6
     ):
         check.fail("joint_names", names, "6 distinct joint names")
+    for name_k in names:
+        if problem := name_problem(name_k, max_chars=MAX_ROBOT_NAME_CHARS):
+            check.fail("joint_names", names, f"joint names that head CSV columns ({problem})")
     limits = record["limits"]
     check.keys(limits, "limits", required=set(_LIMIT_KEYS), allowed={*_LIMIT_KEYS, "jerk_deg_s3"})
     position = check.numbers(limits["position_deg"], "limits.position_deg", shape=(6, 2))

@@ -9,6 +9,8 @@ plan. The record is in SI units (radians, metres), exactly the model's values.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import os
 from pathlib import Path
 
 import numpy as np
@@ -21,10 +23,34 @@ _PARAMS = {"opw": OpwParameters, "ur": UrParameters}
 _ARRAYS = ("q_lower", "q_upper", "qd_max", "qdd_max", "qddd_max", "home_c")
 
 
+def robot_source(robot: RobotModel) -> dict:
+    """Where the robot came from: ``robot_folder`` (absolute) and ``robot_files_sha256``,
+    a hash over every file in it (relative path and content), so a report says which
+    robot folder, and which state of it, a plan used."""
+    folder = robot.urdf_path.parent
+    return {"robot_folder": str(folder), "robot_files_sha256": folder_sha256(folder)}
+
+
+def folder_sha256(folder: Path) -> str:
+    """sha256 over the sorted lines ``<relative path> <sha256 of the file>`` of every
+    regular file below ``folder`` (symbolic links to folders not followed)."""
+    folder = Path(folder)
+    lines = []
+    for root, _, names in os.walk(folder):
+        for name in names:
+            file = Path(root) / name
+            if file.is_file():
+                digest = hashlib.sha256(file.read_bytes()).hexdigest()
+                lines.append(f"{file.relative_to(folder).as_posix()} {digest}\n")
+    return hashlib.sha256("".join(sorted(lines)).encode()).hexdigest()
+
+
 def robot_record(robot: RobotModel) -> dict:
     """The model as JSON-able data: names, family, kinematic parameters, joint limits
-    [rad, rad/s, rad/s², rad/s³], controller conventions and home [rad]."""
+    [rad, rad/s, rad/s², rad/s³], controller conventions and home [rad], and where it
+    came from (:func:`robot_source`; not read back)."""
     return {
+        **robot_source(robot),
         "name": robot.name,
         "family": robot.family,
         "params": None if robot.params is None else dataclasses.asdict(robot.params),

@@ -22,6 +22,7 @@ from offline_prog.errors import InputError
 REVOLUTE = ("revolute",)
 # A joint type on the chain other than these makes the robot "not 6R".
 PASSIVE = ("fixed",)
+WORLD = "world"  # Drake's name of the world body in a URDF
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,7 +61,7 @@ class Chain:
         return (self.base, *(j.child for j in self.joints))
 
 
-def _floats(text: str | None, count: int, file: Path, key: str) -> np.ndarray:
+def floats(text: str | None, count: int, file: Path, key: str) -> np.ndarray:
     try:
         values = np.array([float(v) for v in (text or "").split()]) if text else np.zeros(count)
     except ValueError:
@@ -74,8 +75,8 @@ def origin(element: ET.Element | None, file: Path, key: str) -> RigidTransform:
     """The pose an ``<origin xyz rpy>`` element gives (identity when absent)."""
     if element is None:
         return RigidTransform()
-    xyz = _floats(element.get("xyz"), 3, file, f"{key} origin xyz")
-    rpy = _floats(element.get("rpy"), 3, file, f"{key} origin rpy")
+    xyz = floats(element.get("xyz"), 3, file, f"{key} origin xyz")
+    rpy = floats(element.get("rpy"), 3, file, f"{key} origin rpy")
     return RigidTransform(RollPitchYaw(rpy), xyz)
 
 
@@ -116,25 +117,25 @@ def parse_chain(text: str, file: Path, *, base: str = "base_link", tip: str = "t
         root = ET.fromstring(text)
     except ET.ParseError as error:
         raise InputError(file, "", f"not valid URDF XML ({error})") from None
-    links = {link.get("name") for link in root.findall("link")}
+    links = _unique(root, "link", file)
+    _unique(root, "joint", file)
     for key, name in (("--base", base), ("--tip", tip)):
         if name not in links:
             raise InputError(
                 file, key, f"no link named {name!r} (links: {', '.join(sorted(links))})"
             )
-    for joint in root.findall("joint"):
-        for tag in ("parent", "child"):
-            if joint.find(tag) is None or not joint.find(tag).get("link"):
-                raise InputError(file, f"joint {joint.get('name')}", f"needs <{tag} link=...>")
-    by_child = {j.find("child").get("link"): j for j in root.findall("joint")}
-    path: list[ET.Element] = []
-    link = tip
-    while link != base:
-        if link not in by_child:
-            raise InputError(file, "--base", f"{tip!r} is not below {base!r} in the URDF tree")
-        path.append(by_child[link])
-        link = path[-1].find("parent").get("link")
+    if base == WORLD:
+        raise InputError(file, "--base", f"{WORLD!r} is Drake's world: name the robot's base link")
+    path = _path(root, file, base=base, tip=tip)
     joints = tuple(_joint(element, file) for element in reversed(path))
+    for element in path:
+        if element.find("mimic") is not None:
+            raise InputError(
+                file,
+                f"joint {element.get('name')} mimic",
+                f"follows joint {element.find('mimic').get('joint')!r}: a dependent joint on "
+                "the chain is not a free axis, and the planner moves six free axes",
+            )
     moving = [j for j in joints if j.kind not in PASSIVE]
     if len(moving) != 6 or any(j.kind not in REVOLUTE for j in moving):
         found = ", ".join(f"{j.name} ({j.kind})" for j in moving) or "none"
@@ -144,10 +145,59 @@ def parse_chain(text: str, file: Path, *, base: str = "base_link", tip: str = "t
     return Chain(root, Path(file), base, tip, joints)
 
 
+def _unique(root: ET.Element, tag: str, file: Path) -> set[str]:
+    """The names of the ``<tag>`` elements, each given once."""
+    names: set[str] = set()
+    for element in root.findall(tag):
+        name = element.get("name")
+        if not name:
+            raise InputError(file, tag, f"a <{tag}> without a name")
+        if name in names:
+            raise InputError(file, f"{tag} {name}", "the name is used twice")
+        names.add(name)
+    return names
+
+
+def _path(root: ET.Element, file: Path, *, base: str, tip: str) -> list[ET.Element]:
+    """The joint elements from ``tip`` up to ``base`` (tip first).
+
+    Raises:
+        InputError: a link that is the child of two joints, a cycle, a missing
+            parent or child, or no path.
+    """
+    by_child: dict[str, ET.Element] = {}
+    for joint in root.findall("joint"):
+        for tag in ("parent", "child"):
+            if joint.find(tag) is None or not joint.find(tag).get("link"):
+                raise InputError(file, f"joint {joint.get('name')}", f"needs <{tag} link=...>")
+        child = joint.find("child").get("link")
+        if child in by_child:
+            raise InputError(
+                file,
+                f"joint {joint.get('name')}",
+                f"link {child!r} is already the child of joint {by_child[child].get('name')!r} "
+                "(a URDF is a tree)",
+            )
+        by_child[child] = joint
+    path: list[ET.Element] = []
+    link, seen = tip, {tip}
+    while link != base:
+        if link not in by_child:
+            raise InputError(file, "--base", f"{tip!r} is not below {base!r} in the URDF tree")
+        path.append(by_child[link])
+        link = path[-1].find("parent").get("link")
+        if link in seen:
+            raise InputError(
+                file, f"joint {path[-1].get('name')}", f"the joints form a cycle through {link!r}"
+            )
+        seen.add(link)
+    return path
+
+
 def _joint(element: ET.Element, file: Path) -> ChainJoint:
     name, kind = element.get("name"), element.get("type")
     key = f"joint {name}"
-    axis = _floats(
+    axis = floats(
         element.find("axis").get("xyz") if element.find("axis") is not None else "1 0 0",
         3,
         file,

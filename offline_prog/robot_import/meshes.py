@@ -21,8 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.errors import InputError
-from offline_prog.robot_import.chain import Chain, origin
-from offline_prog.robot_import.sources import resolve_uri
+from offline_prog.robot_import.chain import Chain, floats, origin
+from offline_prog.robot_import.plausible import MAX_CHAIN_LENGTH_M
+from offline_prog.robot_import.sources import Packages, resolve_uri
 
 DIGITS = 5  # 10 µm in metres, as the bundled meshes
 SMOOTH_ANGLE_DEG = 30.0
@@ -49,7 +50,7 @@ class MeshSource:
 
 
 def convert_meshes(
-    chain: Chain, packages: dict[str, Path], out: Path
+    chain: Chain, packages: Packages, out: Path
 ) -> tuple[dict[str, dict[str, list[str]]], list[MeshSource]]:
     """Write every chain link's meshes under ``out/meshes``.
 
@@ -75,7 +76,10 @@ def convert_meshes(
                     continue
                 mesh, source = loaded
                 meshes.append(mesh)
-                colours.append(_rgba(element, materials))
+                visual = role == "visual"
+                colours.append(
+                    material_rgba(element, materials, chain.file) if visual else DEFAULT_RGBA
+                )
                 sources.append(source)
             if meshes:
                 written = _write(out, name, role, meshes, colours, trimesh)
@@ -94,7 +98,7 @@ def _load(element: ET.Element, chain: Chain, packages, link: str, role: str, tri
         return None  # primitives are kept as they are (see record.write_urdf)
     uri = mesh_element.get("filename", "")
     file = resolve_uri(uri, packages, base_dir=chain.file.parent, file=chain.file)
-    scale = np.array([float(s) for s in mesh_element.get("scale", "1 1 1").split()])
+    scale = floats(mesh_element.get("scale", "1 1 1"), 3, chain.file, f"{uri} scale")
     try:
         mesh = trimesh.load(file, force="mesh")
     except Exception as error:  # trimesh raises many kinds for unreadable files
@@ -106,6 +110,13 @@ def _load(element: ET.Element, chain: Chain, packages, link: str, role: str, tri
     X_LG = origin(element.find("origin"), chain.file, f"link {link} {role}")
     mesh.apply_scale(scale)
     mesh.apply_transform(X_LG.GetAsMatrix4())
+    if mesh.extents.max() > MAX_CHAIN_LENGTH_M:
+        raise InputError(
+            chain.file,
+            uri,
+            f"the mesh is {mesh.extents.max():.4g} m across, more than {MAX_CHAIN_LENGTH_M:g} m: "
+            'a mesh in millimetres needs <mesh scale="0.001 0.001 0.001">',
+        )
     rpy = X_LG.rotation().ToRollPitchYaw().vector()
     source = MeshSource(
         link,
@@ -122,17 +133,28 @@ def _load(element: ET.Element, chain: Chain, packages, link: str, role: str, tri
     return mesh, source
 
 
-def _rgba(element: ET.Element, materials: dict) -> tuple[float, ...]:
+def material_rgba(element: ET.Element, materials: dict, file: Path) -> tuple[float, ...]:
+    """The colour (r, g, b, a) of a ``<visual>``: its material's ``<color rgba>``, or
+    the named top-level material's; DEFAULT_RGBA when neither gives one.
+
+    Raises:
+        InputError: an rgba that is not four numbers in [0, 1].
+    """
     material = element.find("material")
     if material is not None and material.find("color") is None:
         material = materials.get(material.get("name"), material)
     colour = material.find("color") if material is not None else None
     if colour is None:
         return DEFAULT_RGBA
+    text = colour.get("rgba", "")
+    key = f"material {material.get('name') or ''} color rgba".replace("  ", " ")
     try:
-        return tuple(float(v) for v in colour.get("rgba", "").split())[:4] or DEFAULT_RGBA
+        rgba = tuple(float(v) for v in text.split())
     except ValueError:
-        return DEFAULT_RGBA
+        rgba = ()
+    if len(rgba) != 4 or not all(0.0 <= v <= 1.0 for v in rgba):
+        raise InputError(file, key, f"expected four numbers in [0, 1], got {text!r}")
+    return rgba
 
 
 def _write(out: Path, link: str, role: str, meshes, colours, trimesh) -> list[str]:

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from offline_prog.robot.kinematics_opw import OpwParameters
 from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot_import.chain import Chain
+from offline_prog.robot_import.sources import Packages
 from offline_prog.robot_import.verify import VERIFY_TOL_M, FkCheck
 
 
@@ -21,11 +20,13 @@ def readme_text(
     fk: FkCheck | None,
     notes: list[str],
     controller: dict,
-    packages: dict[str, Path],
+    packages: Packages,
+    source: str,
     pairs: list,
     samples: int,
 ) -> str:
-    """The folder's README (Markdown)."""
+    """The folder's README (Markdown); paths appear without the user's folders
+    (``source`` and the packages as :meth:`Packages.display` gives them)."""
     joints = chain.revolute
     rows = "".join(
         f"| {j.name} | {np.degrees(j.lower):.3f} .. {np.degrees(j.upper):.3f} | "
@@ -37,25 +38,15 @@ def readme_text(
         for kind in ("adjacent", "always", "constant", "never", "check")
     }
     kinematics = "## Kinematics\n\n" + _kinematics(chain, params, fk) + "\n"
-    coupling = (
-        f"\n## Controller axes\n\nFANUC counts J3 from the horizontal, not from the upper arm: "
-        f"controller J3 = q3 + ({controller['j23_factor']}) q2 of this URDF "
-        "(`controller: {j23_coupled: true, j23_factor: ...}`; the factor is the dot product "
-        "of the URDF's parallel axes 2 and 3). The ROS-Industrial FANUC driver converts between "
-        "the two the same way (ros-industrial/fanuc, `fanuc_driver`: the J23 linkage "
-        "correction, parameter `J23_factor`). The URDF's position limits are FANUC's axis "
-        "ranges and apply to the controller's axes.\n"
-        if controller.get("j23_coupled")
-        else ""
-    )
+    coupling = _coupling(vendor, controller)
     return (
-        f"# {name}\n\nImported by `offline-prog robots import` from `{chain.file}` "
+        f"# {name}\n\nImported by `offline-prog robots import` from `{source}` "
         f"(vendor: {vendor}). Files: `{name}.urdf` (the chain `{chain.base}` -> `{chain.tip}` of "
         "the description; joint names, origins, axes, limits unchanged; links off the chain "
         "dropped; base and tip named `base_link` and `tool0`), `robot.yaml`, "
         "`self_collision.yaml`, `meshes/` (`meshes/SOURCES.md`: every source file and what was "
         "done to it).\n\nROS packages used: "
-        + ", ".join(f"`{k}` ({v})" for k, v in sorted(packages.items()))
+        + (", ".join(f"`{k}`" for k in sorted(packages.folders)) or "none")
         + "\n\n"
         + kinematics
         + "\n## Limits\n\n| joint | position [deg] | velocity [deg/s] |\n| --- | --- | --- |\n"
@@ -67,6 +58,28 @@ def readme_text(
         + f"`self_collision.yaml`, {samples} sampled configurations, seed 0: "
         + ", ".join(f"{v} {k}" for k, v in counts.items())
         + " pairs; the planner checks the `check` pairs.\n"
+    )
+
+
+def _coupling(vendor: str, controller: dict) -> str:
+    """The Controller axes section of a J2/J3-coupled robot ("" for the others)."""
+    if not controller.get("j23_coupled"):
+        return ""
+    factor = controller.get("j23_factor", 1)
+    source = (
+        "The ROS-Industrial FANUC driver converts between the two the same way "
+        "(ros-industrial/fanuc, `fanuc_driver`: the J23 linkage correction, parameter "
+        "`J23_factor`)."
+        if vendor == "fanuc"
+        else "As the ROS-Industrial ABB driver's `J23_coupled` parameter (given on the "
+        "command line: `--j23-coupled`)."
+    )
+    return (
+        f"\n## Controller axes\n\nThe {vendor.upper()} controller counts J3 from the "
+        f"horizontal, not from the upper arm: controller J3 = q3 + ({factor}) q2 of this URDF "
+        "(`controller: {j23_coupled: true, j23_factor: ...}`; the factor is the dot product "
+        f"of the URDF's parallel axes 2 and 3). {source} The URDF's position limits are the "
+        "controller's axis ranges and apply to the controller's axes.\n"
     )
 
 

@@ -18,7 +18,8 @@ import yaml
 from offline_prog.robot.kinematics_opw import OpwParameters
 from offline_prog.robot.kinematics_ur import UrParameters
 from offline_prog.robot_import.chain import Chain
-from offline_prog.robot_import.meshes import MeshSource
+from offline_prog.robot_import.meshes import MeshSource, material_rgba
+from offline_prog.robot_import.sources import Packages
 
 # Assumptions where a URDF is silent (the bundled robots state the same two ratios).
 ASSUMED_VELOCITY_DEG_S = 90.0  # a joint without a URDF velocity limit
@@ -47,10 +48,10 @@ def write_urdf(chain: Chain, files: dict, out: Path, name: str) -> Path:
         if source.find("inertial") is not None:
             link.append(source.find("inertial"))
         for role in ("visual", "collision"):
-            for element in source.findall(role):  # primitives kept as they are
+            for k, element in enumerate(source.findall(role)):  # primitives kept
                 geometry = element.find("geometry")
                 if geometry is not None and geometry.find("mesh") is None:
-                    link.append(element)
+                    link.append(_primitive(element, chain, f"{link_name}_{role}_{k}", role))
             for file in files.get(link_name, {}).get(role, []):
                 element = ET.SubElement(link, role)
                 ET.SubElement(element, "origin", xyz="0 0 0", rpy="0 0 0")
@@ -70,6 +71,24 @@ def write_urdf(chain: Chain, files: dict, out: Path, name: str) -> Path:
         '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n", encoding="utf-8"
     )
     return file
+
+
+def _primitive(element: ET.Element, chain: Chain, material: str, role: str) -> ET.Element:
+    """A copy of a ``<visual>``/``<collision>`` primitive whose material, if any, is its
+    own colour by a name of its own (Drake refuses a material without colour, and one
+    name given two colours)."""
+    copy = ET.fromstring(ET.tostring(element))
+    for old in copy.findall("material"):
+        copy.remove(old)
+    if role == "visual":
+        rgba = material_rgba(element, _materials(chain), chain.file)
+        colour = ET.SubElement(copy, "material", name=material)
+        ET.SubElement(colour, "color", rgba=" ".join(f"{v:g}" for v in rgba))
+    return copy
+
+
+def _materials(chain: Chain) -> dict[str, ET.Element]:
+    return {m.get("name"): m for m in chain.root.findall("material")}
 
 
 def limits_record(chain: Chain) -> tuple[dict, list[str]]:
@@ -138,8 +157,10 @@ def robot_yaml(
     limits: dict,
     notes: list[str],
     controller: dict,
+    source: str,
 ) -> str:
-    """The text of robot.yaml (comments say where each number comes from)."""
+    """The text of robot.yaml (comments say where each number comes from); ``source``
+    names the description without the user's folders (Packages.display)."""
     record = {
         "vendor": vendor,
         "family": family(params),
@@ -150,7 +171,7 @@ def robot_yaml(
         record["kinematics"] = kinematics_record(params)
     record["limits"], record["controller"] = limits, controller
     header = (
-        f"# Imported by `offline-prog robots import` from {chain.file}.\n"
+        f"# Imported by `offline-prog robots import` from {source}.\n"
         "# Angles at this edge are in degrees (keys say so); lengths in metres.\n"
         + "".join(f"# limits.{note}\n" for note in notes)
         + (
@@ -164,10 +185,13 @@ def robot_yaml(
     return header + yaml.safe_dump(record, sort_keys=False, width=100, default_flow_style=None)
 
 
-def sources_md(name: str, sources: list[MeshSource], licence: Path | None) -> str:
-    """meshes/SOURCES.md: every converted mesh, its source, checksum and transform."""
+def sources_md(
+    name: str, sources: list[MeshSource], licence: Path | None, packages: Packages
+) -> str:
+    """meshes/SOURCES.md: every converted mesh, its source (without the user's folders),
+    checksum and transform."""
     rows = "".join(
-        f"| {s.link} | {s.role} | `{s.source}` | `{s.sha256[:16]}…` | "
+        f"| {s.link} | {s.role} | `{packages.display(s.source)}` | `{s.sha256[:16]}…` | "
         f"{' '.join(f'{v:g}' for v in s.xyz)} | {' '.join(f'{v:g}' for v in s.rpy)} | "
         f"{' '.join(f'{v:g}' for v in s.scale)} | {s.triangles} | {', '.join(s.written)} |\n"
         for s in sources
@@ -187,7 +211,7 @@ def sources_md(name: str, sources: list[MeshSource], licence: Path | None) -> st
         + "\n## Licence\n\n"
         + (
             "The source package's licence is copied beside the meshes "
-            f"(`LICENSE`, from `{licence}`)."
+            f"(`LICENSE`, from `{packages.display(licence)}`)."
             if licence
             else "No licence file was found in or above the source package: check the\n"
             "package's `package.xml` before distributing these meshes."

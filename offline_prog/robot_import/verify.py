@@ -1,7 +1,7 @@
 """Drake's forward kinematics of the description against the derived kinematic model.
 
-The description's own chain (its URDF text, geometry removed so that no mesh needs
-resolving) is loaded into a MultibodyPlant; tool0's pose in base_link at seeded
+The description's own chain (its links and joints base → tip, without geometry, so that
+no mesh needs resolving) is loaded into a MultibodyPlant; tool0's pose in base_link at seeded
 configurations within the joint limits is compared with the OPW model's.
 """
 
@@ -39,12 +39,21 @@ class FkCheck:
 
 
 def kinematic_urdf(chain: Chain) -> str:
-    """The description's URDF text without visual and collision elements."""
-    root = ET.fromstring(ET.tostring(chain.root))
-    for link in root.findall("link"):
-        for child in link.findall("visual") + link.findall("collision"):
-            link.remove(child)
-    return ET.tostring(root, encoding="unicode")
+    """The chain base → tip alone as URDF text: its links (no geometry, no inertia) and
+    its joints (name, type, parent, child, origin, axis, limit). Whatever else the
+    description holds (a ``world`` link fixed to the base, materials, grippers) stays
+    out of Drake's way."""
+    robot = ET.Element("robot", name="chain")
+    for link in chain.links:
+        ET.SubElement(robot, "link", name=link)
+    sources = {j.get("name"): j for j in chain.root.findall("joint")}
+    for joint in chain.joints:
+        source = sources[joint.name]
+        copy = ET.SubElement(robot, "joint", name=joint.name, type=joint.kind)
+        for tag in ("parent", "child", "origin", "axis", "limit"):
+            if source.find(tag) is not None:
+                copy.append(ET.fromstring(ET.tostring(source.find(tag))))
+    return ET.tostring(robot, encoding="unicode")
 
 
 def check_fk(

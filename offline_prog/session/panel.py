@@ -9,6 +9,10 @@ from), the controls and the status line on the right. The API:
 - ``POST /set`` ``{"key": ..., "value": "typed text"}``: a control's new value;
 - ``POST /action`` ``{"name": "plan" | "save" | "export" | "play" | "pause" | "seek" |
   "auto", "value": ...}``;
+- ``POST /touches`` ``{"file": name, "text": the touches file's text,
+  "controller_angles": false}``: calibrate the cell from touches (``offline-prog
+  calibrate``'s file; the panel reads it in the browser, so the session reads no path a
+  page names) and draw the nominal and calibrated flange paths side by side;
 - ``GET /seams``: for a cell with ``part.model``, the page of ``offline-prog seams`` on
   it (the model's faces, loops and chains with the numbers its ``cad:`` seams pick by),
   linked from the panel.
@@ -32,12 +36,22 @@ from importlib import resources
 from urllib.parse import urlsplit
 
 from offline_prog.session.guard import Guard, is_json
-from offline_prog.session.request import MAX_BODY_BYTES, RequestError, read_body
+from offline_prog.session.request import (
+    MAX_BODY_BYTES,
+    MAX_TOUCHES_BODY_BYTES,
+    RequestError,
+    read_body,
+)
 from offline_prog.viz.local_server import bind_address, family
 
 log = logging.getLogger(__name__)
 PAGES = ("/", "/index.html")
-KEYS = {"/set": ("key", "value"), "/action": ("name", "value")}  # what each POST takes
+KEYS = {  # what each POST takes
+    "/set": ("key", "value"),
+    "/action": ("name", "value"),
+    "/touches": ("file", "text", "controller_angles"),
+}
+LIMITS = {"/touches": MAX_TOUCHES_BODY_BYTES}  # body sizes other than MAX_BODY_BYTES
 
 
 SEAMS_LINK = (
@@ -139,27 +153,32 @@ class _Handler(BaseHTTPRequestHandler):
             message = f"refused: Content-Type {kind!r}: the panel takes application/json"
             self._refuse(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, message)
             return
+        limit = LIMITS.get(path, MAX_BODY_BYTES)
         try:
-            body = read_body(self._body(), keys=KEYS[path])
+            body = read_body(self._body(limit), keys=KEYS[path], max_bytes=limit)
         except RequestError as error:
             self._refuse(HTTPStatus.BAD_REQUEST, f"bad request: {error}")
             return
         if path == "/set":
             reply = self.session.set_value(body.get("key"), body.get("value"))
+        elif path == "/touches":
+            reply = self.session.load_touches(
+                body.get("file"), body.get("text"), body.get("controller_angles", False)
+            )
         else:
             reply = self.session.action(body.get("name"), body.get("value"))
         self._json(reply, HTTPStatus.OK if reply["ok"] else HTTPStatus.BAD_REQUEST)
 
-    def _body(self) -> bytes:
-        """The body, at most MAX_BODY_BYTES (RequestError otherwise; never read past)."""
+    def _body(self, limit: int) -> bytes:
+        """The body, at most ``limit`` bytes (RequestError otherwise; never read past)."""
         if self.headers.get("Transfer-Encoding") is not None:
             raise RequestError("send a Content-Length, not a Transfer-Encoding")
         try:
             length = int(self.headers.get("Content-Length") or 0)
         except ValueError:
             raise RequestError("Content-Length is not a number") from None
-        if not 0 <= length <= MAX_BODY_BYTES:
-            raise RequestError(f"body larger than {MAX_BODY_BYTES} bytes")
+        if not 0 <= length <= limit:
+            raise RequestError(f"body larger than {limit} bytes")
         return self.rfile.read(length)
 
     def _failed(self, error: Exception) -> None:

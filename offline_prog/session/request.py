@@ -1,7 +1,8 @@
 """The panel's request bodies and values, checked before they reach the session.
 
 A request the session cannot use is refused with a one-line reason (400) and changes
-nothing: a body larger than ``MAX_BODY_BYTES`` or nested deeper than ``MAX_DEPTH``
+nothing: a body larger than ``MAX_BODY_BYTES`` (a touches file: ``MAX_TOUCHES_BODY_BYTES``)
+or nested deeper than ``MAX_DEPTH``
 (read without recursion, so no RecursionError), text that is not JSON (``NaN`` and
 ``Infinity`` included, which Python's json would accept), a key the endpoint does not
 take, and a value of the wrong kind. Values (:func:`finite`, :func:`boolean`,
@@ -15,6 +16,7 @@ import json
 import math
 
 MAX_BODY_BYTES = 10_000  # a request is a key and a value: ~100 bytes
+MAX_TOUCHES_BODY_BYTES = 200_000  # a touches file's text: ~70 bytes a touch
 MAX_DEPTH = 2  # an object holding a list at most (a request is one flat object)
 
 
@@ -51,15 +53,16 @@ def _no_constant(name: str):
     raise RequestError(f"{name} is not a JSON number")
 
 
-def read_body(body: bytes, *, keys: tuple[str, ...]) -> dict:
-    """The JSON object of a request body, holding only ``keys`` (each optional).
+def read_body(body: bytes, *, keys: tuple[str, ...], max_bytes: int = MAX_BODY_BYTES) -> dict:
+    """The JSON object of a request body, holding only ``keys`` (each optional), of at
+    most ``max_bytes``.
 
     Raises:
         RequestError: too large, not UTF-8, not JSON, too deep, not an object, or a
             key the endpoint does not take.
     """
-    if len(body) > MAX_BODY_BYTES:
-        raise RequestError(f"body larger than {MAX_BODY_BYTES} bytes")
+    if len(body) > max_bytes:
+        raise RequestError(f"body larger than {max_bytes} bytes")
     try:
         text = body.decode("utf-8")
     except UnicodeDecodeError:
@@ -124,6 +127,19 @@ def typed(value, what: str) -> str | float:
     """
     if isinstance(value, bool) or not isinstance(value, int | float | str):
         raise RequestError(f"{what} {_shown(value)} is not a number or text")
+    return value
+
+
+def text(value, what: str, *, max_chars: int) -> str:
+    """Text of at most ``max_chars`` characters.
+
+    Raises:
+        RequestError: anything but text, or longer.
+    """
+    if not isinstance(value, str):
+        raise RequestError(f"{what} {_shown(value)} is not text")
+    if len(value) > max_chars:
+        raise RequestError(f"{what} is longer than {max_chars} characters")
     return value
 
 

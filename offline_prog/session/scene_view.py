@@ -7,7 +7,9 @@ joints, the part at X_IP = X_IE · X_PE⁻¹ of the plan shown, the tool at the 
 (at once: it is what the engineer moved). The processing path hangs under the part's
 node in P, one line set per sample state; an outdated plan's path turns grey. The
 closest pair of the plan is a red (below the clearance) or amber segment between its
-witness points, measured at the pose shown.
+witness points, measured at the pose shown. A calibration (touches loaded) adds the
+nominal and the calibrated flange paths side by side in I, blue and orange, with both
+tool tips.
 
 Every call must come from the thread that created the Meshcat (Drake's rule).
 """
@@ -18,6 +20,7 @@ import numpy as np
 from pydrake.geometry import Meshcat, Rgba, Sphere
 from pydrake.math import RigidTransform
 
+from offline_prog.calibration.path_shift import moved_flange
 from offline_prog.session.sample_states import sample_states
 from offline_prog.viz.preview import camera
 
@@ -33,6 +36,9 @@ MAX_PATH_SEGMENTS = 1500
 LINE_WIDTH = 4.0
 WITNESS_RADIUS_M = 0.004
 ROOT = "/drake/visualizer"
+CALIBRATION = "/session/calibration"
+CALIBRATION_COLORS = {"nominal": (0.15, 0.45, 0.95, 1.0), "calibrated": (1.0, 0.5, 0.0, 1.0)}
+TIP_RADIUS_M = 0.003
 
 
 class SceneView:
@@ -89,6 +95,36 @@ class SceneView:
         )
         self.set_outdated(False)
         self._pair = _pair_query(result.scene, plan.collisions)
+
+    def show_calibration(self, calibration) -> None:
+        """The nominal flange path of the plan shown and the one the calibrated cell
+        asks for, side by side, and both tool tips (a calibration.run.Calibration)."""
+        self.meshcat.Delete(CALIBRATION)
+        tips = {"calibrated": calibration.X_IT.translation()}
+        plan = None if self.shown is None else self.shown.plan
+        if plan is not None:
+            flange = plan.trajectory.flange
+            index = np.unique(np.linspace(0, len(flange.p_IE) - 1, MAX_PATH_SEGMENTS).astype(int))
+            p_IE, R_IE = flange.p_IE[index], flange.R_IE[index]
+            paths = {
+                "nominal": p_IE,
+                "calibrated": moved_flange(
+                    p_IE,
+                    R_IE,
+                    X_IT=plan.flange.X_IT,
+                    X_PE=plan.flange.X_PE,
+                    X_IT_new=calibration.X_IT,
+                    X_PE_new=calibration.X_PE,
+                ),
+            }
+            for name, p in paths.items():
+                rgba = Rgba(*CALIBRATION_COLORS[name])
+                self.meshcat.SetLine(f"{CALIBRATION}/{name}/path", p.T, LINE_WIDTH, rgba)
+            tips["nominal"] = plan.flange.X_IT.translation()
+        for name, p in tips.items():
+            path = f"{CALIBRATION}/{name}/tip"
+            self.meshcat.SetObject(path, Sphere(TIP_RADIUS_M), Rgba(*CALIBRATION_COLORS[name]))
+            self.meshcat.SetTransform(path, RigidTransform(p))
 
     def set_outdated(self, outdated: bool) -> None:
         """Grey path for a plan that no longer matches the controls."""

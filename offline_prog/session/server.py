@@ -27,7 +27,7 @@ from offline_prog.config import cell_text
 from offline_prog.config.cell import transform
 from offline_prog.errors import InputError
 from offline_prog.scene.drake_cell import build_cell_model
-from offline_prog.session import outputs, request
+from offline_prog.session import calibration, outputs, request
 from offline_prog.session.replan import Replanner, SupersededError
 from offline_prog.session.scene_view import SceneView
 from offline_prog.session.state import controls, values, with_value
@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 
 SETTLE_S = 0.3  # a control untouched this long has settled: re-plan
 FRAME_S = 1.0 / 30.0  # main-loop period (animation frames)
-ACTIONS = ("plan", "save", "export", "play", "pause", "seek", "auto")
+ACTIONS = ("plan", "save", "export", "play", "pause", "seek", "auto", "calibrated")
 
 
 class Session:
@@ -59,6 +59,7 @@ class Session:
         self.last_step = time.monotonic()
         self.seek: float | None = None  # σ [m] asked for by the panel
         self.plan_line = {"kind": "planning", "line": "planning…"}
+        self.last_calibration: calibration.SessionCalibration | None = None  # the last solved
         self.requests: queue.Queue = queue.Queue()
         self.answers: queue.Queue = queue.Queue()
         cell = self.replanner.base.cell
@@ -108,7 +109,17 @@ class Session:
                 "length": length,
                 "saved": None if self.last_saved is None else str(self.last_saved),
                 "exported": None if self.last_exported is None else str(self.last_exported),
+                "calibration": self._calibration(),
             }
+
+    def _calibration(self) -> dict | None:
+        """The last touches file solved: its name, summary lines, and whether the
+        controls hold its frames (call with the lock held)."""
+        found = self.last_calibration
+        if found is None:
+            return None
+        applied = calibration.calibrated(self.state, found) == self.state
+        return {"file": found.file, "lines": found.lines, "applied": applied}
 
     def set_value(self, key: str, text) -> dict:
         """A typed or slid value (text or a number, in the control's unit): the new
@@ -124,6 +135,20 @@ class Session:
                 self.state, self.changed_at = state, time.monotonic()
                 self.generation += 1
                 self.message = ("info", f"{key} = {values(state)[key]:g}")
+            return {"ok": True}
+
+    def load_touches(self, file, text, controller_angles=False) -> dict:
+        """A touches file's text from the panel: checked now (``ok: False`` with a
+        one-line message, nothing changed), solved on the planner thread against the
+        cell as the controls set it, then drawn beside the plan."""
+        with self.lock:
+            try:
+                found = calibration.read(self.replanner, self.state, file, text, controller_angles)
+            except (request.RequestError, InputError) as error:
+                self.message = ("refused", f"touches refused: {error}")
+                return {"ok": False, "message": self.message[1]}
+            self.requests.put(("calibrate", self.generation, found))
+            self.message = ("info", f"calibrating from {found[1].file}…")
             return {"ok": True}
 
     def action(self, name: str, value=None) -> dict:
@@ -154,6 +179,14 @@ class Session:
         elif name in ("save", "export"):
             self.requests.put((name, self.generation, self.state))
             self.message = ("info", f"{name}…")
+        elif name == "calibrated":  # the controls to the calibrated X_IT and X_PE
+            if self.last_calibration is None:
+                raise request.RequestError("no calibration yet: load a touches file")
+            state = calibration.calibrated(self.state, self.last_calibration)
+            if state != self.state:
+                self.state, self.changed_at = state, time.monotonic()
+                self.generation += 1
+            self.message = ("info", f"X_IT and X_PE from {self.last_calibration.file}")
         else:
             self.playing = name == "play"
 
@@ -199,6 +232,9 @@ class Session:
         progress = self._progress(generation, supersede=kind == "plan")
         if kind == "plan":
             return self.replanner.plan(state, progress)
+        if kind == "calibrate":  # state: the checked (inputs, touches)
+            progress("calibrating")
+            return calibration.solve(*state)
         saved = self.saved.get(state)
         if saved is None or not saved.exists():
             planner = self.replanner
@@ -264,6 +300,12 @@ class Session:
             with self.lock:
                 self.last_saved, self.last_exported = saved, folder
                 self.message = ("info", line)
+            return
+        if kind == "calibrate":
+            self.view.show_calibration(answer.calibration)
+            with self.lock:
+                self.last_calibration = answer
+                self.message = ("info", f"calibrated from {answer.file}: " + answer.lines[-1])
             return
         with self.lock:
             if generation != self.generation:

@@ -143,6 +143,21 @@ def test_bad_cell_names_file_key_and_reason(tmp_path, old, new, key, reason):
     assert reason in message
 
 
+@pytest.mark.parametrize("robots_dir", ["robotz", "robots"])
+def test_robots_dir_must_hold_the_robot(tmp_path, robots_dir):
+    """A missing or mistyped robot.robots_dir planned with the bundled robot of the
+    same name: the folder must exist and hold the robot."""
+    (tmp_path / "robots" / "other").mkdir(parents=True)
+    text = BASE.replace("model: kuka_kr16_2\n", f"model: kuka_kr16_2\n  robots_dir: {robots_dir}\n")
+    cell = write_cell(tmp_path, text)
+    with pytest.raises(InputError) as error:
+        plan_cell(cell)
+    assert error.value.file == str(cell) and error.value.key == "robot.robots_dir"
+    folder = tmp_path / robots_dir
+    reason = "folder not found" if robots_dir == "robotz" else "holds no robot folder 'kuka_kr16_2'"
+    assert reason in error.value.reason and str(folder) in error.value.reason
+
+
 def test_closed_defaults_to_false(tmp_path):
     assert (
         load_cell(write_cell(tmp_path, BASE.replace("  closed: false\n", ""))).path.closed is False

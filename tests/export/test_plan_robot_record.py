@@ -146,3 +146,19 @@ def test_export_runs_no_inverse_kinematics(planned_with_own_robot, tmp_path, mon
         monkeypatch.setattr(module, "inverse", no_ik)
     monkeypatch.setattr(model.RobotModel, "inverse", no_ik)
     assert programs(plan_folder, tmp_path / "after") == before
+
+
+def test_report_and_plan_name_the_robot_folder_and_its_content(planned_with_own_robot):
+    """report.json and the plan's robot record say which robot folder the plan used and
+    a hash of its files, so a later edit of the folder shows (issue 36)."""
+    from offline_prog.robot.record import folder_sha256
+
+    plan_folder, robots = planned_with_own_robot
+    report = json.loads((plan_folder / "report.json").read_text())
+    folder = robots / "kuka_kr16_2"
+    assert report["robot_folder"] == str(folder)
+    assert report["robot_files_sha256"] == folder_sha256(folder)
+    assert folder_sha256(folder) != folder_sha256(model.ROBOTS_DIR / "ur10e")
+    record = ProgramData.load(plan_folder).robot_record
+    assert record["robot_folder"] == str(folder)
+    assert record["robot_files_sha256"] == report["robot_files_sha256"]

@@ -9,6 +9,7 @@ import pytest
 
 from offline_prog.config.cell import load_cell
 from offline_prog.robot.model import load_robot
+from offline_prog.robot.record import folder_sha256
 from offline_prog.scene.drake_cell import build_cell_model
 
 from conftest import CELLS
@@ -136,6 +137,9 @@ def test_report_splits_cycle_time(job):
     assert [s["seam"] for s in report["seams"]] == [o.name for o in plan.chosen]
     assert len(report["links"]) == len(plan.chosen) + 1
     assert report["collision_free"] == plan.collisions.collision_free
+    # Which robot folder, in which state (issue 36): the bundled one here.
+    assert report["robot_folder"] == str(plan.robot.urdf_path.parent)
+    assert report["robot_files_sha256"] == folder_sha256(plan.robot.urdf_path.parent)
 
 
 def test_home_pose_is_collision_free_in_the_cell():

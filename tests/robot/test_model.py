@@ -175,6 +175,12 @@ def test_invalid_yaml(robots_copy):
         ("ur10e", lambda r: r.update(urdf="ur10.urdf"), ["key 'urdf'", "'ur10.urdf'"]),
         ("ur10e", lambda r: r.update(joint_names=["a"] * 6), ["key 'joint_names'"]),
         (
+            "ur10e",  # a comma, a space, a newline break joint_trajectory.csv's header
+            lambda r: r.update(joint_names=["j,1", "j 2", "j\n3", "j4", "j5", "j6"]),
+            ["key 'joint_names'", "'j,1' is not a name"],
+        ),
+        ("ur10e", lambda r: r.update(urdf="../kuka_kr16_2/kuka_kr16_2.urdf"), ["key 'urdf'"]),
+        (
             "kuka_kr16_2",
             lambda r: r["kinematics"].update(a2_mm=35),
             ["key 'kinematics.a2_mm': unknown"],
@@ -204,6 +210,13 @@ def test_invalid_yaml(robots_copy):
 def test_bad_record_names_file_and_key(robots_copy, name, edit, fragments):
     path = edit_record(robots_copy, name, edit)
     assert_one_line_error(lambda: load_robot(name, robots_copy), str(path), *fragments)
+
+
+@pytest.mark.parametrize("name", ["my robot", "kr16,2", "x-y"])
+def test_a_robot_folder_name_follows_the_seam_name_rule(robots_copy, name):
+    """The folder name heads programs and CSV files: checked when the folder loads."""
+    shutil.copytree(robots_copy / "ur10e", robots_copy / name)
+    assert_one_line_error(lambda: load_robot(name, robots_copy), f"{name!r} is not a name")
 
 
 def test_urdf_joints_inverts_controller_joints(rng):

@@ -137,3 +137,26 @@ def test_bad_values_are_400_and_the_session_keeps_running_with_its_values(own):
     assert own.stop() == 130
     stderr = own.stderr()
     assert "Traceback" not in stderr and "RecursionError" not in stderr, stderr
+
+
+def test_a_touches_file_passes_the_same_guard(live):
+    """POST /touches (the panel's calibration): another page, a missing token or a
+    form body is refused before the session reads it; a bad file or a body beyond the
+    touches limit is a 400 with one line; the session keeps its values."""
+    before = live.status()
+    body = {"file": "t.csv", "text": "target,q1_deg\n", "controller_angles": False}
+    for headers, expected in (
+        ({"Origin": "http://evil.example"}, 403),
+        ({"X-Session-Token": None}, 403),
+        ({"Content-Type": "text/plain"}, 415),
+    ):
+        code, reply = live.send("POST", "/touches", body, headers=headers)
+        assert code == expected and reply["ok"] is False, (headers, reply)
+    code, reply = live.send("POST", "/touches", body)
+    assert code == 400 and "calibration: missing" in reply["message"], reply  # the tape demo
+    code, reply = live.send("POST", "/touches", {**body, "path": "/etc/passwd"})
+    assert code == 400 and "unexpected key 'path'" in reply["message"]
+    code, reply = live.send("POST", "/touches", {**body, "text": "x" * 250_000})
+    assert code == 400 and "larger than 200000 bytes" in reply["message"]
+    unchanged(live, before)
+    assert live.status()["calibration"] is None
