@@ -82,7 +82,10 @@ def test_joint_csv_and_ros_json(data, tmp_path):
     (csv_file,) = export(data, "csv", tmp_path, force=True)
     (json_file,) = export(data, "ros-json", tmp_path, force=True)
     lines = csv_file.read_text().splitlines()
-    assert lines[0] == "t_s,segment," + ",".join(f"{n}_rad" for n in rows.joint_names)
+    columns = ["t_s", "segment", *(f"{n}_rad" for n in rows.joint_names)]
+    io = data.process_io  # the tape's heater power: its flow output's column
+    columns += [] if io is None or io.analog_output is None else [f"ao{io.analog_output}"]
+    assert lines[0] == ",".join(columns)
     table = [line.split(",") for line in lines[1:]]
     np.testing.assert_allclose([float(r[0]) for r in table], rows.t, atol=1e-9)
     np.testing.assert_allclose([[float(v) for v in r[2:8]] for r in table], rows.q, atol=1e-9)

@@ -64,7 +64,8 @@ GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
-IDENTIFIER_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
+NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
+MODULE_NAME_MAX = NAME_MAX - 6  # the module's name (room for a suffix)
 # The triggdata of each kind of event; a second one of a kind on the same move gets a
 # number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
 TRIGGERS = {
@@ -89,15 +90,15 @@ class RapidPost(CartesianPost):
     FORMAT = "rapid"
     Options = RapidOptions
     NAME_OPTION = "module"
-    NAME_MAX = IDENTIFIER_MAX - 6
+    NAME_MAX = MODULE_NAME_MAX
 
     def __init__(self, job, options: RapidOptions, *, forced: bool = False):
         super().__init__(job, options, forced=forced)
         if not options.zone_mm >= 0:
             raise ValueError(f"zone_mm={options.zone_mm}: need a zone >= 0 mm")
         rows = job.job
-        tool = identifier_from("tool", rows.tool, max_chars=IDENTIFIER_MAX)
-        wobj = identifier_from("wobj", rows.part, max_chars=IDENTIFIER_MAX)
+        tool = identifier_from("tool", rows.tool, max_chars=NAME_MAX)
+        wobj = identifier_from("wobj", rows.part, max_chars=NAME_MAX)
         self.tool, self.wobj, self.tail = tool, wobj, f", {tool}\\WObj:={wobj};"
         self.decls: list[str] = []
         self.main: list[str] = []
