@@ -43,21 +43,39 @@ USER_ERRNOS = {
 }
 
 
+# The export flags, as library options.
+EXPORT_FLAGS = {
+    "chord_tol_m": "--chord-tol-mm",
+    "angle_tol_rad": "--angle-tol-deg",
+    "tcp_pose_convention": "--tcp-pose-convention",
+    "line_limit": "--line-limit",
+}
+
+
 def _export_options(args) -> dict:
-    """Library keyword arguments from the export flags that apply to the format."""
-    options = {}
-    if args.chord_tol_mm is not None and args.format != "csv":
-        options["chord_tol_m"] = args.chord_tol_mm * 1e-3
-    if args.angle_tol_deg is not None and args.format != "csv":
-        options["angle_tol_rad"] = float(np.deg2rad(args.angle_tol_deg))
-    if args.style is not None and args.format == "krl":
-        options["style"] = args.style
-    if args.tcp_pose_convention is not None and args.format == "krl":
-        options["tcp_pose_convention"] = args.tcp_pose_convention
-    if args.mode is not None and args.format == "urscript":
-        options["mode"] = args.mode
-    if args.line_limit is not None and args.format in ("krl", "rapid", "fanuc"):
-        options["line_limit"] = args.line_limit
+    """Library keyword arguments from the export flags given.
+
+    Raises:
+        ValueError: a flag the format does not take (one line naming the ones it does).
+    """
+    from offline_prog.export.formats import format_options
+
+    given = {
+        "chord_tol_m": None if args.chord_tol_mm is None else args.chord_tol_mm * 1e-3,
+        "angle_tol_rad": None
+        if args.angle_tol_deg is None
+        else float(np.deg2rad(args.angle_tol_deg)),
+        "tcp_pose_convention": args.tcp_pose_convention,
+        "line_limit": args.line_limit,
+    }
+    options = {key: value for key, value in given.items() if value is not None}
+    takes = format_options(args.format)
+    refused = [EXPORT_FLAGS[key] for key in options if key not in takes]
+    if refused:
+        flags = ", ".join(EXPORT_FLAGS[key] for key in takes if key in EXPORT_FLAGS) or "none"
+        raise ValueError(
+            f"{', '.join(refused)}: not an option of --format {args.format} (its flags: {flags})"
+        )
     return options
 
 
@@ -86,11 +104,11 @@ def _run_calibrate(args, console: Console) -> None:
 
 
 def _run_export(args, console: Console) -> None:
-    from offline_prog.export.formats import export
+    from offline_prog.export.formats import check_export, export
     from offline_prog.export.job_program import JobProgramData
-    from offline_prog.export.program import ProgramData
 
-    data = JobProgramData.load(args.plan_dir) or ProgramData.load(args.plan_dir)
+    data = JobProgramData.load(args.plan_dir)
+    check_export(data, args.format, force=args.force)  # before the flags: the plan's words
     out = args.out or args.plan_dir / "programs"
     files = export(data, args.format, out, force=args.force, **_export_options(args))
     for file in files:

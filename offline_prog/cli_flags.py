@@ -146,40 +146,29 @@ def parser() -> argparse.ArgumentParser:
         "--force", action="store_true", help="export even if the plan failed (the header says so)"
     )
     export.add_argument(
-        "--style",
-        choices=["external_tcp", "flange"],
-        default=None,
-        help="KRL: external TCP ($IPO_MODE #TCP) or flange path",
-    )
-    export.add_argument(
         "--tcp-pose-convention",
         choices=["X_TP", "X_PF"],
         default=None,
-        help="KRL external_tcp points: the part P in the tool T (X_TP, default) or T in P (X_PF)",
-    )
-    export.add_argument(
-        "--mode",
-        choices=["servoj", "movel"],
-        default=None,
-        help="URScript: joint trajectory (servoj) or movel poses",
+        help="KRL: points are the part P in the tool T (X_TP, default) or T in P (X_PF)",
     )
     export.add_argument(
         "--chord-tol-mm",
         type=POSITIVE,
         default=None,
-        help="Cartesian point density: chordal tolerance [mm] (default 0.05)",
+        help="KRL, RAPID, FANUC point density: chordal tolerance [mm] (default 0.05)",
     )
     export.add_argument(
         "--angle-tol-deg",
         type=POSITIVE,
         default=None,
-        help="Cartesian point density: orientation tolerance [deg] (default 0.1)",
+        help="KRL, RAPID, FANUC point density: orientation tolerance [deg] (default 0.1)",
     )
     export.add_argument(
         "--line-limit",
         type=_number(int, low=MIN_LINE_LIMIT, inclusive=True),
         default=None,
-        help="split programs longer than this (KRL 1400, RAPID 5000)",
+        help="FANUC: most lines of one program; a seam's longer program is split into "
+        "called parts (default 2000)",
     )
     return parser
 

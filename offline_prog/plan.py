@@ -201,6 +201,7 @@ def plan_loaded_job(
         timed.order,
         linked.links,
         linked.samples,
+        linked.X_BE,
         linked.tcp_speed,
         results["io"],
         results["check"],

@@ -34,10 +34,13 @@ sys.path.insert(0, _PACKAGE or str(Path(__file__).resolve().parents[1]))
 
 from offline_prog.export.densify import densify  # noqa: E402
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M  # noqa: E402
-from offline_prog.export.formats import PROGRAMS_DIR, export, job_formats  # noqa: E402
-from offline_prog.export.kuka.krl_points import process_points  # noqa: E402
+from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export  # noqa: E402
+from offline_prog.export.points import PointRule, process_points  # noqa: E402
 from offline_prog.plan import plan_job  # noqa: E402
 from offline_prog.results import job_folder  # noqa: E402
+from offline_prog.results.job_report import job_report  # noqa: E402
+from offline_prog.results.job_table import trajectory_csv  # noqa: E402
+from offline_prog.results.program_data import job_program_data  # noqa: E402
 from offline_prog.viz.job_preview import write_job_preview_html  # noqa: E402
 from offline_prog.viz.job_report_html import write_job_report_html  # noqa: E402
 
@@ -64,16 +67,16 @@ def median_time(runs: int, function, clock=time.process_time) -> float:
 
 def parts(job, folder: Path, runs: int) -> dict[str, float]:
     """Median time [s] of each part of the folder, each measured alone."""
-    summary = job_folder.job_report(job)
-    data = job_folder.job_program_data(job, summary)
+    summary = job_report(job)
+    data = job_program_data(job, summary)
     out = {
-        "report": median_time(runs, lambda: job_folder.job_report(job)),
-        "trajectory.csv": median_time(runs, lambda: job_folder.trajectory_csv(job)),
-        "program data": median_time(runs, lambda: job_folder.job_program_data(job, summary)),
+        "report": median_time(runs, lambda: job_report(job)),
+        "trajectory.csv": median_time(runs, lambda: trajectory_csv(job)),
+        "program data": median_time(runs, lambda: job_program_data(job, summary)),
         "npz": median_time(runs, lambda: data.save(folder)),
     }
     if data.feasible:
-        for fmt in job_formats(data.language):
+        for fmt in default_formats(data.language):
             out[fmt] = median_time(runs, lambda fmt=fmt: export(data, fmt, folder / PROGRAMS_DIR))
     plan_dir = folder / "plan"
     job_folder.write_job_outputs(job, plan_dir)  # report.html's inputs
@@ -92,7 +95,7 @@ def baseline(job, summary: dict, runs: int) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))
     from selection_reference import reference_process_points
 
-    data = job_folder.job_program_data(job, summary)
+    data = job_program_data(job, summary)
     for style in ("external_tcp", "flange"):
         old = new = 0.0
         same = True
@@ -100,9 +103,11 @@ def baseline(job, summary: dict, runs: int) -> None:
             dense = densify(seam, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
             tol = dense.selection_tolerances(DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
             args = (dense.data, style, *tol, "X_TP")
+            rule = PointRule(style)
+            new_args = (dense.data, rule, *tol)
             old += median_time(runs, lambda args=args: reference_process_points(*args))
-            new += median_time(runs, lambda args=args: process_points(*args))
-            a, b = reference_process_points(*args), process_points(*args)
+            new += median_time(runs, lambda args=new_args: process_points(*args))
+            a, b = reference_process_points(*args), process_points(*new_args)
             same &= np.array_equal(a[0], b[0]) and a[1:] == b[1:]
         print(
             f"    KRL point selection ({style}): before {old * 1e3:.0f} ms, "
@@ -136,7 +141,7 @@ def main() -> None:
         )
         print("    " + ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in each.items()))
         if args.baseline:
-            baseline(job, job_folder.job_report(job), args.runs)
+            baseline(job, job_report(job), args.runs)
 
 
 if __name__ == "__main__":

@@ -98,13 +98,16 @@ def _planned_once(tmp_path_factory, plan, write):
 
 
 @pytest.fixture(scope="session")
-def planned_folder(tmp_path_factory):
-    """name ↦ (plan, folder): a demo cell planned once per session with all its outputs
+def planned_folder(planned_job):
+    """name ↦ (plan, folder): a one-seam demo cell (``path:``) planned once per session as
+    the job it is, with all its outputs: its seam's Plan and the job's plan folder
     (tests read the folder; they write anything of their own elsewhere)."""
-    from offline_prog.plan import plan_cell
-    from offline_prog.results.plan_folder import write_outputs
 
-    return _planned_once(tmp_path_factory, plan_cell, write_outputs)
+    def get(name: str):
+        job, folder = planned_job(name)
+        return job.seams[0], folder
+
+    return get
 
 
 @pytest.fixture

@@ -2,16 +2,17 @@
 
 The plan is sampled in time (``motion.sample_rate_hz``): at 1 Hz two samples can lie
 100 mm apart on a curve, and a LIN segment through samples can leave the path between
-them by millimetres while every sample fits. ``plan.npz`` therefore also holds the
-process frames X_PF of the continuous path on a fine grid of s (``dense_grid``).
-:func:`densify` inserts the grid points into the sample intervals where the path leaves
-the interval's own chord by more than ``DENSIFY_SHARE`` of a tolerance; the others
+them by millimetres while every sample fits. The plan therefore also holds the tool
+frames X_PT (the process frames) of the continuous path on a fine grid of s
+(``dense_grid``). :func:`densify` inserts the grid points into the sample intervals
+where the path leaves the interval's own chord by more than ``DENSIFY_SHARE`` of a
+tolerance; the others
 differ from their chord by at most the returned residual. A LIN segment within d of the
 points it passes is then within d + residual of the continuous path (the distance to a
 segment is convex), so the writers select with the tolerance less the residual and
 state d + residual.
 
-Inserted rows: s and X_PF from the grid, X_BE = X_BT · X_PF⁻¹ · X_EP⁻¹, t by monotone
+Inserted rows: s and X_PT from the grid, X_BE = X_BT · X_PT⁻¹ · X_EP⁻¹, t by monotone
 interpolation of t(s), q the plan's joints at the grid point (``q_dense``, planned once
 by ``robot.dense_joints``: the writers run no inverse kinematics), speeds interpolated.
 A plan made before plans stored q_dense gets them from the robot's IK here.
@@ -86,13 +87,13 @@ def _chord_deviation(p, R, a, b, x, R_x) -> tuple[np.ndarray, np.ndarray]:
     return distance, rotation_angles(np.swapaxes(R_lam, 1, 2) @ R_x)
 
 
-def grid_error(X_PF_dense: np.ndarray) -> tuple[float, float]:
+def grid_error(X_PT_dense: np.ndarray) -> tuple[float, float]:
     """Bound [m, rad] of the continuous path's deviation from the grid's own chords: each
     odd point against the chord of its neighbours (twice the step, four times the
     error), divided by four."""
-    if len(X_PF_dense) < 3:
+    if len(X_PT_dense) < 3:
         return 0.0, 0.0
-    p, R = X_PF_dense[:, :3, 3], X_PF_dense[:, :3, :3]
+    p, R = X_PT_dense[:, :3, 3], X_PT_dense[:, :3, :3]
     k = np.arange(1, len(p) - 1, 2)
     d, a = _chord_deviation(p, R, k - 1, k + 1, p[k], R[k])
     return float(d.max()) / 4.0, float(a.max()) / 4.0
@@ -100,10 +101,10 @@ def grid_error(X_PF_dense: np.ndarray) -> tuple[float, float]:
 
 def densify(data: ProgramData, chord_tol_m: float, angle_tol_rad: float) -> Densified:
     """Insert the grid points where the sample intervals miss the continuous path."""
-    s_d, X_d = data.sigma_dense, data.X_PF_dense
+    s_d, X_d = data.path_dense_m, data.X_PT_dense
     if len(s_d) == 0:
         return Densified(data, None, None, 0)
-    s, p, R = data.sigma, data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
+    s, p, R = data.path_m, data.X_PT[:, :3, 3], data.X_PT[:, :3, :3]
     i = np.searchsorted(s, s_d, side="right") - 1
     inside = (i >= 0) & (i < len(s) - 1) & (s_d > s[np.clip(i, 0, len(s) - 1)])
     inside &= s_d < s[np.clip(i + 1, 0, len(s) - 1)]
@@ -123,16 +124,16 @@ def densify(data: ProgramData, chord_tol_m: float, angle_tol_rad: float) -> Dens
 
 
 def _insert(data: ProgramData, new: np.ndarray) -> ProgramData:
-    """The plan's rows plus the grid points ``new`` (K,) (indices into sigma_dense)."""
-    s_new, X_PF_new = data.sigma_dense[new], data.X_PF_dense[new]
-    rising = np.concatenate([[True], np.diff(data.sigma) > 0])
-    t_new = PchipInterpolator(data.sigma[rising], data.t[rising])(s_new)
+    """The plan's rows plus the grid points ``new`` (K,) (indices into path_dense_m)."""
+    s_new, X_PT_new = data.path_dense_m[new], data.X_PT_dense[new]
+    rising = np.concatenate([[True], np.diff(data.path_m) > 0])
+    t_new = PchipInterpolator(data.path_m[rising], data.t[rising])(s_new)
     qd_new = CubicHermiteSpline(data.t, data.q, data.qd, axis=0)(t_new, 1)
-    X_BE_new = data.X_BT @ np.linalg.inv(X_PF_new) @ np.linalg.inv(data.X_EP)
+    X_BE_new = data.X_BT @ np.linalg.inv(X_PT_new) @ np.linalg.inv(data.X_EP)
     q_new = (
-        data.q_dense[new] if len(data.q_dense) == len(data.sigma_dense) else _old_plan(data)[new]
+        data.q_dense[new] if len(data.q_dense) == len(data.path_dense_m) else _old_plan(data)[new]
     )
-    order = np.argsort(np.concatenate([data.sigma, s_new]), kind="stable")
+    order = np.argsort(np.concatenate([data.path_m, s_new]), kind="stable")
 
     def merged(old, new):
         return np.concatenate([old, new])[order]
@@ -140,12 +141,12 @@ def _insert(data: ProgramData, new: np.ndarray) -> ProgramData:
     return dataclasses.replace(
         data,
         t=merged(data.t, t_new),
-        sigma=merged(data.sigma, s_new),
+        path_m=merged(data.path_m, s_new),
         q=merged(data.q, q_new),
         qd=merged(data.qd, qd_new),
         X_BE=merged(data.X_BE, X_BE_new),
-        X_PF=merged(data.X_PF, X_PF_new),
-        tcp_speed=merged(data.tcp_speed, np.interp(s_new, data.sigma, data.tcp_speed)),
+        X_PT=merged(data.X_PT, X_PT_new),
+        tcp_speed=merged(data.tcp_speed, np.interp(s_new, data.path_m, data.tcp_speed)),
     )
 
 
@@ -153,6 +154,6 @@ def _old_plan(data: ProgramData) -> np.ndarray:
     """(M, 6) q_dense of a plan made before plans stored it, from the robot's IK."""
     from offline_prog.robot.dense_joints import dense_joints
 
-    X_BE_dense = data.X_BT @ np.linalg.inv(data.X_PF_dense) @ np.linalg.inv(data.X_EP)
-    args = (data.sigma, data.t, data.q, data.qd, data.X_BE, data.sigma_dense, X_BE_dense)
+    X_BE_dense = data.X_BT @ np.linalg.inv(data.X_PT_dense) @ np.linalg.inv(data.X_EP)
+    args = (data.path_m, data.t, data.q, data.qd, data.X_BE, data.path_dense_m, X_BE_dense)
     return dense_joints(data.load_robot(), *args)

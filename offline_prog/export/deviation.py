@@ -1,6 +1,6 @@
 """How far LIN segments between pose samples pass from the samples between them, for
 many segments at once (the measure of the point selection: ``export.density``,
-``export.kuka.krl_points``, and of ``export.densify``).
+``export.points``, and of ``export.densify``).
 
 A segment (i, j) of a sampled pose path runs from sample i to sample j; its inner
 samples are i+1 .. j-1. A controller moving LIN interpolates the position along the

@@ -1,14 +1,21 @@
 """One entry point for every export format, and which ones a robot gets by default.
 
+The registry: each controller format is one writer class (``export.post``), imported when
+it is used; the joint-trajectory files are one function each. A format's export options
+are its writer's ``Options`` fields: any other is refused in one line naming the ones it
+takes.
+
 A format's files are written into a temporary folder inside ``out_dir`` and moved into
 place; the folder's manifest (``atomic.MANIFEST``) lists them by format, so a re-export
-removes the files its previous run wrote and this one did not (``name_3.src`` after a
+removes the files its previous run wrote and this one did not (``name_S1_3.ls`` after a
 split into fewer parts), and never a file we did not write.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import importlib
 import os
 import shutil
 import tempfile
@@ -17,12 +24,22 @@ from pathlib import Path
 
 from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_manifest
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.program import ProgramData
+from offline_prog.export.post import ControllerPost, write_program
 
-FORMATS = ("krl", "rapid", "urscript", "fanuc", "csv", "ros-json")
-# A controller's own language: only for a plan of that controller's robot (the joint
-# CSV and ROS JSON are for every robot).
-CONTROLLER_FORMATS = ("krl", "rapid", "urscript", "fanuc")
+# A controller's own language (only for a plan of that controller's robot): its writer,
+# as module and class.
+CONTROLLER_FORMATS = {
+    "krl": ("offline_prog.export.kuka.krl", "KrlPost"),
+    "rapid": ("offline_prog.export.abb.rapid", "RapidPost"),
+    "urscript": ("offline_prog.export.ur.urscript", "UrScriptPost"),
+    "fanuc": ("offline_prog.export.fanuc.fanuc_ls", "FanucPost"),
+}
+# The joint trajectory, for every robot: its writer function, which takes no options.
+JOINT_FORMATS = {
+    "csv": ("offline_prog.export.joint_files", "write_joint_csv"),
+    "ros-json": ("offline_prog.export.joint_files", "write_ros_json"),
+}
+FORMATS = (*CONTROLLER_FORMATS, *JOINT_FORMATS)
 PROGRAMS_DIR = "programs"
 
 
@@ -32,32 +49,22 @@ class ExportRefusedError(ValueError):
 
 def default_formats(language: str | None) -> list[str]:
     """The robot's controller language (robot.yaml) plus the joint-trajectory files."""
-    return ([language] if language else []) + ["csv", "ros-json"]
+    return ([language] if language in CONTROLLER_FORMATS else []) + list(JOINT_FORMATS)
 
 
-# Controller languages with a whole-job writer.
-JOB_LANGUAGES = ("krl", "rapid", "urscript", "fanuc")
+def format_options(fmt: str) -> tuple[str, ...]:
+    """The export options a format takes (its writer's ``Options`` fields)."""
+    if fmt not in CONTROLLER_FORMATS:
+        return ()
+    return tuple(f.name for f in dataclasses.fields(_writer(CONTROLLER_FORMATS[fmt]).Options))
 
 
-def job_formats(language: str | None) -> list[str]:
-    """The formats a whole job is exported in: as for one seam (default_formats), for
-    the languages that have a job writer."""
-    return default_formats(language if language in JOB_LANGUAGES else None)
-
-
-def export(
-    data: ProgramData | JobProgramData,
-    fmt: str,
-    out_dir: Path,
-    *,
-    force: bool = False,
-    **options,
-) -> list[Path]:
-    """Write ``fmt`` for the plan into ``out_dir``; returns the files written.
+def check_export(data: JobProgramData, fmt: str, *, force: bool = False) -> None:
+    """Whether ``fmt`` may be written for the plan (before any option is looked at).
 
     Raises:
         ExportRefusedError: the plan failed and force is False.
-        ValueError: unknown format or option.
+        ValueError: unknown format, or another robot's controller language.
     """
     if fmt not in FORMATS:
         raise ValueError(f"unknown format {fmt!r} (use {', '.join(FORMATS)})")
@@ -66,16 +73,54 @@ def export(
             f"the plan failed ({data.failure}); refusing to export a "
             "program from it (use --force to export anyway)"
         )
-    if fmt in CONTROLLER_FORMATS and fmt != data.language:  # (a job's is its robot's)
+    if fmt in CONTROLLER_FORMATS and fmt != data.language:
         raise ValueError(
             f"{fmt} is not the controller language of the plan's robot "
             f"{data.robot} (use {', '.join(default_formats(data.language))})"
         )
-    if isinstance(data, JobProgramData):
-        return replace_owned(
-            Path(out_dir), fmt, lambda folder: _write_job(data, fmt, folder, **options)
-        )
-    return replace_owned(Path(out_dir), fmt, lambda folder: _write(data, fmt, folder, **options))
+
+
+def export(
+    data: JobProgramData, fmt: str, out_dir: Path, *, force: bool = False, **options
+) -> list[Path]:
+    """Write ``fmt`` for the plan into ``out_dir``; returns the files written.
+
+    Raises:
+        ExportRefusedError: the plan failed and force is False.
+        ValueError: unknown format or option, or an option value the writer refuses.
+    """
+    check_export(data, fmt, force=force)
+    _check_options(fmt, options)
+    if fmt in JOINT_FORMATS:
+        write = _writer(JOINT_FORMATS[fmt])
+        return replace_owned(Path(out_dir), fmt, lambda folder: write(data, folder))
+    post = controller_post(data, fmt, **options)  # its options checked before any file
+    return replace_owned(Path(out_dir), fmt, lambda folder: write_program(post, folder))
+
+
+def controller_post(data: JobProgramData, fmt: str, **options) -> ControllerPost:
+    """The writer of controller format ``fmt`` for the plan, with its options (a failed
+    plan's header says so); ``write_program(post, folder)`` writes its files.
+
+    Raises:
+        ValueError: an option value the writer refuses, a robot it cannot write for.
+    """
+    _check_options(fmt, options)
+    post_class = _writer(CONTROLLER_FORMATS[fmt])
+    return post_class(data, post_class.Options(**options), forced=not data.feasible)
+
+
+def _check_options(fmt: str, options: dict) -> None:
+    unknown = sorted(set(options) - set(format_options(fmt)))
+    if unknown:
+        takes = ", ".join(format_options(fmt)) or "none"
+        raise ValueError(f"{fmt}: no option {', '.join(unknown)} (its options: {takes})")
+
+
+def _writer(where: tuple[str, str]):
+    """The writer (class or function) a registry entry names."""
+    module, name = where
+    return getattr(importlib.import_module(module), name)
 
 
 def replace_owned(out_dir: Path, group: str, write: Callable[[Path], list[Path]]) -> list[Path]:
@@ -105,79 +150,3 @@ def replace_owned(out_dir: Path, group: str, write: Callable[[Path], list[Path]]
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return [out_dir / name for name in names]
-
-
-def _write(data: ProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
-    """Write one format's files into out_dir (a fresh folder)."""
-    forced = not data.feasible
-    if fmt == "csv":
-        from offline_prog.export.joint_files import write_joint_csv
-
-        return [write_joint_csv(data, out_dir)]
-    if fmt == "ros-json":
-        from offline_prog.export.joint_files import write_ros_json
-
-        return [write_ros_json(data, out_dir)]
-    if fmt == "urscript":
-        from offline_prog.export.ur.urscript import write_urscript
-
-        return [write_urscript(data, out_dir, forced=forced, **options).file]
-    if fmt == "fanuc":
-        from offline_prog.export.fanuc.fanuc_ls import write_fanuc
-
-        return list(write_fanuc(data, out_dir, forced=forced, **options).files)
-    if fmt == "krl":
-        from offline_prog.export.kuka.krl import write_krl
-
-        return list(write_krl(data, out_dir, forced=forced, **options).files)
-    from offline_prog.export.abb.rapid import write_rapid
-
-    return list(write_rapid(data, out_dir, forced=forced, **options).files)
-
-
-# The options each job writer takes (the rest are one-seam options: refused by name).
-_JOB_OPTIONS = {
-    "krl": {"chord_tol_m", "angle_tol_rad", "name", "blend_m", "tcp_pose_convention"},
-    "rapid": {"chord_tol_m", "angle_tol_rad", "module", "zone_mm"},
-    "urscript": {"name", "period_s"},
-    "fanuc": {"chord_tol_m", "angle_tol_rad", "name", "line_limit"},
-}
-
-
-def _write_job(data: JobProgramData, fmt: str, out_dir: Path, **options) -> list[Path]:
-    """Write one format's files of a whole job into out_dir (a fresh folder).
-
-    Raises:
-        ValueError: an option of one-seam programs only (style, mode, line_limit).
-    """
-    if fmt == "urscript":  # servoj streams the plan: point tolerances do not apply
-        options = {k: v for k, v in options.items() if k not in ("chord_tol_m", "angle_tol_rad")}
-    unknown = sorted(set(options) - _JOB_OPTIONS.get(fmt, set()))
-    if unknown:
-        raise ValueError(
-            f"{fmt}: {', '.join(unknown)} is for one-seam plans; a whole job's {fmt} "
-            "program has its own form (see the README, Whole jobs)"
-        )
-    if fmt == "csv":
-        from offline_prog.export.joint_files import write_job_joint_csv
-
-        return [write_job_joint_csv(data, out_dir)]
-    if fmt == "ros-json":
-        from offline_prog.export.joint_files import write_job_ros_json
-
-        return [write_job_ros_json(data, out_dir)]
-    if fmt == "krl":
-        from offline_prog.export.kuka.krl_job import write_krl_job
-
-        return write_krl_job(data, out_dir, forced=not data.feasible, **options)
-    if fmt == "fanuc":
-        from offline_prog.export.fanuc.fanuc_job import write_fanuc_job
-
-        return write_fanuc_job(data, out_dir, forced=not data.feasible, **options)
-    if fmt == "rapid":
-        from offline_prog.export.abb.rapid_job import write_rapid_job
-
-        return write_rapid_job(data, out_dir, forced=not data.feasible, **options)
-    from offline_prog.export.ur.urscript_job import write_urscript_job
-
-    return [write_urscript_job(data, out_dir, forced=not data.feasible, **options)]

@@ -2,17 +2,19 @@
 
 A job is one sampled trajectory in named segments (``link``, ``approach:<seam>``,
 ``process:<seam>``, ``retract:<seam>``; see ``job.assemble``). ``job`` holds every row as
-a :class:`ProgramData` (``sigma`` is the signed distance along the tool's path on the
-part from the seam's start, NaN on links; ``X_PF`` is the tool frame T in P, which is
+a :class:`ProgramData` (``path_m`` is the signed distance along the tool's path on the
+part from the seam's start, NaN on links; ``X_PT`` is the tool frame T in P, which is
 the process frame F on the seams and the backed-off frame on approach and retract);
-``seams`` holds each seam's process rows exactly as a one-seam plan's ProgramData, so the
-one-seam point selection applies to them unchanged. Process I/O: ``digital`` (N,) 0/1
-and ``analog`` (N,) per row, and the plan's I/O events (``offline_prog.io_events``):
-the writers translate them into statements and never recompute a switch position.
+``seams`` holds each seam's process rows as a ProgramData of their own (with the
+continuous path on a fine grid), where the point selection (``export.points``) runs.
+Process I/O: ``digital`` (N,) 0/1 and ``analog`` (N,) per row, and the plan's I/O
+events (``offline_prog.io_events``): the writers translate them into statements and
+never recompute a switch position.
 
-Saved as ``plan.npz`` (the job's rows, under the one-seam keys) plus ``job.npz`` (the
-segments, the link waypoints, the I/O and each seam's data), so ``offline-prog export``
-re-exports without re-planning.
+Saved as ``plan.npz`` (the job's rows) plus ``job.npz`` (the segments, the link
+waypoints, the I/O and each seam's data), so ``offline-prog export`` re-exports without
+re-planning. A folder written before every plan was a job (a ``plan.npz`` of one seam,
+no ``job.npz``) is refused: re-plan it.
 """
 
 from __future__ import annotations
@@ -53,7 +55,7 @@ class JobProgramData:
     Attributes:
         job: every row of the job (see the module docstring), header fields included.
         segments: in run order; the last one ends at the last row.
-        seams: each seam's process rows as a one-seam ProgramData, in run order.
+        seams: each seam's process rows as a ProgramData, in run order.
         seam_names: (n_seams,) in run order; seam_lengths_m: their path lengths L [m].
         link_waypoints: per link, (K, 6) joint targets [rad] a controller moves through
             to fine points (the first is where the link starts).
@@ -130,21 +132,24 @@ class JobProgramData:
         return target
 
     @classmethod
-    def load(cls, folder: Path) -> JobProgramData | None:
-        """Read a job's plan folder; None when the folder holds a one-seam plan.
+    def load(cls, folder: Path) -> JobProgramData:
+        """Read a job's plan folder.
 
         Raises:
-            ValueError: one line naming the file when it is unreadable, missing (a
-                job's plan.npz without its job.npz) or from another plan.
+            ValueError: one line naming the file when it is unreadable, missing, from
+                another plan, or a one-seam plan written before every plan was a job.
         """
         file = Path(folder) / JOB_FILE
         if not file.is_file():
-            if ProgramData.load(folder).whole_job:
+            if ProgramData.load(folder).whole_job:  # (raises for a folder without a plan)
                 raise ValueError(
                     f"{file}: missing: {Path(folder) / PLAN_FILE} holds a whole job's rows, "
                     "which export only with their job.npz (plan the cell again)"
                 )
-            return None
+            raise ValueError(
+                f"{Path(folder) / PLAN_FILE}: a one-seam plan written before every plan was "
+                "a job (no job.npz): re-plan it with this version"
+            )
         job = ProgramData.load(folder)
         try:
             with np.load(file) as data:

@@ -1,9 +1,9 @@
-"""Joint trajectories as files: CSV with units in the header, and JSON shaped like
-ROS 2 ``trajectory_msgs/msg/JointTrajectory``."""
+"""A job's joint trajectory as files for every robot: CSV with units in the header
+(``--format csv``), and JSON shaped like ROS 2 ``trajectory_msgs/msg/JointTrajectory``
+(``--format ros-json``), each with the segment and process I/O of every row."""
 
 from __future__ import annotations
 
-import io
 import itertools
 import json
 from pathlib import Path
@@ -16,20 +16,7 @@ from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.program import ProgramData
 
-
-def joint_csv_text(data: ProgramData) -> str:
-    """``t_s,<joint>_rad,...`` then one row per planned sample (SI units)."""
-    buffer = io.StringIO()
-    header = ",".join(["t_s", *(f"{name}_rad" for name in data.joint_names)])
-    np.savetxt(
-        buffer,
-        np.column_stack([data.t, data.q]),
-        delimiter=",",
-        fmt="%.10g",
-        header=header,
-        comments="",
-    )
-    return buffer.getvalue()
+FILE_STEM = "joint_trajectory"
 
 
 _POINTS = "@points@"  # where ros_json_text puts the points into the message's text
@@ -75,19 +62,7 @@ def _rows(values: np.ndarray) -> list[str]:
     return json.dumps(values.tolist(), separators=(",", ":"))[2:-2].split("],[")
 
 
-def write_joint_csv(data: ProgramData, out_dir: Path, name: str = "joint_trajectory") -> Path:
-    file = Path(out_dir) / f"{name}.csv"
-    write_atomic(file, joint_csv_text(data))
-    return file
-
-
-def write_ros_json(data: ProgramData, out_dir: Path, name: str = "joint_trajectory") -> Path:
-    file = Path(out_dir) / f"{name}.json"
-    write_atomic(file, ros_json_text(ros_json(data), data))
-    return file
-
-
-def job_joint_csv_text(data: JobProgramData) -> str:
+def joint_csv_text(data: JobProgramData) -> str:
     """``t_s,segment,<joint>_rad,...[,do<n>][,ao<n>]``: one row per planned sample of a
     job, the segment label (link, approach:<seam>, process:<seam>, retract:<seam>) and
     the process outputs (0/1 and the flow value) on each row."""
@@ -127,13 +102,15 @@ def job_ros_json(data: JobProgramData) -> dict:
     return message
 
 
-def write_job_joint_csv(data: JobProgramData, out_dir: Path, name: str = "joint_trajectory"):
-    file = Path(out_dir) / f"{name}.csv"
-    write_atomic(file, job_joint_csv_text(data))
-    return file
+def write_joint_csv(data: JobProgramData, out_dir: Path) -> list[Path]:
+    """``joint_trajectory.csv`` (:func:`joint_csv_text`) in out_dir."""
+    file = Path(out_dir) / f"{FILE_STEM}.csv"
+    write_atomic(file, joint_csv_text(data))
+    return [file]
 
 
-def write_job_ros_json(data: JobProgramData, out_dir: Path, name: str = "joint_trajectory"):
-    file = Path(out_dir) / f"{name}.json"
+def write_ros_json(data: JobProgramData, out_dir: Path) -> list[Path]:
+    """``joint_trajectory.json`` (:func:`job_ros_json`) in out_dir."""
+    file = Path(out_dir) / f"{FILE_STEM}.json"
     write_atomic(file, ros_json_text(job_ros_json(data), data.job))
-    return file
+    return [file]

@@ -3,8 +3,11 @@
 Frames (paper letters): B robot base (URDF base_link), E flange (tool0), P part,
 F process frame on the path, T fixed tool. All poses are 4×4 arrays in SI units;
 the writers convert to each vendor's units and angle conventions at the edge.
-``plan.npz`` in the plan folder holds it, so ``offline-prog export`` re-exports
-without re-planning.
+``plan.npz`` (the job's rows) and ``job.npz`` (each seam's rows, see ``job_program``)
+in the plan folder hold it, so ``offline-prog export`` re-exports without re-planning.
+They store ``path_m`` and the tool frame ``X_PT`` under the keys plans have always had
+(``sigma``, ``X_PF``, ``sigma_dense``, ``X_PF_dense``): on a seam the tool frame is the
+process frame and the path position is its arc length σ.
 """
 
 from __future__ import annotations
@@ -18,22 +21,24 @@ import numpy as np
 from offline_prog.atomic import atomic_stream
 
 PLAN_FILE = "plan.npz"
-_ARRAYS = (
-    "t",
-    "sigma",
-    "q",
-    "qd",
-    "X_BE",
-    "X_PF",
-    "X_BT",
-    "X_EP",
-    "tcp_speed",
-    "q_lower",
-    "q_upper",
-    "qd_max",
-)
+# The arrays by field name, and the key each is stored under in the .npz files.
+_ARRAYS = {
+    "t": "t",
+    "path_m": "sigma",
+    "q": "q",
+    "qd": "qd",
+    "X_BE": "X_BE",
+    "X_PT": "X_PF",
+    "X_BT": "X_BT",
+    "X_EP": "X_EP",
+    "tcp_speed": "tcp_speed",
+    "q_lower": "q_lower",
+    "q_upper": "q_upper",
+    "qd_max": "qd_max",
+}
 # The continuous path on a fine grid of s (plans written before it existed lack it).
-_DENSE_ARRAYS = ("sigma_dense", "X_PF_dense", "q_dense")
+_DENSE_ARRAYS = {"path_dense_m": "sigma_dense", "X_PT_dense": "X_PF_dense", "q_dense": "q_dense"}
+_STORED = _ARRAYS | _DENSE_ARRAYS
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,20 +51,25 @@ class ProgramData:
         cycle_time_s: planned duration [s].
         feasible: the plan passed every check; failure: why not ("" if feasible).
         joint_names: the six URDF joint names, in q's column order.
-        t: (N,) time [s]; sigma: (N,) arc length on the processing path [m].
+        t: (N,) time [s].
+        path_m: (N,) position along the tool's path on the part [m]: on a seam its arc
+            length σ; on a job's rows signed from each seam's start (negative on the
+            approach, beyond the seam's length on the retract, NaN on links).
         q: (N, 6) joint positions [rad]; qd: (N, 6) joint speeds [rad/s].
         X_BE: (N, 4, 4) flange E in the robot base B.
-        X_PF: (N, 4, 4) process frame F (the tool's pose on the part) in P.
+        X_PT: (N, 4, 4) the tool frame T in the part frame P: on a seam the process
+            frame F (turned by any free rotation about the tool's axis), on the approach
+            and retract the frame backed off the seam's end.
         X_BT: (4, 4) the fixed tool frame T in B (with any free rotation applied).
         X_EP: (4, 4) the part frame P in the flange frame E.
         tcp_speed: (N,) speed of the path point under the TCP [m/s].
         q_lower, q_upper, qd_max: (6,) joint limits [rad, rad/s] of the controller's
             joints (see j23_coupled).
         generated: ISO time the plan was made.
-        sigma_dense: (M,) a fine grid of s [m] over the whole path (export.densify).
-        X_PF_dense: (M, 4, 4) the process frames of the continuous plan at sigma_dense,
+        path_dense_m: (M,) a fine grid of s [m] over the whole path (export.densify).
+        X_PT_dense: (M, 4, 4) the tool frames of the continuous plan at path_dense_m,
             so that point selection measures deviations between the samples too.
-        q_dense: (M, 6) the planned joints [rad] at sigma_dense (robot.dense_joints),
+        q_dense: (M, 6) the planned joints [rad] at path_dense_m (robot.dense_joints),
             which the writers read for points they insert (empty: an older plan).
     """
 
@@ -76,11 +86,11 @@ class ProgramData:
     joint_names: tuple[str, ...]
     generated: str
     t: np.ndarray
-    sigma: np.ndarray
+    path_m: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     X_BE: np.ndarray
-    X_PF: np.ndarray
+    X_PT: np.ndarray
     X_BT: np.ndarray
     X_EP: np.ndarray
     tcp_speed: np.ndarray
@@ -94,8 +104,8 @@ class ProgramData:
     payload: dict | None = None  # export.payload.payload_record (None: plan before payloads)
     # The process time law (motion.time_law, and motion.process for time_optimal).
     time_law: str = "sin2"
-    sigma_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
-    X_PF_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
+    path_dense_m: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))
+    X_PT_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 4, 4)))
     q_dense: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 6)))
     # These rows are a whole job's (job.npz beside them holds its segments and I/O).
     whole_job: bool = False
@@ -124,20 +134,19 @@ class ProgramData:
         return values + self.j23_factor * col[f"{prefix}2"] if coupled else values
 
     def packed(self) -> tuple[dict, dict[str, np.ndarray]]:
-        """(meta, arrays): the JSON-able header fields and the arrays by name."""
+        """(meta, arrays): the JSON-able header fields, and the arrays by their stored
+        names (see the module docstring)."""
         meta = {
-            f.name: getattr(self, f.name)
-            for f in dataclasses.fields(self)
-            if f.name not in _ARRAYS + _DENSE_ARRAYS
+            f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in _STORED
         }
         meta["joint_names"] = list(self.joint_names)
-        return meta, {name: getattr(self, name) for name in _ARRAYS + _DENSE_ARRAYS}
+        return meta, {key: getattr(self, name) for name, key in _STORED.items()}
 
     @classmethod
     def unpacked(cls, meta: dict, arrays: dict[str, np.ndarray]) -> ProgramData:
         """The inverse of :meth:`packed` (KeyError / TypeError when incomplete)."""
         meta = {**meta, "joint_names": tuple(meta["joint_names"])}
-        return cls(**meta, **{k: v for k, v in arrays.items() if k in _ARRAYS + _DENSE_ARRAYS})
+        return cls(**meta, **{name: arrays[key] for name, key in _STORED.items() if key in arrays})
 
     def save(self, folder: Path) -> Path:
         """Write ``folder/plan.npz`` (arrays plus a JSON header), atomically; stored
@@ -160,8 +169,10 @@ class ProgramData:
         try:
             with np.load(file) as data:
                 meta = json.loads(str(data["meta"]))
-                arrays = {name: np.asarray(data[name]) for name in _ARRAYS}
-                arrays |= {name: np.asarray(data[name]) for name in _DENSE_ARRAYS if name in data}
+                arrays = {key: np.asarray(data[key]) for key in _ARRAYS.values()}
+                arrays |= {
+                    key: np.asarray(data[key]) for key in _DENSE_ARRAYS.values() if key in data
+                }
         except FileNotFoundError:
             raise ValueError(f"{file}: not a plan folder (no {PLAN_FILE})") from None
         except Exception as error:  # truncated or foreign: zipfile, zlib, pickle, json ...

@@ -189,6 +189,7 @@ class JobPlan:
     order: JobOrder
     links: list[LinkMotion]  # in order (home → first, …, last → home)
     samples: JobSamples
+    X_BE: np.ndarray  # (N, 4, 4) the flange E in the robot base B on every row [m]
     tcp_speed: np.ndarray  # (N,) speed of the tool along the part [m/s]
     io: IoColumns
     collisions: CollisionResult

@@ -233,12 +233,14 @@ def _seam_pieces(option: SeamOption) -> list[Piece]:
 @dataclasses.dataclass
 class LinkedJob:
     """Stage ``links``: the options run, in order; the links (home → first, …, last →
-    home); the job's samples and the tool's speed along the part on every row (N,)
-    [m/s]."""
+    home); the job's samples, the flange E in the robot base B on every row X_BE
+    (N, 4, 4) (forward kinematics, once for the job) and the tool's speed along the
+    part on every row (N,) [m/s]."""
 
     chosen: list[SeamOption]
     links: list[LinkMotion]
     samples: JobSamples
+    X_BE: np.ndarray
     tcp_speed: np.ndarray
 
 
@@ -255,7 +257,10 @@ def link_job(
     chosen = [flat[i] for i in timed.order.sequence]
     pieces, links = job_pieces(inputs, scene, chosen, q_home, progress)
     samples = lay_out(pieces)
-    return LinkedJob(chosen, links, samples, tool_speed(inputs, samples, chosen))
+    X_BE = inputs.robot.forward(samples.q)
+    return LinkedJob(
+        chosen, links, samples, X_BE, tool_speed(inputs, samples, chosen=chosen, X_BE=X_BE)
+    )
 
 
 def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
@@ -317,12 +322,12 @@ def job_clearance(scene: DrakeCell, linked: LinkedJob):
     return distance_profile(scene, linked.samples.q, linked.samples.t)
 
 
-def tool_speed(inputs: Inputs, samples: JobSamples, chosen: list[SeamOption]) -> np.ndarray:
+def tool_speed(
+    inputs: Inputs, samples: JobSamples, *, chosen: list[SeamOption], X_BE: np.ndarray
+) -> np.ndarray:
     """(N,) speed of the tool point along the part [m/s] on every row: |d p_PT / dt|
-    with X_PT = X_PE · X_EB(q) · X_BI · X_IT (forward kinematics); the seams' own exact
-    TCP speed on their process rows."""
-    robot = inputs.robot
-    X_BE = robot.forward(samples.q)
+    with X_PT = X_PE · X_EB · X_BI · X_IT (X_BE (N, 4, 4): the flange on every row);
+    the seams' own exact TCP speed on their process rows."""
     X_BT = (inputs.X_IB.inverse() @ inputs.X_IT).GetAsMatrix4()
     X_PE = inputs.X_PE.GetAsMatrix4()
     p_PT = (X_PE @ np.linalg.inv(X_BE) @ X_BT)[:, :3, 3]

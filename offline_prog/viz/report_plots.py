@@ -245,7 +245,7 @@ def _triad_lines(X: np.ndarray, length: float, width: float) -> list:
 def views_svg(col: dict, data: ProgramData) -> str:
     """Four SVG views: the part's path with process frames F in P (top, side), and
     the flange path with the part's path at t = 0, base B and tool T in I (top, side)."""
-    X_PF = data.X_PF
+    X_PF = data.X_PT  # the tool frame T in P: the process frame F on the seams
     p_PF = X_PF[:, :3, 3]
     length = float(np.sum(np.linalg.norm(np.diff(p_PF, axis=0), axis=1)))
     pick = np.linspace(0, len(p_PF) - 1, N_TRIADS).round().astype(int)

@@ -138,20 +138,20 @@ def reference_process_points(
     Returns:
         (indices (K,), max chord [m], max angle [rad]).
     """
-    p, R = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
+    p, R = data.X_PT[:, :3, 3], data.X_PT[:, :3, :3]
     chosen = reference_select_points(p, R, chord_tol_m=chord_tol_m, angle_tol_rad=angle_tol_rad)
     if style == "external_tcp" and convention == "X_PF":  # the written poses are X_PF
         return chosen.indices, chosen.max_chord_m, chosen.max_angle_rad
     if style == "flange":  # the controller interpolates P in B; the tool is fixed in B
         X_BP, X_BT = data.X_BE @ data.X_EP, data.X_BT
     else:  # it interpolates P in T, the tool at T's origin
-        X_BP, X_BT = np.linalg.inv(data.X_PF), np.eye(4)
+        X_BP, X_BT = np.linalg.inv(data.X_PT), np.eye(4)
     indices, worst = [int(chosen.indices[0])], np.zeros(2)
     stack = list(zip(chosen.indices[1:], chosen.indices[:-1], strict=True))[::-1]
     while stack:  # split each LIN segment until the nozzle curve on P fits as well
         j, i = (int(v) for v in stack.pop())
         deviation = np.maximum(
-            segment_deviation(p, R, i, j), reference_nozzle_deviation(X_BP, X_BT, data.X_PF, i, j)
+            segment_deviation(p, R, i, j), reference_nozzle_deviation(X_BP, X_BT, data.X_PT, i, j)
         )
         if j - i > 1 and (deviation[0] > chord_tol_m or deviation[1] > angle_tol_rad):
             stack += [(j, (i + j) // 2), ((i + j) // 2, i)]

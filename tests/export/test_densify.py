@@ -13,13 +13,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import transform
-from offline_prog.export.abb.rapid import write_rapid
 from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
-from offline_prog.export.kuka.krl import write_krl
-from offline_prog.plan import plan_cell
-from offline_prog.results.plan_folder import program_data
-from offline_prog.results.report import report
+from offline_prog.export.formats import export
+from offline_prog.export.points import PointRule
+from offline_prog.export.record import program_record
+from offline_prog.plan import plan_job
+from offline_prog.results.program_data import job_program_data
 
 from conftest import CELLS
 
@@ -28,19 +28,20 @@ HEADER_ROUNDING_MM = 1e-4  # the header prints 4 decimals
 
 
 def plan_at(tmp_path_factory, name: str, rate_hz: float):
-    """(plan, ProgramData) of a demo cell planned at rate_hz."""
+    """(the seam's plan, the job as the writers read it) of a one-seam demo cell
+    planned at rate_hz."""
     folder = tmp_path_factory.mktemp(f"{name}_{rate_hz:g}hz")
     if (CELLS / "data").is_dir():
         shutil.copytree(CELLS / "data", folder / "data")
     text = (CELLS / f"{name}.yaml").read_text()
     text = text.replace("  max_jerk:", f"  sample_rate_hz: {rate_hz}\n  max_jerk:", 1)
     (folder / "cell.yaml").write_text(text)
-    plan = plan_cell(folder / "cell.yaml")
-    return plan, program_data(plan, report(plan))
+    job = plan_job(folder / "cell.yaml")
+    return job.seams[0], job_program_data(job, {"generated": "now"})
 
 
 def true_frames(plan, data):
-    """(s (M,), X_PF (M, 4, 4)) of the continuous plan, finely, as program_data does."""
+    """(s (M,), X_PT (M, 4, 4)) of the continuous plan, finely, as program_data does."""
     s = np.linspace(0.0, plan.path.length, int(plan.path.length / TRUE_SPACING_M) + 1)
     flange = plan.flange(s)
     X_BE = np.zeros((len(s), 4, 4))
@@ -50,7 +51,7 @@ def true_frames(plan, data):
 
 
 def true_deviation(plan, data, s_points, X_points) -> tuple[float, float]:
-    """Largest distance [m] / angle [rad] of the continuous X_PF from the LIN segments
+    """Largest distance [m] / angle [rad] of the continuous X_PT from the LIN segments
     between consecutive program points (s_points (K,), X_points (K, 4, 4)): the tool moves
     in a straight line across the part, orientation by slerp at the same share."""
     s, X = true_frames(plan, data)
@@ -68,7 +69,7 @@ def true_deviation(plan, data, s_points, X_points) -> tuple[float, float]:
 
 def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> float:
     """Largest distance [m] of the tool's trace on the part from the continuous path when
-    the controller interpolates the written KRL poses X_TP = X_PF⁻¹ (P in T: position
+    the controller interpolates the written KRL poses X_TP = X_PT⁻¹ (P in T: position
     linear, orientation slerp) between consecutive points."""
     s, X = true_frames(plan, data)
     lam = np.linspace(0.0, 1.0, grid + 1)
@@ -88,77 +89,119 @@ def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> fl
     return worst
 
 
+def written_points(data, fmt: str, folder, rule: PointRule):
+    """The seam's points (path positions (K,) [m], the tool frames X_PT (K, 4, 4) read
+    from the written program), and the program record's stated bound [m, rad]."""
+    export(data, fmt, folder, force=True)  # (a low sample rate's link may miss its budget)
+    (run,) = program_record(data, rule).runs()
+    seam, indices = run.process.data, run.process.indices
+    if fmt == "krl":
+        main, module = (folder / name for name in ("offline_prog.dat", "offline_prog_1.dat"))
+        decls = re.findall(r"^DECL E6POS (XA1|XP\d+)=\{([^}]*)\}", main.read_text(), re.M)
+        decls += re.findall(r"^DECL E6POS (XP\d+)=\{([^}]*)\}", module.read_text(), re.M)
+        fields = [{k: float(v) for k, v in (i.split() for i in d.split(","))} for _, d in decls]
+        X_TP = np.array([krl_pose(f) for f in fields])
+        X_PT = np.linalg.inv(X_TP)
+    else:
+        text = (folder / "OfflineProg.mod").read_text()
+        targets = dict(re.findall(r"robtarget (\w+) := \[(\[[^\]]*\],\[[^\]]*\])", text))
+        names = ["pA1"] + [f"seam_1_{m}" for m in range(1, len(indices))]
+        X_PT = np.array([rapid_pose(targets[n]) for n in names])
+    assert len(X_PT) == len(indices)
+    return seam.path_m[indices], X_PT, (run.process.max_chord_m, run.process.max_angle_rad)
+
+
+def krl_pose(f) -> np.ndarray:
+    """(4, 4) [m] of a KRL E6POS: X, Y, Z [mm], A, B, C [deg] Z-Y'-X''."""
+    X = np.eye(4)
+    X[:3, :3] = Rotation.from_euler("ZYX", [f["A"], f["B"], f["C"]], degrees=True).as_matrix()
+    X[:3, 3] = np.array([f["X"], f["Y"], f["Z"]]) * 1e-3
+    return X
+
+
+def rapid_pose(text: str) -> np.ndarray:
+    """(4, 4) [m] of a RAPID pose ``[x,y,z],[q1,q2,q3,q4]`` [mm, w x y z]."""
+    position, quaternion = (
+        np.array(v.split(","), float) for v in re.findall(r"\[([^\]]*)\]", text)
+    )
+    X = np.eye(4)
+    X[:3, :3] = Rotation.from_quat(quaternion, scalar_first=True).as_matrix()
+    X[:3, 3] = position * 1e-3
+    return X
+
+
+KRL_RULE = PointRule("external_tcp", "X_TP")
+
+
 @pytest.fixture(scope="module", params=[1.0, 10.0])
 def kuka(request, tmp_path_factory):
     return plan_at(tmp_path_factory, "seal_plate_kr16", request.param)
 
 
 def test_samples_alone_miss_the_plan_at_low_rates(tmp_path_factory):
-    plan, data = plan_at(tmp_path_factory, "seal_plate_kr16", 1.0)
-    chosen = select_points(data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]).indices
-    chord, _ = true_deviation(plan, data, data.sigma[chosen], data.X_PF[chosen])
+    plan, job = plan_at(tmp_path_factory, "seal_plate_kr16", 1.0)
+    data = job.seams[0]
+    chosen = select_points(data.X_PT[:, :3, 3], data.X_PT[:, :3, :3]).indices
+    chord, _ = true_deviation(plan, data, data.path_m[chosen], data.X_PT[chosen])
     assert chord > 100 * DEFAULT_CHORD_TOL_M  # the bug this module fixes: 11 mm at 1 Hz
 
 
 def test_krl_holds_the_tolerance_and_says_so(kuka, tmp_path):
-    plan, data = kuka
-    result = write_krl(data, tmp_path)
-    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
-    chord, angle = true_deviation(
-        plan, data, dense.sigma[result.indices], dense.X_PF[result.indices]
-    )
+    plan, job = kuka
+    s_points, X_points, (bound_m, bound_rad) = written_points(job, "krl", tmp_path, KRL_RULE)
+    chord, angle = true_deviation(plan, job.seams[0], s_points, X_points)
     assert chord <= DEFAULT_CHORD_TOL_M and angle <= DEFAULT_ANGLE_TOL_RAD
-    assert result.max_chord_m >= chord and result.max_angle_rad >= angle * (1 - 1e-6)
-    comments = [line[2:] for line in result.files[0].read_text().splitlines() if line[:2] == "; "]
-    header = re.search(r"achieved ([\d.]+) mm, ([\d.]+) deg", " ".join(comments))
-    assert float(header.group(1)) + HEADER_ROUNDING_MM >= chord * 1e3
-    assert float(header.group(2)) + HEADER_ROUNDING_MM >= np.rad2deg(angle)
+    assert bound_m >= chord and bound_rad >= angle * (1 - 1e-6)
+    module = (tmp_path / "offline_prog_1.src").read_text()
+    stated = re.search(r"deviation <= ([\d.]+) mm, ([\d.]+) deg from the plan", module)
+    assert float(stated.group(1)) + HEADER_ROUNDING_MM >= chord * 1e3
+    assert float(stated.group(2)) + HEADER_ROUNDING_MM >= np.rad2deg(angle)
 
 
 @pytest.mark.slow
 def test_krl_points_also_hold_when_the_written_poses_are_interpolated(kuka, tmp_path):
-    plan, data = kuka
-    result = write_krl(data, tmp_path)
-    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
-    s_points, X_points = dense.sigma[result.indices], dense.X_PF[result.indices]
-    assert pose_interpolation_deviation(plan, data, s_points, X_points) <= DEFAULT_CHORD_TOL_M
-    text = result.files[0].read_text()
-    assert "and if it interpolates the written poses" in " ".join(text.replace("; ", "").split())
+    plan, job = kuka
+    s_points, X_points, _ = written_points(job, "krl", tmp_path, KRL_RULE)
+    assert pose_interpolation_deviation(plan, job.seams[0], s_points, X_points) <= (
+        DEFAULT_CHORD_TOL_M
+    )
     # Thinned for straight lines across the part only, the same plan misses by more.
-    chosen = select_points(dense.X_PF[:, :3, 3], dense.X_PF[:, :3, :3]).indices
-    missed = pose_interpolation_deviation(plan, data, dense.sigma[chosen], dense.X_PF[chosen])
+    dense = densify(job.seams[0], DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
+    chosen = select_points(dense.X_PT[:, :3, 3], dense.X_PT[:, :3, :3]).indices
+    missed = pose_interpolation_deviation(
+        plan, job.seams[0], dense.path_m[chosen], dense.X_PT[chosen]
+    )
     assert missed > 2 * DEFAULT_CHORD_TOL_M
 
 
-def test_rapid_holds_the_tolerance_and_says_so(tmp_path_factory, tmp_path):
-    plan, data = plan_at(tmp_path_factory, "weld_seam_irb2400", 1.0)
-    result = write_rapid(data, tmp_path)
-    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD).data
-    chord, angle = true_deviation(
-        plan, data, dense.sigma[result.indices], dense.X_PF[result.indices]
-    )
+def test_rapid_holds_the_tolerance(tmp_path_factory, tmp_path):
+    plan, job = plan_at(tmp_path_factory, "weld_seam_irb2400", 1.0)
+    rule = PointRule("external_tcp", "X_PF")
+    s_points, X_points, (bound_m, _) = written_points(job, "rapid", tmp_path, rule)
+    chord, angle = true_deviation(plan, job.seams[0], s_points, X_points)
     assert chord <= DEFAULT_CHORD_TOL_M and angle <= DEFAULT_ANGLE_TOL_RAD
-    header = re.search(r"LIN deviation <= ([\d.]+) mm", result.files[0].read_text())
-    assert float(header.group(1)) + HEADER_ROUNDING_MM >= chord * 1e3
+    assert bound_m >= chord
 
 
 def test_inserted_rows_are_on_the_plan(kuka):
     """Inserted joints reproduce the inserted flange poses (the plan's branch)."""
     from offline_prog.robot.model import load_robot
 
-    plan, data = kuka
-    dense = densify(data, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
+    _, job = kuka
+    dense = densify(job.seams[0], DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
     d = dense.data
-    assert np.all(np.diff(d.sigma) >= 0) and np.all(np.diff(d.t) >= 0)
+    assert np.all(np.diff(d.path_m) >= 0) and np.all(np.diff(d.t) >= 0)
     X_BE = load_robot(d.robot).forward(d.q)
     assert np.abs(X_BE[:, :3, 3] - d.X_BE[:, :3, 3]).max() < 1e-6
     assert np.abs(np.diff(d.q, axis=0)).max() < 0.2  # no branch switch
 
 
-def test_old_plan_files_say_they_are_measured_at_samples(kuka, tmp_path):
+def test_old_plan_files_say_they_are_measured_at_samples(kuka):
     import dataclasses
 
-    _, data = kuka
-    old = dataclasses.replace(data, sigma_dense=np.empty(0), X_PF_dense=np.empty((0, 4, 4)))
-    text = write_krl(old, tmp_path).files[0].read_text()
-    assert "measured at the plan samples only" in text
+    _, job = kuka
+    old = dataclasses.replace(
+        job.seams[0], path_dense_m=np.empty(0), X_PT_dense=np.empty((0, 4, 4))
+    )
+    dense = densify(old, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
+    assert dense.n_inserted == 0 and "measured at the plan samples only" in dense.basis

@@ -20,10 +20,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from offline_prog.config.cell import load_cell
-from offline_prog.export.abb.rapid_job import write_rapid_job
+from offline_prog.export.formats import controller_post
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.kuka.krl_job import write_krl_job
-from offline_prog.export.ur.urscript_job import write_urscript_job
+from offline_prog.export.post import write_program
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
@@ -38,6 +37,12 @@ END_P = np.array([0.120, 0.080, 0.0])
 LENGTH_M = float(np.linalg.norm(END_P - START_P))  # 240 mm
 ON_LEAD_MM, OFF_LEAD_MM, PER_MPS, OFFSET_V, LAG_S = -100.0, 2.0, 40.0, 0.5, 0.1
 SPEED_M_S = 0.15  # the stripe's speed in the cell
+
+
+def write(data: JobProgramData, fmt: str, folder: Path) -> list[Path]:
+    """The files of format ``fmt``'s writer on the job (whatever the plan's controller:
+    its events are what is read here)."""
+    return write_program(controller_post(data, fmt), folder)
 
 
 def stripe_cell(tmp_path, on_lead_mm=ON_LEAD_MM, off_lead_mm=OFF_LEAD_MM, lag_s=LAG_S):
@@ -148,7 +153,7 @@ def krl_events(data, folder):
 
 def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
     data, _, _ = stripe
-    files = write_krl_job(data, tmp_path)
+    files = write(data, "krl", tmp_path)
     run, events = krl_events(data, tmp_path)
     on, off = asked()
     out = [(value, position) for what, value, position, _ in events if what == "$OUT[1]"]
@@ -210,7 +215,7 @@ def rapid_events(data, text):
 
 def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     data, _, _ = stripe
-    text = write_rapid_job(data, tmp_path)[0].read_text()
+    text = write(data, "rapid", tmp_path)[0].read_text()
     events = rapid_events(data, text)
     on, off = asked()
     out = [(v, p) for what, v, p, _ in events if what == "do1"]
@@ -234,7 +239,8 @@ def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
 
 def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     data, _, _ = stripe
-    lines = [s.strip() for s in write_urscript_job(data, tmp_path).read_text().splitlines()]
+    (script,) = write(data, "urscript", tmp_path)
+    lines = [s.strip() for s in script.read_text().splitlines()]
     period = float(re.search(r"servoj\(.*t=([\d.]+)", "\n".join(lines))[1])
     q_of = lambda line: np.array(re.search(r"\(\[([^\]]*)\]", line)[1].split(","), float)  # noqa: E731
     servoj = [i for i, line in enumerate(lines) if line.startswith("servoj(")]
@@ -364,9 +370,9 @@ def test_programs_switch_where_the_events_say(stripe, positions_mm):
     data = dataclasses.replace(data, events=events)
     expected = [(k % 2 == 0, p * 1e-3) for k, p in enumerate(positions_mm)]
     with tempfile.TemporaryDirectory() as folder:
-        write_krl_job(data, Path(folder))
+        write(data, "krl", Path(folder))
         _, krl = krl_events(data, Path(folder))
-        text = write_rapid_job(data, Path(folder))[0].read_text()
+        text = write(data, "rapid", Path(folder))[0].read_text()
     got = [(value == "TRUE", p) for what, value, p, _ in krl if what == "$OUT[1]"]
     assert [s for s, _ in got] == [s for s, _ in expected]
     assert [p for _, p in got] == [pytest.approx(p, abs=IO_TOL_M) for _, p in expected]

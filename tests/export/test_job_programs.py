@@ -274,7 +274,7 @@ def test_urscript_job_links_and_io(folders):
     # The path position of the tool at each servoj: along the approach from its start,
     # then along the seam's planned points (σ of the nearest dense sample).
     seam = data.seams[0]
-    p_seam = seam.X_PF[:, :3, 3]
+    p_seam = seam.X_PT[:, :3, 3]
     switched, last_q = {}, None
     pending = None
     for line in lines:
@@ -287,10 +287,10 @@ def test_urscript_job_links_and_io(folders):
                 p = tool_in_part_from_joints(data, last_q)
                 gap = np.linalg.norm(p_seam - p, axis=1)
                 i = int(np.argmin(gap))
-                if seam.sigma[i] < 1e-6 and gap[i] > 1e-4:  # off the seam's start: approach
+                if seam.path_m[i] < 1e-6 and gap[i] > 1e-4:  # off the seam's start: approach
                     position = -gap[i]
                 else:
-                    position = seam.sigma[i]
+                    position = seam.path_m[i]
                 switched[pending] = position
                 pending = None
     on, off = asked(folders.cells["urscript"], data, 0)
@@ -299,16 +299,28 @@ def test_urscript_job_links_and_io(folders):
     assert any(line.strip().startswith("set_standard_analog_out") for line in lines)
 
 
-def test_export_of_a_job_refuses_one_seam_options_in_one_line(folders, capsys):
+def test_export_offers_only_what_a_plan_accepts_and_refuses_the_rest_in_one_line(folders, capsys):
+    """``export --help`` lists no option that every plan refuses (the one-seam
+    writers' ``--style`` and ``--mode`` are gone); a flag of another format is one line,
+    exit 2, naming the flags the format takes."""
     from offline_prog.cli import main
 
     _, _, plan_folder = folders["krl"]
     out = plan_folder.parent / "reexport"
     assert main(["export", str(plan_folder), "--format", "krl", "--out", str(out)]) == 0
     assert (out / "offline_prog.src").is_file()
-    capsys.readouterr()
-    code = main(
-        ["export", str(plan_folder), "--format", "krl", "--style", "flange", "--out", str(out)]
-    )
-    err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "style is for one-seam plans" in err[0]
+    with pytest.raises(SystemExit):
+        main(["export", "--help"])
+    usage = capsys.readouterr().out
+    assert "--style" not in usage and "--mode" not in usage and "--tcp-pose-convention" in usage
+    for flags, words in [
+        (["--style", "flange"], "unrecognized arguments: --style flange"),
+        (["--line-limit", "100"], "--line-limit: not an option of --format krl"),
+    ]:
+        argv = ["export", str(plan_folder), "--format", "krl", *flags, "--out", str(out)]
+        try:
+            code = main(argv)
+        except SystemExit as error:  # argparse's own
+            code = error.code
+        err = capsys.readouterr().err.strip().splitlines()
+        assert code == 2 and len(err) == 1 and words in err[0], err

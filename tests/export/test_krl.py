@@ -1,6 +1,7 @@
 """KUKA KRL export read back with an independent parser and independent maths: poses
 (scipy's intrinsic "ZYX" Euler angles), joints (Drake forward kinematics of the URDF),
-Status/Turn (URDF link geometry), point density, splitting, linting, forced header."""
+Status/Turn (URDF link geometry), point density against the plan, speeds, linting,
+the forced header and the options a KRL program takes."""
 
 import dataclasses
 import re
@@ -10,15 +11,16 @@ import pytest
 from krl_lint import assert_krllint_clean
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.kuka.krl import write_krl
+from offline_prog.export.formats import export
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.kuka.kuka import kuka_abc_deg, status_turn
-from offline_prog.export.program import ProgramData
+from offline_prog.export.points import PointRule
+from offline_prog.export.record import program_record
 from offline_prog.robot.model import load_robot
 from offline_prog.robot.record import robot_record
 
 POSITION_TOL_M = 0.01e-3  # round trip of every written pose
 ANGLE_TOL_DEG = 0.01
-JOINT_TOL_DEG = 0.001
 # Writing rounds to 1e-4 mm and 1e-5 deg; over lever arms below 1 m that is < 1e-6 m.
 ROUNDING_SLACK_M, ROUNDING_SLACK_RAD = 1e-6, np.deg2rad(2e-5)
 # The URDF tool0 in KUKA's $FLANGE: the same frame, z out of the flange (kuka_experimental,
@@ -29,16 +31,17 @@ DECL = re.compile(r"^DECL (E6POS|E6AXIS|FRAME) (\w+)=\{(.*)\}$")
 
 
 @pytest.fixture(scope="module")
-def data(planned_folder):
-    return ProgramData.load(planned_folder("seal_plate_kr16")[1])
+def data(planned_job):
+    """The seal demo (a one-seam job with its flow output)."""
+    return JobProgramData.load(planned_job("seal_plate_kr16")[1])
 
 
 @pytest.fixture(scope="module")
 def slowed(tmp_path_factory):
     """The seal demo with its nozzle's turn fixed (no tool.turn_smoothing_mm): the
     wrist's jerk slows the plate at each corner."""
-    from offline_prog.plan import plan_cell
-    from offline_prog.results.plan_folder import write_outputs
+    from offline_prog.plan import plan_job
+    from offline_prog.results.job_folder import write_job_outputs
 
     from conftest import CELLS
 
@@ -46,8 +49,8 @@ def slowed(tmp_path_factory):
     text = (CELLS / "seal_plate_kr16.yaml").read_text()
     cell = folder / "seal_fixed_turn.yaml"
     cell.write_text(re.sub(r"\n  turn_smoothing_mm: .*", "", text))
-    write_outputs(plan_cell(cell), folder / "plan")
-    return ProgramData.load(folder / "plan")
+    write_job_outputs(plan_job(cell), folder / "plan")
+    return JobProgramData.load(folder / "plan")
 
 
 @pytest.fixture(scope="module")
@@ -82,8 +85,8 @@ def pose(fields):
     return X
 
 
-def read_program(folder, name):
-    """Motions in execution order, following sub-program calls.
+def read_program(folder, name="offline_prog"):
+    """Motions in execution order, following the calls of the seams' modules.
 
     Returns:
         (motions, frames): motions is a list of dicts (kind, point, blended, vel_cp,
@@ -124,14 +127,13 @@ def read_program(folder, name):
     return motions, settings
 
 
-def flange_poses(motions, settings, style, convention):
-    """X_BE (n, 4, 4) of every LIN target, composed as the convention says."""
-    tool_inv = np.linalg.inv(pose(settings["TOOL"]))
-    base = np.eye(4) if settings["BASE"] == "$NULLFRAME" else pose(settings["BASE"])
+def flange_poses(motions, settings, convention="X_TP"):
+    """X_BE (n, 4, 4) of LIN targets, composed as the convention says."""
+    tool_inv, base = np.linalg.inv(pose(settings["TOOL"])), pose(settings["BASE"])
     out = []
     for motion in motions:
         X = pose(motion["fields"])
-        if style == "external_tcp" and convention == "X_PF":
+        if convention == "X_PF":
             X = np.linalg.inv(X)  # the point is T in P: $BASE : inv(POS) : inv($TOOL)
         out.append(base @ X @ tool_inv @ X_FLANGE_TOOL0)  # $BASE : POS : inv($TOOL)
     return np.array(out)
@@ -144,64 +146,61 @@ def pose_errors(X_a, X_b):
     return dp, np.rad2deg(Rotation.from_matrix(R).magnitude().max())
 
 
-def offset_pose(data, k, approach_m=0.02):
-    """X_BE with the tool frame backed off approach_m against the normal (y of F)."""
-    X_PF = data.X_PF[k].copy()
-    X_PF[:3, 3] -= approach_m * X_PF[:3, 1]
-    return data.X_BT @ np.linalg.inv(X_PF) @ np.linalg.inv(data.X_EP)
+def seam_lins(motions):
+    """The seam's LIN targets: the approach's end (its first point) and the module's."""
+    approach = next(k for k, m in enumerate(motions) if m["point"] == "XA1")
+    lins = [motions[approach]]
+    for m in motions[approach + 1 :]:
+        if m["module"] == "offline_prog":
+            break
+        lins.append(m)
+    return lins
 
 
-CASES = [("external_tcp", "X_TP"), ("external_tcp", "X_PF"), ("flange", "X_TP")]
+def record_points(data, convention="X_TP", **tolerances):
+    """The seam's points as the program record holds them: (densified data, indices)."""
+    rule = PointRule("external_tcp", convention, **tolerances)
+    (run,) = program_record(data, rule, flow_where_set=True).runs()
+    return run.process.data, run.process.indices
 
 
-@pytest.mark.parametrize(("style", "convention"), CASES)
-def test_round_trip_reproduces_the_flange_poses(data, tmp_path, style, convention):
-    result = write_krl(data, tmp_path, style=style, tcp_pose_convention=convention)
-    motions, settings = read_program(tmp_path, "offline_prog")
-    assert settings["IPO_MODE"] == ("#TCP" if style == "external_tcp" else "#BASE")
-    # No approach or retract of the writer's own: PTP to the plan's start, its points.
-    assert [m["kind"] for m in motions] == ["PTP"] + ["LIN"] * result.n_points
-    assert motions[0]["type"] == "E6AXIS" and motions[0]["point"] == "XSTART"
-    lin = [m for m in motions if m["kind"] == "LIN"]
-    assert [m["point"] for m in lin] == [f"XP{k + 1}" for k in range(result.n_points)]
-    indices = np.asarray(result.indices)
-    assert indices[0] == 0 and indices[-1] == len(data.t) - 1 and np.all(np.diff(indices) > 0)
-    X_BE = flange_poses(lin, settings, style, convention)
-    dp, da = pose_errors(X_BE, data.X_BE[indices])
+@pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
+def test_round_trip_reproduces_the_flange_poses(data, tmp_path, convention):
+    export(data, "krl", tmp_path, tcp_pose_convention=convention)
+    motions, settings = read_program(tmp_path)
+    assert settings["IPO_MODE"] == "#TCP"
+    lins = seam_lins(motions)
+    seam, indices = record_points(data, convention)
+    assert [m["point"] for m in lins] == ["XA1"] + [f"XP{k + 1}" for k in range(1, len(indices))]
+    assert indices[0] == 0 and indices[-1] == len(seam.t) - 1 and np.all(np.diff(indices) > 0)
+    dp, da = pose_errors(flange_poses(lins, settings, convention), seam.X_BE[indices])
     assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    # Exact stops at the process start and end; blending in between.
-    assert [m["blended"] for m in lin] == [False] + [True] * (result.n_points - 2) + [False]
-    if style == "external_tcp":  # the other convention would put the flange elsewhere
-        other = {"X_TP": "X_PF", "X_PF": "X_TP"}[convention]
-        assert pose_errors(flange_poses(lin, settings, style, other), X_BE)[0] > 0.01
+    # An exact stop where the approach ends and at the seam's end; blending in between.
+    assert [m["blended"] for m in lins] == [False] + [True] * (len(lins) - 2) + [False]
+    # The other convention would put the flange elsewhere.
+    other = {"X_TP": "X_PF", "X_PF": "X_TP"}[convention]
+    assert pose_errors(flange_poses(lins, settings, other), seam.X_BE[indices])[0] > 0.01
 
 
-def test_ptp_start_is_the_planned_start(data, tmp_path):
-    write_krl(data, tmp_path)
-    motions, _ = read_program(tmp_path, "offline_prog")
-    fields = motions[0]["fields"]
-    axes_deg = np.array([fields[f"A{i}"] for i in range(1, 7)])
-    np.testing.assert_allclose(axes_deg, np.rad2deg(data.q[0]), atol=1e-5)
-
-
-def test_ptp_to_an_asked_approach(data, tmp_path, plant):
-    write_krl(data, tmp_path, approach_m=0.02)
-    motions, _ = read_program(tmp_path, "offline_prog")
-    assert motions[0]["point"] == "XAPPROACH" and motions[-1]["point"] == "XRETRACT"
-    fields = motions[0]["fields"]
-    axes_deg = np.array([fields[f"A{i}"] for i in range(1, 7)])
-    assert all(fields[f"E{i}"] == 0.0 for i in range(1, 7))
-    # A_i = URDF q_i in degrees: Drake's forward kinematics puts the flange on the approach.
-    X_BE = link_poses(plant, np.deg2rad(axes_deg), ["tool0"])["tool0"]
-    dp, da = pose_errors(X_BE[None], offset_pose(data, 0)[None])
+def test_ptp_targets_are_the_planned_joints_and_put_the_flange_there(data, tmp_path, plant):
+    """E6AXIS A_i = URDF q_i in degrees: home first, then each link's waypoints; Drake's
+    forward kinematics of the last one before the approach is the flange where the
+    approach starts."""
+    export(data, "krl", tmp_path)
+    motions, _ = read_program(tmp_path)
+    ptp = [m for m in motions if m["kind"] == "PTP"]
+    axes = np.array([[m["fields"][f"A{i}"] for i in range(1, 7)] for m in ptp])
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(axes, np.rad2deg(planned), atol=1e-5)
+    assert all(m["fields"][f"E{i}"] == 0.0 for m in ptp for i in range(1, 7))
+    assert ptp[0]["point"] == "XHOME" and motions[-1]["kind"] == "PTP"
+    before = motions[[m["point"] for m in motions].index("XA1") - 1]
+    X_BE = link_poses(
+        plant, np.deg2rad([before["fields"][f"A{i}"] for i in range(1, 7)]), ["tool0"]
+    )
+    approach = next(s for s in data.segments if s.kind == "approach")
+    dp, da = pose_errors(X_BE["tool0"][None], data.job.X_BE[approach.start][None])
     assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    # ... with the analytic IK solution nearest the plan's start, to 0.001 deg.
-    robot = load_robot(data.robot)
-    q = robot.inverse(offset_pose(data, 0)[None])[0]
-    q = data.q[0] + (q - data.q[0] + np.pi) % (2 * np.pi) - np.pi
-    nearest = q[np.nanargmin(np.abs(q - data.q[0]).max(axis=1))]
-    assert np.abs(axes_deg - np.rad2deg(nearest)).max() <= JOINT_TOL_DEG
-    assert np.abs(axes_deg - np.rad2deg(data.q[0])).max() < 10.0  # same branch as the path
 
 
 def geometric_status(plant, q_rad):
@@ -215,14 +214,15 @@ def geometric_status(plant, q_rad):
 
 
 def test_status_and_turn_on_the_plan(data, tmp_path, plant):
-    result = write_krl(data, tmp_path)
-    motions, _ = read_program(tmp_path, "offline_prog")
-    lin = [m for m in motions if m["kind"] == "LIN"]
-    q = data.q[result.indices]
-    turn = np.array([m["fields"]["T"] for m in lin])
+    export(data, "krl", tmp_path)
+    motions, _ = read_program(tmp_path)
+    lins = seam_lins(motions)
+    seam, indices = record_points(data)
+    q = seam.q[indices]
+    turn = np.array([m["fields"]["T"] for m in lins])
     expected = sum((q[:, i] < 0).astype(int) << i for i in range(6))  # bit i: A(i+1) < 0
     np.testing.assert_array_equal(turn, expected)
-    status = np.array([m["fields"]["S"] for m in lin])
+    status = np.array([m["fields"]["S"] for m in lins])
     np.testing.assert_array_equal(status, [geometric_status(plant, row) for row in q])
 
 
@@ -259,85 +259,63 @@ def test_euler_angles_round_trip():
     assert np.all(np.abs(abc[:, 1]) <= 90.0) and np.all(np.abs(abc) <= 180.0)
 
 
-def nozzle_curve(X_BP_a, X_BP_b, p_BT, n=200):
-    """(n, 3) tool origin in P while the controller interpolates X_BP from a to b
-    (position linear, orientation by slerp, one parameter)."""
-    lam = np.linspace(0, 1, n)
-    rotvec = Rotation.from_matrix(X_BP_a[:3, :3].T @ X_BP_b[:3, :3]).as_rotvec()
-    R = X_BP_a[:3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
-    p = X_BP_a[:3, 3] + lam[:, None] * (X_BP_b[:3, 3] - X_BP_a[:3, 3])
-    return np.einsum("nji,nj->ni", R, p_BT - p)
-
-
 def distance_to_polyline(points, line):
     a, d = line[:-1], np.diff(line, axis=0)
     u = np.clip(np.einsum("kgc,gc->kg", points[:, None] - a, d) / (d * d).sum(1), 0, 1)
     return np.linalg.norm(points[:, None] - a - u[..., None] * d, axis=2).min(axis=1)
 
 
-@pytest.mark.parametrize("style", ["external_tcp", "flange"])
-def test_exported_points_follow_the_dense_plan(data, tmp_path, style):
-    chord, angle = 0.05e-3, np.deg2rad(0.1)
-    result = write_krl(data, tmp_path, style=style, chord_tol_m=chord, angle_tol_rad=angle)
-    motions, settings = read_program(tmp_path, "offline_prog")
-    X_BE = flange_poses([m for m in motions if m["kind"] == "LIN"], settings, style, "X_TP")
-    X_BP = X_BE @ data.X_EP
-    X_PT = np.linalg.inv(X_BP) @ data.X_BT  # the exported process frames, from the file
-    p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
+@pytest.mark.parametrize("chord_mm", [0.05, 0.2])
+def test_exported_points_follow_the_dense_plan(data, tmp_path, chord_mm):
+    """The controller moves the fixed TCP in straight lines across the part between the
+    written points: every densified sample of the seam lies within the chord tolerance
+    of that line, orientation by slerp within the angle tolerance."""
+    chord, angle = chord_mm * 1e-3, np.deg2rad(0.1)
+    export(data, "krl", tmp_path, chord_tol_m=chord, angle_tol_rad=angle)
+    motions, settings = read_program(tmp_path)
+    X_BE = flange_poses(seam_lins(motions), settings)
+    X_PT = np.linalg.inv(data.job.X_BT) @ X_BE @ data.job.X_EP
+    X_PT = np.linalg.inv(X_PT)  # the written tool frames in P, from the file
+    seam, indices = record_points(data, chord_tol_m=chord, angle_tol_rad=angle)
+    p, R = seam.X_PT[:, :3, 3], seam.X_PT[:, :3, :3]
     worst = 0.0
-    for k, (i, j) in enumerate(zip(result.indices[:-1], result.indices[1:], strict=True)):
-        if style == "external_tcp":  # the controller moves T straight across P
-            line = X_PT[k : k + 2, :3, 3]
-        else:  # the controller moves P straight in B
-            line = nozzle_curve(X_BP[k], X_BP[k + 1], data.X_BT[:3, 3])
-        gap = distance_to_polyline(p_PF[i : j + 1], line)
-        worst = max(worst, gap.max())
-        if style == "external_tcp" and j > i + 1:
+    for k, (i, j) in enumerate(zip(indices[:-1], indices[1:], strict=True)):
+        line = X_PT[k : k + 2, :3, 3]
+        worst = max(worst, distance_to_polyline(p[i : j + 1], line).max())
+        if j > i + 1:
             chord_vec = line[1] - line[0]
-            lam = np.clip((p_PF[i + 1 : j] - line[0]) @ chord_vec / (chord_vec @ chord_vec), 0, 1)
+            lam = np.clip((p[i + 1 : j] - line[0]) @ chord_vec / (chord_vec @ chord_vec), 0, 1)
             rel = Rotation.from_matrix(X_PT[k, :3, :3].T @ X_PT[k + 1, :3, :3]).as_rotvec()
             R_lin = X_PT[k, :3, :3] @ Rotation.from_rotvec(lam[:, None] * rel).as_matrix()
-            err = Rotation.from_matrix(np.swapaxes(R_lin, 1, 2) @ R_PF[i + 1 : j]).magnitude()
+            err = Rotation.from_matrix(np.swapaxes(R_lin, 1, 2) @ R[i + 1 : j]).magnitude()
             assert err.max() <= angle + ROUNDING_SLACK_RAD
     assert worst <= chord + ROUNDING_SLACK_M
-    assert result.max_chord_m <= chord and result.max_angle_rad <= angle
+    if chord_mm > 0.05:  # a larger tolerance: fewer points
+        assert len(indices) < len(record_points(data)[1])
 
 
 def test_vel_cp_follows_the_planned_speed(slowed, tmp_path):
-    data = slowed
-    result = write_krl(data, tmp_path)
-    motions, _ = read_program(tmp_path, "offline_prog")
-    lin = [m for m in motions if m["kind"] == "LIN"]
-    assert lin[0]["vel_cp"] == pytest.approx(data.process_speed_m_s)
-    for k, (i, j) in enumerate(zip(result.indices[:-1], result.indices[1:], strict=True)):
-        planned = data.tcp_speed[i : j + 1].max()
-        assert planned - 1e-4 - 1e-9 <= lin[k + 1]["vel_cp"] <= max(planned, 1e-3) + 1e-9
-    assert min(m["vel_cp"] for m in lin) < data.process_speed_m_s  # the slowed corners
-
-
-def test_split_programs_are_called_in_order(data, tmp_path):
-    whole, parts = tmp_path / "whole", tmp_path / "parts"
-    write_krl(data, whole)
-    result = write_krl(data, parts, line_limit=25)
-    subs = [f.stem for f in result.files if f.suffix == ".src"][1:]
-    assert subs == [f"offline_prog_{k + 1}" for k in range(len(subs))] and len(subs) > 2
-    main = (parts / "offline_prog.src").read_text().splitlines()
-    assert [line[:-3] for line in main if re.match(r"^offline_prog_\d+\( \)$", line)] == subs
-    for sub in subs:
-        body = (parts / f"{sub}.src").read_text().splitlines()
-        body = body[body.index(f"DEF {sub}( )") + 1 : body.index("END")]
-        assert 0 < len(body) <= 25 and body[0].startswith("$VEL.CP=")
-    split_motions, _ = read_program(parts, "offline_prog")
-    whole_motions, _ = read_program(whole, "offline_prog")
-    key = ("kind", "point", "blended", "vel_cp", "fields")
-    assert [[m[k] for k in key] for m in split_motions] == [
-        [m[k] for k in key] for m in whole_motions
-    ]
+    export(slowed, "krl", tmp_path)
+    motions, _ = read_program(tmp_path)
+    lins = seam_lins(motions)
+    seam, indices = record_points(slowed)
+    speed = slowed.seams[0].process_speed_m_s
+    assert lins[0]["vel_cp"] == pytest.approx(speed, abs=1e-4)  # the approach
+    for k, (i, j) in enumerate(zip(indices[:-1], indices[1:], strict=True)):
+        planned = seam.tcp_speed[i : j + 1].max()
+        assert planned - 1e-4 - 1e-9 <= lins[k + 1]["vel_cp"] <= max(planned, 1e-3) + 1e-9
+    assert min(m["vel_cp"] for m in lins) < speed  # the slowed corners
 
 
 def test_files_are_plain_krl(data, tmp_path):
-    result = write_krl(data, tmp_path, style="flange", line_limit=100)
-    for file in result.files:
+    files = export(data, "krl", tmp_path)
+    assert [f.name for f in files] == [
+        "offline_prog.src",
+        "offline_prog.dat",
+        "offline_prog_1.src",
+        "offline_prog_1.dat",
+    ]
+    for file in files:
         raw = file.read_bytes()
         raw.decode("ascii")
         assert raw.count(b"\r\n") == raw.count(b"\n")  # CRLF, as KSS writes
@@ -346,7 +324,8 @@ def test_files_are_plain_krl(data, tmp_path):
         assert max(len(line) for line in lines) <= 255
         code = [line for line in lines if not line.startswith(";")]
         kind = "DEF" if file.suffix == ".src" else "DEFDAT"
-        assert code[0] == (f"{kind} {file.stem}( )" if kind == "DEF" else f"DEFDAT {file.stem}")
+        head = f"{kind} {file.stem}( )" if kind == "DEF" else f"DEFDAT {file.stem}"
+        assert code[0].split(" PUBLIC")[0] == head
         assert code[-1] == ("END" if kind == "DEF" else "ENDDAT")
         for line in code:
             if m := DECL.match(line):
@@ -354,72 +333,54 @@ def test_files_are_plain_krl(data, tmp_path):
 
 
 def test_krllint_finds_nothing(data, tmp_path):
-    write_krl(data, tmp_path / "krl", line_limit=60)
+    export(data, "krl", tmp_path / "krl")
     assert_krllint_clean(tmp_path / "krl", tmp_path)
 
 
 def test_forced_export_says_so_in_every_file(data, tmp_path):
-    failed = dataclasses.replace(data, feasible=False, failure="collision at t = 3.2 s")
-    result = write_krl(failed, tmp_path, forced=True, line_limit=100)
-    for file in result.files:
+    rows = dataclasses.replace(data.job, feasible=False, failure="collision at t = 3.2 s")
+    failed = dataclasses.replace(data, job=rows)
+    for file in export(failed, "krl", tmp_path, force=True):
         head = [line for line in file.read_text().splitlines() if line.startswith(";")]
         assert any("WARNING: EXPORTED WITH --force FROM A FAILED PLAN" in h for h in head)
         assert any("collision at t = 3.2 s" in h for h in head)
 
 
 @pytest.mark.parametrize(
-    "options",
+    ("options", "words"),
     [
-        {"style": "tcp"},
-        {"tcp_pose_convention": "X_PT"},
-        {"name": "1abc"},
-        {"name": "a_name_that_is_far_too_long"},
-        {"line_limit": 1},
-        {"chord_tol_m": 0.0},
+        ({"style": "flange"}, "no option style"),
+        ({"line_limit": 100}, "no option line_limit"),
+        ({"tcp_pose_convention": "X_PT"}, "tcp_pose_convention"),
+        ({"name": "1abc"}, "name="),
+        ({"name": "a_name_that_is_far_too_long"}, "name="),
+        ({"chord_tol_m": 0.0}, "chord_tol_m > 0"),
     ],
 )
-def test_bad_arguments_are_refused(data, tmp_path, options):
-    with pytest.raises(ValueError, match="write_krl"):
-        write_krl(data, tmp_path, **options)
+def test_bad_arguments_are_refused(data, tmp_path, options, words):
+    with pytest.raises(ValueError, match=words):
+        export(data, "krl", tmp_path / "out", **options)
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_non_opw_robot_is_refused(data, tmp_path):
+    ur = robot_record(load_robot("ur10e"))
+    rows = dataclasses.replace(data.job, robot="ur10e", robot_record=ur)
     with pytest.raises(ValueError, match="not an OPW arm"):
-        ur = robot_record(load_robot("ur10e"))
-        write_krl(dataclasses.replace(data, robot="ur10e", robot_record=ur), tmp_path)
-
-
-@pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
-def test_export_command_sets_the_tcp_pose_convention(planned_folder, tmp_path, convention):
-    """README: ``offline-prog export --tcp-pose-convention X_PF`` writes the inverse
-    points; either reads back to the planned flange poses."""
-    from offline_prog.cli import main
-
-    plan_dir = planned_folder("seal_plate_kr16")[1]
-    flags = [] if convention == "X_TP" else ["--tcp-pose-convention", convention]
-    argv = ["export", str(plan_dir), "--format", "krl", "--out", str(tmp_path), *flags]
-    assert main(argv) == 0
-    motions, settings = read_program(tmp_path, "offline_prog")
-    lin = [m for m in motions if m["kind"] == "LIN"]  # the seam's (no unplanned retract)
-    X_BE = flange_poses(lin, settings, "external_tcp", convention)
-    data = ProgramData.load(plan_dir)
-    dp, da = pose_errors(X_BE[[0, -1]], data.X_BE[[0, -1]])
-    assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
+        export(dataclasses.replace(data, job=rows), "krl", tmp_path)
 
 
 @pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
 def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, convention):
-    """A job's KRL (every plan's, a path: cell being a one-seam job) takes
-    ``--tcp-pose-convention`` too: the approach ends on each seam's first point and the
-    seam's last LIN on its last, read back under the convention the header names."""
+    """``offline-prog export --tcp-pose-convention``: the approach ends on each seam's
+    first point and the seam's last LIN on its last, read back under the convention the
+    header names."""
     from offline_prog.cli import main
-    from offline_prog.export.job_program import JobProgramData
 
     plan_dir = planned_job("seal_job_kr16")[1]
     argv = ["export", str(plan_dir), "--format", "krl", "--out", str(tmp_path)]
     assert main([*argv, "--tcp-pose-convention", convention]) == 0
-    motions, settings = read_program(tmp_path, "offline_prog")
+    motions, settings = read_program(tmp_path)
     job = JobProgramData.load(plan_dir)
     lin = [m for m in motions if m["kind"] == "LIN"]
     for seam in job.seams:
@@ -427,7 +388,7 @@ def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, co
         while lin[0]["module"] != "offline_prog":  # the seam's LINs in its module
             last = lin.pop(0)
         lin.pop(0)  # the retract
-        X_BE = flange_poses([first, last], settings, "external_tcp", convention)
+        X_BE = flange_poses([first, last], settings, convention)
         dp, da = pose_errors(X_BE, seam.X_BE[[0, -1]])
         assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
     assert not lin

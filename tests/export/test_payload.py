@@ -12,10 +12,8 @@ from config.test_cell_errors import BASE, write_cell  # tests/config
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
 from offline_prog.errors import InputError
-from offline_prog.export.abb.rapid import write_rapid
-from offline_prog.export.kuka.krl import write_krl
-from offline_prog.export.program import ProgramData
-from offline_prog.export.ur.urscript import write_urscript
+from offline_prog.export.formats import export
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.robot.model import ROBOTS_DIR
 
 RECORD = {  # gripper 4 kg 80 mm down the flange axis; part 2 kg at (10, 0, 5) mm in P
@@ -27,14 +25,24 @@ RECORD = {  # gripper 4 kg 80 mm down the flange axis; part 2 kg at (10, 0, 5) m
 
 
 def expected_total(data):
-    p_EC = data.X_EP[:3, :3] @ np.array(RECORD["part_com_P_m"]) + data.X_EP[:3, 3]
+    X_EP = data.job.X_EP
+    p_EC = X_EP[:3, :3] @ np.array(RECORD["part_com_P_m"]) + X_EP[:3, 3]
     return 6.0, (4.0 * np.array(RECORD["gripper_com_E_m"]) + 2.0 * p_EC) / 6.0
 
 
+def with_payload(data: JobProgramData) -> JobProgramData:
+    return dataclasses.replace(data, job=dataclasses.replace(data.job, payload=RECORD))
+
+
 @pytest.fixture(scope="module")
-def plans(planned_folder):
+def plans(planned_job):
     names = ("seal_plate_kr16", "weld_seam_irb2400", "tape_cylinder_ur10e")
-    return [ProgramData.load(planned_folder(name)[1]) for name in names]
+    return [JobProgramData.load(planned_job(name)[1]) for name in names]
+
+
+def program(data, fmt, folder) -> str:
+    """The main program's text (force: a test cell's plan may fail its link budget)."""
+    return export(data, fmt, folder, force=True)[0].read_text()
 
 
 def test_cell_keys(tmp_path):
@@ -50,49 +58,48 @@ def test_cell_keys(tmp_path):
 
 
 def test_krl_load(plans, tmp_path):
-    data = dataclasses.replace(plans[0], payload=RECORD)
-    text = write_krl(data, tmp_path).files[0].read_text()
+    data = with_payload(plans[0])
+    text = program(data, "krl", tmp_path)
     m = re.search(r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0,B 0,C 0\}", text, re.M)
     mass, p_EC = expected_total(data)
     assert float(m.group(1)) == pytest.approx(mass)
     np.testing.assert_allclose([float(m.group(i)) for i in (2, 3, 4)], p_EC * 1e3, atol=0.06)
-    assert text.index("$LOAD=") < text.index("PTP XSTART")
+    assert text.index("$LOAD=") < text.index("PTP XHOME")
 
 
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
 def test_rapid_loads(plans, tmp_path):
-    data = dataclasses.replace(plans[1], payload=RECORD)
-    files = write_rapid(data, tmp_path).files
-    text = files[0].read_text()
+    data = with_payload(plans[1])
+    text = program(data, "rapid", tmp_path)
     assert re.search(r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", text)
     assert "PERS loaddata partLoad := [2,[10,0,5],[1,0,0,0],0,0,0];" in text
-    assert text.index("GripLoad partLoad;") < text.index("MoveAbsJ")
+    assert text.index("GripLoad partLoad;") < text.index("MoveAbsJ jHome")
     rapidchecker = pytest.importorskip("rapidchecker.cli")
     assert [str(e) for e in rapidchecker.check_file(text)] == []
 
 
 def test_urscript_payload(plans, tmp_path):
-    data = dataclasses.replace(plans[2], payload=RECORD)
-    text = write_urscript(data, tmp_path).file.read_text()
+    data = with_payload(plans[2])
+    text = program(data, "urscript", tmp_path)
     m = re.search(r"^  set_payload\(([\d.]+), \[(.*)\]\)$", text, re.M)
     mass, p_EC = expected_total(data)
     assert float(m.group(1)) == pytest.approx(mass)
     np.testing.assert_allclose([float(v) for v in m.group(2).split(",")], p_EC, atol=1e-4)
-    assert text.index("set_payload") < text.index("movej")
+    assert text.index("set_payload(") < text.index("  movej(")
 
 
-def test_without_payload_every_header_and_the_report_warn(plans, planned_folder, tmp_path):
+def test_without_payload_every_header_and_the_report_warn(plans, planned_job, tmp_path):
     kuka, abb, ur = plans
     texts = [
-        write_krl(kuka, tmp_path / "k").files[0].read_text(),
-        write_rapid(abb, tmp_path / "r").files[0].read_text(),
-        write_urscript(ur, tmp_path / "u").file.read_text(),
+        program(kuka, "krl", tmp_path / "k"),
+        program(abb, "rapid", tmp_path / "r"),
+        program(ur, "urscript", tmp_path / "u"),
     ]
     for text in texts:
         assert "WARNING: PAYLOAD NOT SET" in text
         assert "$LOAD={" not in text and "GripLoad partLoad" not in text
         assert "set_payload(" not in text
-    report = json.loads((planned_folder("seal_plate_kr16")[1] / "report.json").read_text())
+    report = json.loads((planned_job("seal_plate_kr16")[1] / "report.json").read_text())
     assert report["payload"]["set"] is False and "PAYLOAD NOT SET" in report["payload"]["warning"]
     assert list(report).index("payload") < 10  # near the top: prominent
 

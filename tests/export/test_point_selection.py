@@ -1,5 +1,5 @@
 """The batched point selection (export.deviation, density.select_points,
-krl_points.process_points) chooses the same program points, with the same stated
+points.process_points) chooses the same program points, with the same stated
 deviations, as asking one segment at a time did (tests/selection_reference.py,
 the code before it was batched): on the demo job's seams and on seeded random pose
 paths with straight runs, pure reorientations and turns through π."""
@@ -14,7 +14,7 @@ from offline_prog.export.densify import densify
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
 from offline_prog.export.deviation import segment_deviations
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.kuka.krl_points import process_points
+from offline_prog.export.points import PointRule, process_points
 
 from selection_reference import (
     reference_process_points,
@@ -87,7 +87,7 @@ def test_process_points_of_the_demo_seams_are_unchanged(seal_job, style, convent
     for seam in seal_job.seams:
         dense = densify(seam, DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
         tol = dense.selection_tolerances(DEFAULT_CHORD_TOL_M, DEFAULT_ANGLE_TOL_RAD)
-        got = process_points(dense.data, style, *tol, convention)
+        got = process_points(dense.data, PointRule(style, convention), *tol)
         want = reference_process_points(dense.data, style, *tol, convention)
         np.testing.assert_array_equal(got[0], want[0])
         assert got[1] == pytest.approx(want[1], rel=RELATIVE, abs=1e-15)
@@ -97,14 +97,14 @@ def test_process_points_of_the_demo_seams_are_unchanged(seal_job, style, convent
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize(("style", "convention"), STYLES)
 def test_process_points_of_random_paths_are_unchanged(seal_job, seed, style, convention):
-    """A demo seam's record carrying a random path of process frames X_PF (and the
-    flange poses X_BE = X_BT X_PF⁻¹ X_EP⁻¹ that go with them)."""
+    """A demo seam's record carrying a random path of tool frames X_PT (and the flange
+    poses X_BE = X_BT X_PT⁻¹ X_EP⁻¹ that go with them)."""
     rng = np.random.default_rng(seed)
     seam = seal_job.seams[0]
-    X_PF = random_poses(rng, int(rng.integers(50, 700)), turns=float(rng.uniform(0, 2)))
-    X_BE = seam.X_BT @ np.linalg.inv(X_PF) @ np.linalg.inv(seam.X_EP)
-    data = dataclasses.replace(seam, X_PF=X_PF, X_BE=X_BE)
-    got = process_points(data, style, 1e-4, np.deg2rad(0.5), convention)
+    X_PT = random_poses(rng, int(rng.integers(50, 700)), turns=float(rng.uniform(0, 2)))
+    X_BE = seam.X_BT @ np.linalg.inv(X_PT) @ np.linalg.inv(seam.X_EP)
+    data = dataclasses.replace(seam, X_PT=X_PT, X_BE=X_BE)
+    got = process_points(data, PointRule(style, convention), 1e-4, np.deg2rad(0.5))
     want = reference_process_points(data, style, 1e-4, np.deg2rad(0.5), convention)
     np.testing.assert_array_equal(got[0], want[0])
     assert got[1] == pytest.approx(want[1], rel=RELATIVE, abs=1e-15)

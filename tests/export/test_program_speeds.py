@@ -10,15 +10,15 @@ import re
 
 import pytest
 
-from offline_prog.export.abb.rapid import MAX_SPEED_MMS, write_rapid
-from offline_prog.export.kuka.krl import write_krl
+from offline_prog.export.abb.rapid import MAX_SPEED_MMS
+from offline_prog.export.formats import export
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.kuka.kuka import VEL_CP_MAX_M_S
 from offline_prog.export.program import ProgramData
-from offline_prog.export.ur.urscript import MOVEL_MAX_SPEED_M_S, write_urscript
 
 
-def mm_per_s_slip(data: ProgramData) -> ProgramData:
-    """The plan as if its speeds had been given in mm/s: 1000 times too fast."""
+def slipped(data: ProgramData) -> ProgramData:
+    """Rows as if their speeds had been given in mm/s: 1000 times too fast."""
     return dataclasses.replace(
         data,
         process_speed_m_s=data.process_speed_m_s * 1e3,
@@ -27,35 +27,40 @@ def mm_per_s_slip(data: ProgramData) -> ProgramData:
     )
 
 
+def mm_per_s_slip(data: JobProgramData) -> JobProgramData:
+    """The job as if its speeds had been given in mm/s: the job's and each seam's rows."""
+    seams = tuple(slipped(seam) for seam in data.seams)
+    return dataclasses.replace(data, job=slipped(data.job), seams=seams)
+
+
 @pytest.fixture(scope="module")
-def plans(planned_folder):
-    names = ("seal_plate_kr16", "weld_seam_irb2400", "tape_cylinder_ur10e")
-    return [ProgramData.load(planned_folder(name)[1]) for name in names]
+def plans(planned_job):
+    return [
+        JobProgramData.load(planned_job(name)[1]) for name in ("seal_job_kr16", "weld_seam_irb2400")
+    ]
 
 
 def test_written_speeds_are_in_range(plans, tmp_path):
-    kuka, abb, ur = plans
-    krl = write_krl(kuka, tmp_path / "krl").files[0].read_text()
+    kuka, abb = plans
+    krl = "".join(
+        f.read_text() for f in export(kuka, "krl", tmp_path / "krl") if f.suffix == ".src"
+    )
     vel_cp = [float(v) for v in re.findall(r"\$VEL\.CP=([\d.]+)", krl)]
     assert vel_cp and all(0 < v <= VEL_CP_MAX_M_S for v in vel_cp)
-    # In m/s: the fastest written speed is the cell's process speed (within the 0.1 mm/s
+    # In m/s: the fastest written speed is a seam's process speed (within the 0.1 mm/s
     # floor of $VEL.CP), not 1000 times it.
-    assert max(vel_cp) == pytest.approx(kuka.process_speed_m_s, abs=1e-4)
-    rapid = "".join(f.read_text() for f in write_rapid(abb, tmp_path / "rapid").files)
+    fastest = max(seam.process_speed_m_s for seam in kuka.seams)
+    assert max(vel_cp) == pytest.approx(fastest, abs=1e-4)
+    rapid = "".join(f.read_text() for f in export(abb, "rapid", tmp_path / "rapid"))
     speeds = [float(v) for v in re.findall(r"speeddata \w+ := \[([\d.]+),", rapid)]
     assert speeds and all(0 < v <= MAX_SPEED_MMS for v in speeds)
-    assert max(speeds) == pytest.approx(abb.process_speed_m_s * 1e3, abs=0.1)  # mm/s
-    ur_text = write_urscript(ur, tmp_path / "ur", mode="movel").file.read_text()
-    movel = [float(v) for v in re.findall(r"v=([\d.]+), r=", ur_text)]
-    assert movel and all(0 < v <= MOVEL_MAX_SPEED_M_S for v in movel)
+    assert max(speeds) == pytest.approx(abb.seams[0].process_speed_m_s * 1e3, abs=0.1)  # mm/s
 
 
 def test_speeds_beyond_the_controller_are_refused(plans, tmp_path):
-    kuka, abb, ur = (mm_per_s_slip(data) for data in plans)
+    kuka, abb = (mm_per_s_slip(data) for data in plans)
     with pytest.raises(ValueError, match=r"m/s, not mm/s"):
-        write_krl(kuka, tmp_path / "krl")
+        export(kuka, "krl", tmp_path / "krl")
     with pytest.raises(ValueError, match=r"m/s, not mm/s"):
-        write_rapid(abb, tmp_path / "rapid")
-    with pytest.raises(ValueError, match=r"m/s, not mm/s"):
-        write_urscript(ur, tmp_path / "ur", mode="movel")
-    assert not any(p.is_file() for p in tmp_path.rglob("*"))
+        export(abb, "rapid", tmp_path / "rapid")
+    assert not any(p.is_file() for p in tmp_path.rglob("*") if p.suffix in (".src", ".mod"))

@@ -1,6 +1,7 @@
 """ABB RAPID export read back by an independent parser and compared with the plan:
 targets, the controller's stationary-tool composition, joint values, confdata, the
-chordal rule, splitting, the failed-plan warning and an external syntax checker."""
+chordal rule, speeds, the failed-plan warning, the options a RAPID module takes and an
+external syntax checker."""
 
 import ast
 import dataclasses
@@ -13,8 +14,11 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.spatial.transform import Rotation, Slerp
 
-from offline_prog.export.abb.rapid import confdata, write_rapid
-from offline_prog.export.program import ProgramData
+from offline_prog.export.abb.abb import confdata
+from offline_prog.export.formats import export
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.points import PointRule
+from offline_prog.export.record import program_record
 from offline_prog.robot.model import ROBOTS_DIR, load_robot
 
 POSITION_TOL_MM, ANGLE_TOL_DEG, JOINT_TOL_DEG = 0.01, 0.01, 0.001
@@ -56,7 +60,7 @@ def parse_rapid(files) -> Program:
 
     def run(name):
         for statement in procs[name]:
-            if (call := statement.rstrip(";")) in procs:
+            if (call := statement.split(";")[0]) in procs:
                 yield from run(call)
             elif m := MOVE.match(statement):
                 yield m.groups()
@@ -120,31 +124,42 @@ def drake_cfx(q: np.ndarray) -> int:
 
 
 @pytest.fixture(scope="module")
-def data(planned_folder):
-    return ProgramData.load(planned_folder("weld_seam_irb2400")[1])
+def data(planned_job):
+    """The weld demo (a one-seam job)."""
+    return JobProgramData.load(planned_job("weld_seam_irb2400")[1])
 
 
 @pytest.fixture(scope="module")
 def written(data, tmp_path_factory):
-    """With the legacy approach (``approach_m``): every process point is a MoveL; the
-    points and speeds do not depend on it (the default: test_start_joint_target...)."""
-    result = write_rapid(data, tmp_path_factory.mktemp("rapid"), approach_m=0.02)
-    return result, parse_rapid(result.files)
+    files = export(data, "rapid", tmp_path_factory.mktemp("rapid"))
+    return files, parse_rapid(files)
 
 
-def process_moves(program: Program) -> list:
-    """The MoveL to each process point p0000.. in execution order."""
-    return [m for m in program.moves if m[0] == "MoveL" and re.fullmatch(r"p\d+", m[1])]
+def record_points(data):
+    """The seam's points as the program record holds them: (densified data, indices)."""
+    (run,) = program_record(data, PointRule("external_tcp", "X_PF")).runs()
+    return run.process.data, run.process.indices
+
+
+def seam_moves(program: Program) -> list:
+    """The moves to the seam's points in execution order: the approach's end (its first
+    point), then the seam's own."""
+    names = [m[1] for m in program.moves]
+    first = names.index("pA1")
+    return [program.moves[first]] + [
+        m for m in program.moves[first + 1 :] if re.fullmatch(r"seam_1_\d+", m[1])
+    ]
 
 
 def test_targets_round_trip_to_the_plan(data, written):
-    result, program = written
-    moves = process_moves(program)
-    assert [m[1] for m in moves] == [f"p{i:04d}" for i in range(result.n_points)]
+    _, program = written
+    moves = seam_moves(program)
+    seam, indices = record_points(data)
+    assert [m[1] for m in moves] == ["pA1"] + [f"seam_1_{k}" for k in range(1, len(indices))]
     targets = [program.data[m[1]] for m in moves]
     assert all(kind == "robtarget" for kind, _ in targets)
     X_PT = np.array([pose_matrix(value[:2]) for _, value in targets])
-    distance, angle = pose_errors(X_PT, data.X_PF[result.indices])
+    distance, angle = pose_errors(X_PT, seam.X_PT[indices])
     assert distance.max() <= POSITION_TOL_MM and angle.max() <= ANGLE_TOL_DEG
     quaternions = np.array([value[1] for _, value in targets])
     np.testing.assert_allclose(np.linalg.norm(quaternions, axis=1), 1.0, atol=1e-6)
@@ -153,62 +168,53 @@ def test_targets_round_trip_to_the_plan(data, written):
     # Stationary tool and robot-held work object on every move.
     tool, wobj = {m[4] for m in program.moves}, {m[5] for m in program.moves}
     assert tool == {"tool_welding_torch"} and wobj == {"wobj_bracket"}
+    # Exact stops where the approach ends and at the seam's end, the zone between.
     assert [m[3] for m in moves][0 :: len(moves) - 1] == ["fine", "fine"]
     assert {m[3] for m in moves[1:-1]} == {"zPath"}
 
 
 def test_controller_composition_gives_the_planned_flange(data, written):
     """X_BE = tframe · robtarget⁻¹ · oframe⁻¹ · uframe⁻¹ (stationary tool, world = B)."""
-    result, program = written
+    _, program = written
     kind, tool = program.data["tool_welding_torch"]
     assert kind == "tooldata" and tool[0] is False and tool[2][0] > 0  # robhold, mass
     kind, wobj = program.data["wobj_bracket"]
     assert kind == "wobjdata" and wobj[:3] == [True, True, ""]
     X_WT, X_EU, X_UO = pose_matrix(tool[1]), pose_matrix(wobj[3]), pose_matrix(wobj[4])
-    X_OT = np.array([pose_matrix(program.data[m[1]][1][:2]) for m in process_moves(program)])
+    X_OT = np.array([pose_matrix(program.data[m[1]][1][:2]) for m in seam_moves(program)])
     X_WE = X_WT @ np.linalg.inv(X_OT) @ np.linalg.inv(X_UO) @ np.linalg.inv(X_EU)
-    distance, angle = pose_errors(X_WE, data.X_BE[result.indices])
+    seam, indices = record_points(data)
+    distance, angle = pose_errors(X_WE, seam.X_BE[indices])
     assert distance.max() <= POSITION_TOL_MM and angle.max() <= ANGLE_TOL_DEG
 
 
-def test_start_joint_target_is_the_planned_start(data, tmp_path):
-    """By default no approach or retract of the writer's own: MoveAbsJ to the plan's
-    first joints, the process points, and nothing after the last one."""
-    program = parse_rapid(write_rapid(data, tmp_path).files)
-    assert program.moves[-1][1] == f"p{len(process_moves(program)):04d}"
-    assert program.moves[0][:2] == ("MoveAbsJ", "jStart")
-    kind, (axes, extax) = program.data["jStart"]
-    assert kind == "jointtarget" and extax == [9e9] * 6
-    np.testing.assert_allclose(np.rad2deg(urdf_q(axes)), np.rad2deg(data.q[0]), atol=JOINT_TOL_DEG)
-    assert axes[2] == pytest.approx(np.rad2deg(data.q[0, 1] + data.q[0, 2]), abs=JOINT_TOL_DEG)
-
-
-def test_approach_and_retract_back_off_along_the_tool_axis(data, tmp_path):
-    """Only when asked (approach_m): by default the program moves only as planned."""
-    program = parse_rapid(write_rapid(data, tmp_path, approach_m=0.02).files)
+def test_joint_targets_are_the_planned_joints(data, written):
+    """MoveAbsJ home first (axis 3 = q2 + q3: the J2/J3 linkage), then the links'
+    waypoints; Drake's forward kinematics of the last one before the approach is the
+    flange where the approach starts."""
+    _, program = written
+    joint_moves = [m for m in program.moves if m[0] == "MoveAbsJ"]
+    assert joint_moves[0][1] == "jHome"
+    axes = [program.data[m[1]][1][0] for m in joint_moves]
+    assert all(program.data[m[1]][1][1] == [9e9] * 6 for m in joint_moves)
+    planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
+    np.testing.assert_allclose(urdf_q(axes), planned, atol=np.deg2rad(JOINT_TOL_DEG))
+    assert axes[0][2] == pytest.approx(np.rad2deg(planned[0][1] + planned[0][2]), abs=1e-3)
     names = [m[1] for m in program.moves]
-    assert names[:2] == ["jApproach", "p0000"] and names[-1] == "pRetract"
-    X_EP_inv, approach_m = np.linalg.inv(data.X_EP), 0.02
-    # Approach: Drake FK of the jointtarget = flange with the tool 20 mm off the surface.
-    q_app = urdf_q(program.data["jApproach"][1][0])
-    X_PT = data.X_PF[0].copy()
-    X_PT[:3, 3] -= approach_m * X_PT[:3, 1]
-    (X_BE,) = drake_frames(q_app, [("base_link", "tool0")])
-    distance, angle = pose_errors(X_BE[None], (data.X_BT @ np.linalg.inv(X_PT) @ X_EP_inv)[None])
+    before = program.moves[names.index("pA1") - 1][1]
+    (X_BE,) = drake_frames(urdf_q(program.data[before][1][0]), [("base_link", "tool0")])
+    approach = next(s for s in data.segments if s.kind == "approach")
+    distance, angle = pose_errors(X_BE[None], data.job.X_BE[approach.start][None])
     assert distance.max() <= POSITION_TOL_MM and angle.max() <= ANGLE_TOL_DEG
-    assert np.abs(q_app - data.q[0]).max() < np.deg2rad(10.0)  # same branch as the start
-    # Retract: a robtarget 20 mm off the last process point, along -y of F.
-    p_ret = np.asarray(program.data["pRetract"][1][0]) * 1e-3
-    expected = data.X_PF[-1, :3, 3] - approach_m * data.X_PF[-1, :3, 1]
-    assert np.linalg.norm(p_ret - expected) * 1e3 <= POSITION_TOL_MM
 
 
 def test_confdata_quadrants_and_cfx(data, written):
-    result, program = written
-    conf = np.array([program.data[m[1]][1][2] for m in process_moves(program)])
-    axes = np.rad2deg(data.q[result.indices][:, [0, 3, 5]])
+    _, program = written
+    conf = np.array([program.data[m[1]][1][2] for m in seam_moves(program)])
+    seam, indices = record_points(data)
+    axes = np.rad2deg(seam.q[indices][:, [0, 3, 5]])
     assert np.all((90.0 * conf[:, :3] <= axes) & (axes < 90.0 * (conf[:, :3] + 1)))
-    assert [drake_cfx(q) for q in data.q[result.indices]] == list(conf[:, 3])
+    assert [drake_cfx(q) for q in seam.q[indices]] == list(conf[:, 3])
     # Seeded property loop over the joint ranges: all eight cfx values occur.
     robot, rng = load_robot("abb_irb2400"), np.random.default_rng(0)
     q = rng.uniform(robot.q_lower, robot.q_upper, size=(400, 6))
@@ -218,12 +224,13 @@ def test_confdata_quadrants_and_cfx(data, written):
 
 
 def test_chordal_rule_holds_for_the_written_points(data, written):
-    result, program = written
-    X = np.array([pose_matrix(program.data[m[1]][1][:2]) for m in process_moves(program)])
+    _, program = written
+    X = np.array([pose_matrix(program.data[m[1]][1][:2]) for m in seam_moves(program)])
+    seam, indices = record_points(data)
     chord_tol, angle_tol = 0.05e-3 + ROUNDING_M, np.deg2rad(0.1) + 1e-5
-    for k, (a, b) in enumerate(zip(result.indices[:-1], result.indices[1:], strict=True)):
+    for k, (a, b) in enumerate(zip(indices[:-1], indices[1:], strict=True)):
         p0, p1 = X[k, :3, 3], X[k + 1, :3, 3]
-        dense = data.X_PF[a : b + 1]
+        dense = seam.X_PT[a : b + 1]
         lam = np.clip((dense[:, :3, 3] - p0) @ (p1 - p0) / np.sum((p1 - p0) ** 2), 0.0, 1.0)
         distance = np.linalg.norm(dense[:, :3, 3] - (p0 + lam[:, None] * (p1 - p0)), axis=1)
         slerp = Slerp([0.0, 1.0], Rotation.from_matrix(X[k : k + 2, :3, :3]))
@@ -232,50 +239,27 @@ def test_chordal_rule_holds_for_the_written_points(data, written):
 
 
 def test_speeds_follow_the_planned_timing(data, written):
-    result, program = written
-    moves = process_moves(program)
+    _, program = written
+    moves = seam_moves(program)
+    seam, indices = record_points(data)
     speeds = np.array([program.data[m[2]][1][0] for m in moves[1:]])  # mm/s
-    assert np.all(speeds > 0) and speeds.max() <= data.process_speed_m_s * 1e3 + 0.05
+    assert np.all(speeds > 0) and speeds.max() <= seam.process_speed_m_s * 1e3 + 0.05
     p = np.array([program.data[m[1]][1][0] for m in moves])
     duration = np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1) / speeds)
-    span = data.t[result.indices[-1]] - data.t[result.indices[0]]
+    span = seam.t[indices[-1]] - seam.t[indices[0]]
     assert duration == pytest.approx(span, rel=0.02)
-
-
-def test_split_at_a_small_line_limit_keeps_every_point_in_order(data, tmp_path, written):
-    options = dict(chord_tol_m=0.01e-3, angle_tol_rad=np.deg2rad(0.02))
-    whole = parse_rapid(write_rapid(data, tmp_path / "whole", **options).files)
-    result = write_rapid(data, tmp_path / "split", line_limit=60, **options)
-    modules = [f for f in result.files if f.suffix == ".mod"]
-    assert len(modules) >= 4 and all(f.read_text().count("\n") <= 60 for f in modules)
-    pgf = result.files[-1].read_text()
-    assert re.findall(r"<Module>(.+?)</Module>", pgf) == [f.name for f in modules]
-    split = parse_rapid(result.files)
-    # MoveAbsJ to the first point (no approach of the writer's own), MoveL to the rest.
-    assert split.moves == whole.moves and len(process_moves(split)) == result.n_points - 1
-    for m in process_moves(split):
-        assert split.data[m[1]] == whole.data[m[1]]
-    with pytest.raises(ValueError, match="line_limit"):
-        write_rapid(data, tmp_path / "tiny", line_limit=8, **options)
 
 
 def test_forced_export_of_a_failed_plan_warns_in_the_header(data, tmp_path):
     failure = "joint_5 at its limit at σ = 0.120 m (≥ 120°)"
-    failed = dataclasses.replace(data, feasible=False, failure=failure, tool="Düse 1")
-    result = write_rapid(failed, tmp_path, forced=True)
-    text = result.files[0].read_text()
+    rows = dataclasses.replace(data.job, feasible=False, failure=failure, tool="Düse 1")
+    files = export(dataclasses.replace(data, job=rows), "rapid", tmp_path, force=True)
+    text = files[0].read_text()
     header = text.splitlines()[1:20]
     assert any("WARNING: EXPORTED WITH --force FROM A FAILED PLAN" in line for line in header)
     assert any("sigma = 0.120 m (>= 120 deg)" in line for line in header)
     assert text.isascii() and all(line.startswith("  !") for line in header[:5])
-    assert "tool_Duse_1" in parse_rapid(result.files).data
-
-
-def test_unreachable_approach_starts_at_the_first_point(data, tmp_path):
-    result = write_rapid(data, tmp_path, approach_m=3.0)  # 3 m off the part: out of reach
-    program = parse_rapid(result.files)
-    assert [m[1] for m in program.moves[:2]] == ["jStart", "p0001"]
-    assert "pRetract" not in program.data and "OUT OF REACH" in program.texts[0]
+    assert "tool_Duse_1" in parse_rapid(files).data
 
 
 def test_bad_arguments_are_named(data, tmp_path):
@@ -283,24 +267,24 @@ def test_bad_arguments_are_named(data, tmp_path):
         ({"module": "1bad"}, "module"),
         ({"module": "x" * 40}, "module"),
         ({"zone_mm": -1.0}, "zone_mm"),
-        ({"line_limit": 8}, "line_limit"),
+        ({"line_limit": 80}, "line_limit"),
+        ({"chord_tol_m": -1.0}, "chord_tol_m"),
     ]:
         with pytest.raises(ValueError, match=name):
-            write_rapid(data, tmp_path, **kwargs)
+            export(data, "rapid", tmp_path, **kwargs)
     # A plan made before plans carried their robot record looks the robot up by name.
-    old_plan = dataclasses.replace(data, robot="abb_unknown", robot_record=None)
+    rows = dataclasses.replace(data.job, robot="abb_unknown", robot_record=None)
     with pytest.raises(ValueError, match="no robot folder named 'abb_unknown'"):
-        write_rapid(old_plan, tmp_path)
+        export(dataclasses.replace(data, job=rows), "rapid", tmp_path)
 
 
 @pytest.mark.filterwarnings("ignore::DeprecationWarning")  # rapidchecker's pyparsing calls
 @pytest.mark.slow
-def test_output_passes_rapidchecker(written, tmp_path, data):
+def test_output_passes_rapidchecker(written):
     rapidchecker = pytest.importorskip(
         "rapidchecker.cli", reason="rapidchecker (pip install rapidchecker) not installed"
     )
-    split = write_rapid(data, tmp_path, line_limit=40)
-    for text in written[1].texts + parse_rapid(split.files).texts:
+    for text in written[1].texts:
         assert [str(e) for e in rapidchecker.check_file(text)] == []
-    broken = written[1].texts[0].replace("MoveL p0001, ", "MoveL p0001 ")
+    broken = written[1].texts[0].replace("MoveL seam_1_1, ", "MoveL seam_1_1 ")
     assert rapidchecker.check_file(broken)  # the checker does catch errors

@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 from krl_lint import assert_krllint_clean
 
-from offline_prog.export.abb.rapid import write_rapid
-from offline_prog.export.kuka.krl import write_krl
-from offline_prog.export.program import ProgramData
+from offline_prog.export.formats import export
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.text import (
     RAPID_STRING_MAX,
     identifier,
@@ -18,7 +17,6 @@ from offline_prog.export.text import (
     rapid_string,
     urscript_string,
 )
-from offline_prog.export.ur.urscript import write_urscript
 
 # Each carries a statement after a line break of some kind, and the characters that
 # mean something to one of the languages: quotes, ; (KRL comment), % (RAPID late
@@ -32,17 +30,25 @@ HOSTILE = [
 ]
 
 
-def hostile(data: ProgramData, text: str) -> ProgramData:
-    return dataclasses.replace(
-        data,
+def hostile(data: JobProgramData, text: str) -> JobProgramData:
+    """The job with ``text`` in every name its programs print (a failed plan: the
+    failure is printed too)."""
+    rows = dataclasses.replace(
+        data.job,
         cell_name=text,
         cell_file=f"/tmp/{text}.yaml",
         tool=text,
         part=text,
-        robot=data.robot,
+        feasible=False,
         failure=text,
-        joint_names=tuple(f"{name}{text}" for name in data.joint_names),
+        joint_names=tuple(f"{name}{text}" for name in data.job.joint_names),
     )
+    return dataclasses.replace(data, job=rows)
+
+
+def forced(data: JobProgramData) -> JobProgramData:
+    """The job as a failed plan without a failure text of its own."""
+    return dataclasses.replace(data, job=dataclasses.replace(data.job, feasible=False))
 
 
 def code_lines(text: str, marker: str) -> list[str]:
@@ -83,34 +89,39 @@ def test_identifiers_are_checked_or_derived():
     assert identifier_from("tool", 'x\n"é;%', max_chars=32) == "tool_x__e__"
 
 
-@pytest.fixture(scope="module")
-def kuka(planned_folder):
-    return ProgramData.load(planned_folder("seal_plate_kr16")[1])
+def written(data: JobProgramData, fmt: str, folder) -> list:
+    """The program files of a forced export (the manifest left out)."""
+    return [f for f in export(data, fmt, folder, force=True) if f.suffix != ".json"]
 
 
 @pytest.fixture(scope="module")
-def abb(planned_folder):
-    return ProgramData.load(planned_folder("weld_seam_irb2400")[1])
+def kuka(planned_job):
+    return JobProgramData.load(planned_job("seal_plate_kr16")[1])
 
 
 @pytest.fixture(scope="module")
-def ur(planned_folder):
-    return ProgramData.load(planned_folder("tape_cylinder_ur10e")[1])
+def abb(planned_job):
+    return JobProgramData.load(planned_job("weld_seam_irb2400")[1])
+
+
+@pytest.fixture(scope="module")
+def ur(planned_job):
+    return JobProgramData.load(planned_job("tape_cylinder_ur10e")[1])
 
 
 @pytest.mark.parametrize("text", HOSTILE)
 def test_krl_code_is_unchanged_by_hostile_names(kuka, tmp_path, text):
-    clean = write_krl(kuka, tmp_path / "clean", line_limit=200, forced=True)
-    dirty = write_krl(hostile(kuka, text), tmp_path / "dirty", line_limit=200, forced=True)
-    assert_only_in_comments(dirty.files, ";")
-    for a, b in zip(clean.files, dirty.files, strict=True):
+    clean = written(forced(kuka), "krl", tmp_path / "clean")
+    dirty = written(hostile(kuka, text), "krl", tmp_path / "dirty")
+    assert_only_in_comments(dirty, ";")
+    for a, b in zip(clean, dirty, strict=True):
         assert code_lines(a.read_text(), ";") == code_lines(b.read_text(), ";")
 
 
 @pytest.mark.parametrize("text", HOSTILE)
 def test_rapid_code_is_unchanged_by_hostile_names(abb, tmp_path, text):
-    clean = write_rapid(abb, tmp_path / "clean", forced=True)
-    dirty = write_rapid(hostile(abb, text), tmp_path / "dirty", forced=True)
+    clean = written(forced(abb), "rapid", tmp_path / "clean")
+    dirty = written(hostile(abb, text), "rapid", tmp_path / "dirty")
 
     def names(line):  # tool and wobj identifiers derive from the names: compare the rest
         return re.sub(r"\b(tool|wobj)_\w+", r"\1_", line)
@@ -118,33 +129,33 @@ def test_rapid_code_is_unchanged_by_hostile_names(abb, tmp_path, text):
     def normalized(file):
         return [names(line) for line in code_lines(file.read_text(), "!")]
 
-    assert_only_in_comments(dirty.files, "!", names)
+    assert_only_in_comments(dirty, "!", names)
 
-    for a, b in zip(clean.files, dirty.files, strict=True):
+    for a, b in zip(clean, dirty, strict=True):
         assert normalized(a) == normalized(b)
 
 
-@pytest.mark.parametrize("mode", ["servoj", "movel"])
 @pytest.mark.parametrize("text", HOSTILE)
-def test_urscript_code_is_unchanged_by_hostile_names(ur, tmp_path, text, mode):
-    clean = write_urscript(ur, tmp_path / "clean", mode=mode, forced=True)
-    dirty = write_urscript(hostile(ur, text), tmp_path / "dirty", mode=mode, forced=True)
-    assert_only_in_comments([dirty.file], "#")
-    assert code_lines(clean.file.read_text(), "#") == code_lines(dirty.file.read_text(), "#")
+def test_urscript_code_is_unchanged_by_hostile_names(ur, tmp_path, text):
+    (clean,) = written(forced(ur), "urscript", tmp_path / "clean")
+    (dirty,) = written(hostile(ur, text), "urscript", tmp_path / "dirty")
+    assert_only_in_comments([dirty], "#")
+    assert code_lines(clean.read_text(), "#") == code_lines(dirty.read_text(), "#")
 
 
 def test_program_names_are_identifiers(kuka, abb, ur, tmp_path):
     with pytest.raises(ValueError):
-        write_krl(kuka, tmp_path, name="x\nEND")
+        export(forced(kuka), "krl", tmp_path, force=True, name="x\nEND")
     with pytest.raises(ValueError):
-        write_rapid(abb, tmp_path, module='M"; ENDMODULE')
+        export(forced(abb), "rapid", tmp_path, force=True, module='M"; ENDMODULE')
     with pytest.raises(ValueError):
-        write_urscript(ur, tmp_path, name="x():\n  popup")
+        export(forced(ur), "urscript", tmp_path, force=True, name="x():\n  popup")
     assert not list(tmp_path.iterdir())
 
 
 def test_krllint_accepts_hostile_headers(kuka, tmp_path):
-    write_krl(hostile(kuka, "".join(HOSTILE)), tmp_path / "krl", forced=True)
+    written(hostile(kuka, "".join(HOSTILE)), "krl", tmp_path / "krl")
+    (tmp_path / "krl" / "offline_prog.manifest.json").unlink()
     assert_krllint_clean(tmp_path / "krl", tmp_path)
 
 
@@ -153,7 +164,6 @@ def test_rapidchecker_accepts_hostile_headers(abb, tmp_path):
     rapidchecker = pytest.importorskip(
         "rapidchecker.cli", reason="rapidchecker (pip install rapidchecker) not installed"
     )
-    result = write_rapid(hostile(abb, "".join(HOSTILE)), tmp_path, forced=True, line_limit=60)
-    for file in result.files:
+    for file in written(hostile(abb, "".join(HOSTILE)), "rapid", tmp_path):
         if file.suffix == ".mod":
             assert [str(e) for e in rapidchecker.check_file(file.read_text())] == []

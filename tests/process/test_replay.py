@@ -129,8 +129,9 @@ def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
     and positions (from the program's own poses), replayed at the plan's speed."""
     from export.test_job_io import krl_events, stripe_cell
 
+    from offline_prog.export.formats import controller_post
     from offline_prog.export.job_program import JobProgramData
-    from offline_prog.export.kuka.krl_job import write_krl_job
+    from offline_prog.export.post import write_program
     from offline_prog.plan import plan_job
     from offline_prog.results.job_folder import write_job_outputs
 
@@ -142,7 +143,7 @@ def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
     folder = tmp_path / "plan"
     write_job_outputs(job, folder)
     data = JobProgramData.load(folder)
-    write_krl_job(data, tmp_path / "krl")
+    write_program(controller_post(data, "krl"), tmp_path / "krl")
     src = (tmp_path / "krl" / "offline_prog.src").read_text()
     m = re.search(
         r"ANOUT ON \$ANOUT\[1\]=(\w+)\*\$VEL_ACT\+([-\d.]+) DELAY=([-\d.]+) "

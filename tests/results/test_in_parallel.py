@@ -15,10 +15,10 @@ def test_a_child_error_is_raised_in_the_parent_as_it_was():
         job.wait()
 
 
-def test_a_child_that_works_returns_nothing(tmp_path):
+def test_a_child_that_works_returns_its_result(tmp_path):
     target = tmp_path / "written.txt"
-    job = InParallel(lambda: target.write_text("drawn"))
-    assert job.wait() is None and target.read_text() == "drawn"
+    job = InParallel(lambda: {"drawn": target} if target.write_text("drawn") else None)
+    assert job.wait() == {"drawn": target} and target.read_text() == "drawn"
 
 
 def test_cancel_stops_the_child_before_its_folder_goes(tmp_path):

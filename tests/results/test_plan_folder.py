@@ -1,4 +1,5 @@
-"""The plan folder is replaced whole: no stale files, no mixtures, our files only."""
+"""The plan folder is replaced whole: no stale files, no mixtures, our files only; its
+files are written from the finished plan, without computing its poses again."""
 
 import errno
 import os
@@ -11,9 +12,9 @@ from offline_prog import atomic
 from offline_prog.atomic import MANIFEST, read_manifest, remove_stale, write_atomic
 from offline_prog.errors import InputError
 from offline_prog.export.formats import export
-from offline_prog.export.program import ProgramData
-from offline_prog.results import plan_folder
-from offline_prog.results.plan_folder import write_outputs
+from offline_prog.export.job_program import JobProgramData
+from offline_prog.results import job_folder
+from offline_prog.results.job_folder import write_job_outputs
 
 from conftest import REPO
 
@@ -26,21 +27,21 @@ def listing(folder):
 
 
 @pytest.fixture(scope="module")
-def kuka(planned_folder):
-    return planned_folder("seal_plate_kr16")
+def kuka(planned_job):
+    return planned_job("seal_plate_kr16")
 
 
 @pytest.fixture(scope="module")
-def abb(planned_folder):
-    return planned_folder("weld_seam_irb2400")
+def abb(planned_job):
+    return planned_job("weld_seam_irb2400")
 
 
 @pytest.mark.slow
 def test_replanning_another_cell_leaves_only_its_files(kuka, abb, tmp_path):
     out = tmp_path / "out"
-    write_outputs(kuka[0], out)
+    write_job_outputs(kuka[0], out)
     assert (out / "programs" / "offline_prog.src").is_file()
-    files, _ = write_outputs(abb[0], out)
+    files, _ = write_job_outputs(abb[0], out)
     names = set(listing(out))
     assert not any(name.endswith((".src", ".dat")) for name in names)
     assert {str(p.relative_to(out)) for p in files.values()} <= names
@@ -51,30 +52,30 @@ def test_replanning_another_cell_leaves_only_its_files(kuka, abb, tmp_path):
 @pytest.mark.slow
 def test_a_crash_mid_write_leaves_the_previous_folder(kuka, abb, tmp_path, monkeypatch):
     out = tmp_path / "out"
-    write_outputs(kuka[0], out)
+    write_job_outputs(kuka[0], out)
     before = listing(out)
 
     def crash(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(plan_folder, "write_preview_html", crash)
+    monkeypatch.setattr(job_folder, "write_job_preview_html", crash)
     with pytest.raises(KeyboardInterrupt):
-        write_outputs(abb[0], out)
+        write_job_outputs(abb[0], out)
     assert listing(out) == before
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 
 def test_disk_full_leaves_the_previous_folder(kuka, tmp_path, monkeypatch):
     out = tmp_path / "out"
-    write_outputs(kuka[0], out)
+    write_job_outputs(kuka[0], out)
     before = listing(out)
 
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(out / "report.html"))
 
-    monkeypatch.setattr(plan_folder, "write_report_html", full)
+    monkeypatch.setattr(job_folder, "write_job_report_html", full)
     with pytest.raises(OSError, match="No space"):
-        write_outputs(kuka[0], out)
+        write_job_outputs(kuka[0], out)
     assert listing(out) == before
 
 
@@ -83,27 +84,51 @@ def test_a_folder_with_foreign_files_is_not_replaced(kuka, tmp_path):
     out.mkdir()
     (out / "notes.txt").write_text("mine")
     with pytest.raises(InputError, match="did not write \\(notes.txt\\)"):
-        write_outputs(kuka[0], out)
+        write_job_outputs(kuka[0], out)
     (tmp_path / "file").write_text("x")
     with pytest.raises(InputError, match="not a folder"):
-        write_outputs(kuka[0], tmp_path / "file")
+        write_job_outputs(kuka[0], tmp_path / "file")
     assert (out / "notes.txt").read_text() == "mine"
 
 
-def test_reexport_removes_its_own_stale_parts_only(kuka, tmp_path):
-    data = ProgramData.load(kuka[1])
+def test_reexport_removes_its_own_stale_parts_only(kuka, planned_job, tmp_path):
+    """A job of four seams, then one of one seam into the same folder: the modules of
+    seams 2 to 4 go, the user's file stays."""
     out = tmp_path / "programs"
     out.mkdir()
     (out / "offline_prog_9.src").write_text("a user's file, not in the manifest")
-    split = export(data, "krl", out, line_limit=60)
-    assert len(split) > 4 and (out / "offline_prog_3.src").is_file()
+    four = export(JobProgramData.load(planned_job("seal_job_kr16")[1]), "krl", out)
+    assert len(four) == 10 and (out / "offline_prog_4.src").is_file()
+    data = JobProgramData.load(kuka[1])
     export(data, "csv", out)
-    whole = export(data, "krl", out)
-    assert [p.name for p in whole] == ["offline_prog.src", "offline_prog.dat"]
+    one = export(data, "krl", out)
+    names = ["offline_prog.src", "offline_prog.dat", "offline_prog_1.src", "offline_prog_1.dat"]
+    assert [p.name for p in one] == names
     assert sorted(p.name for p in out.iterdir()) == sorted(
-        ["offline_prog.src", "offline_prog.dat", "joint_trajectory.csv", "offline_prog_9.src"]
-        + [MANIFEST]
+        [*names, "joint_trajectory.csv", "offline_prog_9.src", MANIFEST]
     )
+
+
+def test_the_folders_writers_compute_no_flange_pose_again(kuka, tmp_path, monkeypatch):
+    """trajectory.csv, plan.npz and the programs read the flange poses the plan
+    computed (``JobPlan.X_BE``): with the robot's forward kinematics raising, the
+    folder's files are those of the planned folder."""
+    from offline_prog.robot.model import RobotModel
+
+    job, folder = kuka
+
+    def no_forward(*_):
+        raise AssertionError("a writer computed forward kinematics again")
+
+    monkeypatch.setattr(RobotModel, "forward", no_forward)
+    monkeypatch.setattr(job_folder, "BESIDE", (job_folder.trajectory_file,))  # no preview
+    monkeypatch.setattr(job_folder, "LAST", ())
+    files, _ = write_job_outputs(job, tmp_path / "out")
+    assert (tmp_path / "out" / "trajectory.csv").read_text() == (
+        folder / "trajectory.csv"
+    ).read_text()
+    assert {"trajectory", "report", "collisions", "job", "plan"} <= set(files)
+    assert any(key.startswith("krl:") for key in files)
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
@@ -162,16 +187,13 @@ def test_staged_folder_swaps_with_or_without_renameat2(tmp_path, monkeypatch, ex
     assert [p.name for p in (tmp_path / "d").iterdir()] == ["new"]
 
 
-@pytest.mark.parametrize("kind", ["seam", "job"])
-def test_report_html_names_the_plan_folder_not_the_staged_one(planned_folder, planned_job, kind):
+@pytest.mark.parametrize("name", ["seal_plate_kr16", "seal_job_kr16"])
+def test_report_html_names_the_plan_folder_not_the_staged_one(planned_job, name):
     """The page is rendered in the staged ``.offline_prog-<pid>-...`` sibling; it names
     the folder the user opens."""
     from offline_prog.atomic import TEMP_PREFIX
 
-    if kind == "seam":
-        _, folder = planned_folder("seal_plate_kr16")
-    else:
-        _, folder = planned_job("seal_job_kr16")
+    _, folder = planned_job(name)
     page = (folder / "report.html").read_text()
     assert f"; plan folder {folder.name}</p>" in page
     assert TEMP_PREFIX not in page

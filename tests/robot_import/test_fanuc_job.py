@@ -20,8 +20,9 @@ from hypothesis import strategies as st
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
 
 from offline_prog.config.cell import load_cell
-from offline_prog.export.fanuc.fanuc_job import write_fanuc_job
+from offline_prog.export.formats import controller_post
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.post import write_program
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
@@ -42,6 +43,11 @@ START_P, END_P = np.array([-0.120, 0.080, 0.0]), np.array([0.120, 0.080, 0.0])
 LENGTH_M = float(np.linalg.norm(END_P - START_P))  # 240 mm
 ON_LEAD_MM, OFF_LEAD_MM, PER_MPS, OFFSET_V, LAG_S = -100.0, 2.0, 40.0, 0.5, 0.1
 SPEED_M_S = 0.15
+
+
+def write_fanuc_job(data: JobProgramData, folder: Path) -> list[Path]:
+    """The FANUC writer's files of the job in folder."""
+    return write_program(controller_post(data, "fanuc"), folder)
 
 
 def _m20ia(work: Path) -> None:
@@ -128,7 +134,7 @@ def _walk(data, folder, robot):
     tool's path on the part from the seam's start, from the program's own poses."""
     X_PE, p_BT = np.linalg.inv(data.job.X_EP), data.job.X_BT[:3, 3]
     here, cumulative, ao, seams = None, 0.0, None, []
-    starts = [seam.X_PF[0, :3, 3] for seam in data.seams]  # the seams' planned starts
+    starts = [seam.X_PT[0, :3, 3] for seam in data.seams]  # the seams' planned starts
     for statement, entry in _run(folder):
         if entry is None:
             assert statement.startswith("AO["), statement  # no plain DO statements

@@ -13,6 +13,8 @@ import pytest
 from offline_prog.atomic import write_atomic
 from offline_prog.plan import plan_cell
 from offline_prog.results import plan_folder as outputs
+from offline_prog.results.program_data import seam_program_data
+from offline_prog.results.report import report
 from offline_prog.viz.report_html import REPORT_FILE, render_report_html, write_report_html
 from offline_prog.viz.report_summary import lookup
 
@@ -58,10 +60,10 @@ def make_plan_folder(cell_file, out):
     """A plan folder as `offline-prog plan` writes it (report, CSV, plan.npz), plus
     one stand-in program file: the exporters are tested on their own."""
     plan = plan_cell(cell_file)
-    summary = outputs.report(plan)
+    summary = report(plan)
     write_atomic(out / "trajectory.csv", outputs.trajectory_csv(plan))
     write_atomic(out / "report.json", json.dumps(summary, indent=2) + "\n")
-    outputs.program_data(plan, summary).save(out)
+    seam_program_data(plan, summary).save(out)
     write_atomic(out / "programs" / "stand_in.src", "; program\n")
     return out
 

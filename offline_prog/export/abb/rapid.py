@@ -1,4 +1,5 @@
-"""ABB RAPID: the robot carries the part past a stationary tool (remote TCP).
+"""ABB RAPID: a job as one module ``<module>.mod`` (+ ``.pgf``); the robot carries the
+part past a stationary tool (remote TCP).
 
 Controller model (RAPID Technical Reference Manual, 3HAC050917: ``tooldata``,
 ``wobjdata``, ``robtarget``, ``confdata``; MultiMove manual 3HAC021272 §6.3):
@@ -11,11 +12,28 @@ Controller model (RAPID Technical Reference Manual, 3HAC050917: ``tooldata``,
   at ``X_WE = tframe · robtarget⁻¹ · oframe⁻¹ · uframe⁻¹``.
 
 Here W = B (world = robot base frame), tframe = X_BT, uframe = X_EP, oframe = I and
-robtarget_i = X_PF(i), so the composition is the plan's X_BE = X_BT · X_PF⁻¹ · X_EP⁻¹.
-E, the URDF ``tool0``, is ABB's tool0 (z out of the flange, x down at the calibration
-position). Axis values are the URDF q, except axis 3 = q2 + q3 on robots with a J2/J3
-parallel linkage (ROS-I ``abb_driver`` ``linkage_transform``, ``J23_coupled``).
-Units at this edge: mm, degrees, quaternions ``[q1, q2, q3, q4] = [w, x, y, z]``.
+robtarget_i = X_PT(i) (the process frame on the seam), so the composition is the plan's
+X_BE = X_BT · X_PT⁻¹ · X_EP⁻¹. E, the URDF ``tool0``, is ABB's tool0 (z out of the
+flange, x down at the calibration position). Axis values: ``abb.abb_axes_deg``. Units
+at this edge: mm, degrees, quaternions ``[q1, q2, q3, q4] = [w, x, y, z]``.
+
+``main``: ``MoveAbsJ`` home; per seam the link (``MoveAbsJ`` through its jointtargets,
+fine points: the planned, collision-checked joint moves), the approach (``TriggL`` to
+the seam's first point), the seam (``PROC seam_<k>``: ``MoveL`` / ``TriggL`` through its
+points at each segment's planned mean TCP speed, zone ``zPath``), the retract
+(``MoveL``/``TriggL``); home at the end.
+
+Process I/O on the path from the plan's I/O events (RAPID Instructions, 3HAC050917:
+``TriggIO``, ``TriggL``, ``TriggSpeed``): ``TriggIO t, d \\DOp:=do<n>, 1`` then
+``TriggL p, v, t, z, tool`` sets the output d mm before the move's end point (distance
+from the end, no ``\\Start``); a move holds every event that falls on it (``\\T2``,
+``\\T3``, ...). The flow follows the TCP speed only while the output is on:
+``TriggSpeed tFlowOn, d, lag, ao<n>, k`` at the on switch's position with k = per_mps /
+1000 (the logical value of ``ao<n>`` = k · v_TCP [mm/s], i.e. volts per mm/s) and
+``TriggSpeed tFlowOff, d, lag, ao<n>, 0`` at the off switch's; ScaleLag = the cell's
+``flow.lag_s`` (the dispenser's lag). The offset and limits belong to the signal's
+scaling in the I/O configuration (the header says which): logical 0 is the idle value,
+the offset. Signals are named ``do<n>`` / ``ao<n>``.
 """
 
 from __future__ import annotations
@@ -28,20 +46,15 @@ from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.abb.abb import abb_axes_deg, confdata
-from offline_prog.export.densify import densify
-from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M, select_points
-from offline_prog.export.header import header_lines
 from offline_prog.export.payload import payload
+from offline_prog.export.points import PointRule
+from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.program import ProgramData
-from offline_prog.export.text import identifier, identifier_from, rapid_comment
-from offline_prog.robot.model import RobotModel
+from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
+from offline_prog.export.text import identifier_from, rapid_comment
+from offline_prog.io_events import Signal
 
-# Approach / retract along -y of F (y = pressing direction n): none by default, so the
-# program moves only as planned (MoveAbsJ to the plan's first joints); a whole job's
-# program (rapid_job) has the planned approach and retract.
-DEFAULT_APPROACH_M = 0.0
-START_SPEED = "v100"  # predefined speeddata (BASE module) for MoveAbsJ
-APPROACH_SPEED = "v20"  # predefined speeddata for the linear approach and retract
+LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the controller's)
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
 MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
@@ -52,25 +65,184 @@ EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
 NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
-_PART_OVERHEAD = 6  # MODULE, comment, zone, PROC, ENDPROC, ENDMODULE
+MODULE_NAME_MAX = NAME_MAX - 6  # the module's name (room for a suffix)
+# The triggdata of each kind of event; a second one of a kind on the same move gets a
+# number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
+TRIGGERS = {
+    (Signal.DIGITAL, True): "tOn",
+    (Signal.DIGITAL, False): "tOff",
+    (Signal.ANALOG, True): "tFlowOn",
+    (Signal.ANALOG, False): "tFlowOff",
+}
 
 
 @dataclasses.dataclass(frozen=True)
-class RapidResult:
-    """Files written (modules in load order, then the .pgf program file), the dense
-    plan sample behind each process robtarget, and the achieved LIN deviations."""
+class RapidOptions(PointOptions):
+    """module: the module's name; zone_mm: the corner zone of the seams' moves [mm]."""
 
-    files: tuple[Path, ...]
-    n_points: int
-    indices: np.ndarray
-    max_chord_m: float
-    max_angle_rad: float
+    module: str = "OfflineProg"
+    zone_mm: float = 0.3
+
+
+class RapidPost(CartesianPost):
+    """The RAPID module of a job (see the module docstring)."""
+
+    FORMAT = "rapid"
+    Options = RapidOptions
+    NAME_OPTION = "module"
+    NAME_MAX = MODULE_NAME_MAX
+
+    def __init__(self, job, options: RapidOptions, *, forced: bool = False):
+        super().__init__(job, options, forced=forced)
+        if not options.zone_mm >= 0:
+            raise ValueError(f"zone_mm={options.zone_mm}: need a zone >= 0 mm")
+        rows = job.job
+        tool = identifier_from("tool", rows.tool, max_chars=NAME_MAX)
+        wobj = identifier_from("wobj", rows.part, max_chars=NAME_MAX)
+        self.tool, self.wobj, self.tail = tool, wobj, f", {tool}\\WObj:={wobj};"
+        self.decls: list[str] = []
+        self.main: list[str] = []
+        self.procs: dict[str, list[str]] = {}
+        self.speeds: set[str] = set()  # speeddata declared
+        self.triggdata: set[str] = set()  # declared once the moves are written
+        self.on_move: list[str] = []  # the triggers of the move being written
+
+    def point_rule(self) -> PointRule:
+        o = self.options
+        return PointRule("external_tcp", "X_PF", o.chord_tol_m, o.angle_tol_rad)
+
+    def conventions(self, record: ProgramRecord) -> list[str]:
+        io, names = record.job.process_io, record.job.seam_names
+        lines = [
+            f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            "Units: mm, deg; quaternions [w,x,y,z]. World = robot base. Stationary tool: "
+            "tframe = tool in world; robot-held wobj: uframe = part in tool0; robtarget = tool "
+            "on the part.",
+            "Axes: URDF joints"
+            + (", axis 3 = q2 + q3 (J2/J3 linkage)" if self.robot.j23_coupled else "")
+            + ".",
+            f"Links: MoveAbsJ to fine points ({LINK_SPEED}); approach, seams, retract: MoveL / "
+            "TriggL at the planned speeds.",
+        ]
+        if io is not None and io.digital_output is not None:
+            lines.append(
+                f"Process output do{io.digital_output}: TriggIO at the plan's switch positions "
+                f"(on {io.on_lead_m * 1e3:g} mm before each seam's start, off "
+                f"{io.off_lead_m * 1e3:g} mm before its end)."
+            )
+        if io is not None and io.analog_output is not None:
+            lines.append(
+                f"Flow ao{io.analog_output}: TriggSpeed while the process output is on, logical "
+                f"value = {io.per_mps / 1000:g} V per mm/s x TCP speed, 0 otherwise (ScaleLag "
+                f"{io.lag_s:g} s: the dispenser's lag); set the signal's I/O configuration to "
+                f"add {io.offset:g} V and limit it to [{io.min:g}, {io.max:g}] V (idle "
+                f"{io.idle:g} V)."
+            )
+        return lines
+
+    def header(self, lines: list[str]) -> None:
+        self.head = ["! " + rapid_comment(line) for line in lines]
+
+    def frames(self) -> None:
+        """The stationary tool (its tload: the gripper), the robot-held work object, the
+        part's load (GripLoad) and the seams' zone."""
+        rows, load = self.job.job, payload(self.job.job.payload)
+        gripper = GRIPPER_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
+        self.decls += [
+            f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
+            f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
+        ]
+        if load is not None:
+            self.decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
+        zone = self.options.zone_mm
+        z = _list((zone,) * 3 + (zone / 10, zone, zone / 10), 5)[1:-1]
+        self.decls.append(f"LOCAL CONST zonedata zPath := [FALSE,{z}];")
+        self.main += ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * (load is not None)
+
+    def move_joint(self, move: JointMove) -> None:
+        n = move.number
+        names = ["jHome"] if n == 0 else [f"jL{n}_{w}" for w in range(1, len(move.targets) + 1)]
+        for name, q in zip(names, move.targets, strict=True):
+            axes = abb_axes_deg(q[None], j23_coupled=self.robot.j23_coupled)[0]
+            self.decls.append(
+                f"LOCAL CONST jointtarget {name} := [{_list(axes, DEG_DIGITS)},{EXTAX}];"
+            )
+            self.main.append(f"MoveAbsJ {name}\\NoEOffs, {LINK_SPEED}, fine{self.tail}")
+
+    def move_linear(self, move: LinearMove) -> None:
+        name = f"p{move.kind[0].upper()}{move.number}"
+        self.decls.append(_robtarget(name, move.X_PT, confdata(self.robot, move.q[None])[0]))
+        speed = self._speed(move.speed_m_s * 1e3)
+        triggers = self._triggers(move.switches, self.main)
+        self.main.append(_move(name, speed, triggers, "fine", self.tail))
+
+    def set_output(self, switch: Switch) -> str:
+        event = switch.event
+        name, distance = self._trigger_name(switch), _num(switch.before_end_m * 1e3, 3)
+        return f"TriggIO {name}, {distance}\\DOp:=do{event.output}, {int(event.state)};"
+
+    def follow_speed(self, switch: Switch) -> str:
+        io, event = self.job.process_io, switch.event
+        name, distance = self._trigger_name(switch), _num(switch.before_end_m * 1e3, 3)
+        k = _num(io.per_mps / 1000.0, 6) if event.state else "0"
+        return f"TriggSpeed {name}, {distance}, {_num(io.lag_s, 3)}, ao{event.output}, {k};"
+
+    def call_part(self, process: Process) -> None:
+        """``PROC seam_<k>``: the seam's moves; its first point is the approach's end."""
+        proc, data, idx = f"seam_{process.number}", process.data, process.indices
+        conf, speeds = confdata(self.robot, data.q[idx]), segment_speeds_mms(data, idx)
+        lines = self.procs.setdefault(proc, [])
+        for m in range(1, len(idx)):
+            name = f"{proc}_{m}"
+            self.decls.append(_robtarget(name, data.X_PT[idx[m]], conf[m]))
+            zone = "fine" if m == len(idx) - 1 or self.options.zone_mm == 0 else "zPath"
+            triggers = self._triggers(process.switches_before(m), lines)
+            lines.append(_move(name, self._speed(speeds[m - 1]), triggers, zone, self.tail))
+        self.main.append(f"{proc};  ! seam {process.seam}")
+
+    def footer(self, out_dir: Path) -> list[Path]:
+        module = self.options.module
+        decls = self.decls + [f"VAR triggdata {name};" for name in sorted(self.triggdata)]
+        text = _module_text(module, self.head + decls, {"main": self.main, **self.procs})
+        files = [out_dir / f"{module}.mod", out_dir / f"{module}.pgf"]
+        write_atomic(files[0], text)
+        listing = f"<Program>\n  <Module>{files[0].name}</Module>\n</Program>\n"
+        write_atomic(files[1], PGF_HEAD + listing)
+        return files
+
+    def _speed(self, v_mms: float) -> str:
+        """The speeddata of v_tcp [mm/s] (``v<mm/s>_<tenth>``), declared at first use."""
+        name = f"v{int(round(v_mms * 10)) // 10}_{int(round(v_mms * 10)) % 10}"
+        if name not in self.speeds:
+            self.speeds.add(name)
+            self.decls.append(f"LOCAL CONST speeddata {name} := [{_num(v_mms, 1)},{SPEED_REST}];")
+        return name
+
+    def _triggers(self, switches, lines: list[str]) -> list[str]:
+        """Define the triggers of one move's I/O events in ``lines``; their names in
+        path order."""
+        self.on_move = []
+        lines += [self.switch(s) for s in switches]
+        self.triggdata.update(self.on_move)
+        return self.on_move
+
+    def _trigger_name(self, switch: Switch) -> str:
+        """The triggdata of an event on the move being written: ``tOn``, or ``tOn2`` for
+        the second of its kind on the move, ..."""
+        base = TRIGGERS[switch.event.signal, switch.event.state]
+        count = sum(name.rstrip("0123456789") == base for name in self.on_move)
+        self.on_move.append(base + (str(count + 1) if count else ""))
+        return self.on_move[-1]
 
 
 def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
     """(n-1,) planned TCP speed on each LIN segment [mm/s]: the time mean of
     ``data.tcp_speed`` between its end samples (= planned length / duration), so the
-    program keeps the planned timing; rounded to 0.1 mm/s, at least 0.1 mm/s."""
+    program keeps the planned timing; rounded to 0.1 mm/s, at least 0.1 mm/s.
+
+    Raises:
+        ValueError: a speed beyond MAX_SPEED_MMS (a unit slip: the plan's speeds are m/s).
+    """
     v, t = data.tcp_speed, data.t
     mean = [
         np.trapezoid(v[a : b + 1], t[a : b + 1]) / (t[b] - t[a]) if t[b] > t[a] else v[b]
@@ -79,28 +251,17 @@ def segment_speeds_mms(data: ProgramData, indices: np.ndarray) -> np.ndarray:
     speeds = np.maximum(np.round(np.asarray(mean) * 1e4) / 10.0, MIN_SPEED_MMS)
     if not np.all(speeds <= MAX_SPEED_MMS):  # NaN too
         raise ValueError(
-            f"write_rapid: v_tcp {np.nanmax(speeds):g} mm/s is beyond {MAX_SPEED_MMS:g} mm/s "
+            f"rapid: v_tcp {np.nanmax(speeds):g} mm/s is beyond {MAX_SPEED_MMS:g} mm/s "
             "(the plan's speeds are m/s, not mm/s)"
         )
     return speeds
 
 
-def approach_and_retract(robot: RobotModel, data: ProgramData, distance_m: float):
-    """[(X_PT, q) at the approach, (X_PT, q) at the retract], or None if out of reach:
-    the first / last process frame moved distance_m along -y of F (y of F = n, the
-    pressing direction) so that the tool is off the surface, with the IK solution (6,)
-    [rad] within the plan's limits nearest the plan's first / last joints."""
-    poses, X_EP_inv = [], np.linalg.inv(data.X_EP)
-    for k in (0, -1):
-        X_PT = data.X_PF[k].copy()
-        X_PT[:3, 3] -= distance_m * X_PT[:3, 1]
-        q = robot.inverse((data.X_BT @ np.linalg.inv(X_PT) @ X_EP_inv)[None])[0]
-        q += 2.0 * np.pi * np.round((data.q[k] - q) / (2.0 * np.pi))  # the nearest turn
-        ok = np.all(np.isfinite(q) & (q >= data.q_lower) & (q <= data.q_upper), axis=1)
-        if not ok.any():
-            return None
-        poses.append((X_PT, q[ok][np.argmin(np.abs(q[ok] - data.q[k]).max(axis=1))]))
-    return poses
+def _move(target: str, speed: str, triggers: list[str], zone: str, tail: str) -> str:
+    if not triggers:
+        return f"MoveL {target}, {speed}, {zone}{tail}"
+    extra = "".join(f" \\T{k + 2}:={t}" for k, t in enumerate(triggers[1:]))
+    return f"TriggL {target}, {speed}, {triggers[0]}{extra}, {zone}{tail}"
 
 
 def _num(x: float, digits: int) -> str:
@@ -135,159 +296,3 @@ def _module_text(name: str, body: list[str], procs: dict[str, list[str]]) -> str
     for proc, statements in procs.items():
         lines += [f"  PROC {proc}()"] + ["    " + s for s in statements] + ["  ENDPROC"]
     return "\n".join(lines + ["ENDMODULE"]) + "\n"
-
-
-def _parts(speeds: np.ndarray, line_limit: int) -> list[range]:
-    """Process points 1..n-1 in order, cut so that each part module fits line_limit."""
-    parts, begin, used = [], 1, set()
-    for i in range(1, len(speeds) + 1):
-        used = used | {speeds[i - 1]}
-        if i > begin and _PART_OVERHEAD + len(used) + 2 * (i - begin + 1) > line_limit:
-            parts.append(range(begin, i))
-            begin, used = i, {speeds[i - 1]}
-    return parts + [range(begin, len(speeds) + 1)]
-
-
-def write_rapid(
-    data: ProgramData,
-    out_dir: Path,
-    *,
-    module: str = "OfflineProg",
-    chord_tol_m: float = DEFAULT_CHORD_TOL_M,
-    angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
-    line_limit: int = 5000,
-    zone_mm: float = 0.3,
-    approach_m: float = DEFAULT_APPROACH_M,
-    j23_coupled: bool | None = None,
-    forced: bool = False,
-) -> RapidResult:
-    r"""Write ``<module>.mod`` (and ``<module>_<k>.mod`` parts, called in order from
-    main, when one module would exceed line_limit) and ``<module>.pgf`` that loads them.
-
-    Program: ConfJ/ConfL on; MoveAbsJ to the approach pose (first process frame backed
-    off by approach_m; IK nearest the plan's start); MoveL to the first process point
-    (fine); one MoveL per point chosen by ``select_points`` on X_PF, at the segment's
-    planned TCP speed (speeddata ``v<mm/s>_<tenth>``), zone ``zPath`` (z0 proportions,
-    zone_mm), fine at the end; MoveL to the retract pose. All with ``tool\WObj:=wobj``.
-
-    Args:
-        data: the plan, of an OPW robot in robots/.
-        out_dir: folder for the files.
-        module: RAPID module name (letter first, then letters, digits, _).
-        chord_tol_m, angle_tol_rad: LIN deviation allowed from the dense X_PF [m, rad].
-        line_limit: most lines in one module file.
-        zone_mm: corner zone of the process moves [mm] (0: fine everywhere).
-        approach_m: approach / retract distance off the surface [m] (0 or out of reach: none).
-        j23_coupled: the controller's axis 3 is q2 + q3 (None: from the robot's record).
-        forced: the plan failed and is exported anyway (the header says so).
-
-    Raises:
-        ValueError: naming the bad argument.
-    """
-    identifier(module, max_chars=NAME_MAX - 6, what="module")
-    if not (chord_tol_m > 0 and angle_tol_rad > 0 and zone_mm >= 0 and approach_m >= 0):
-        raise ValueError("need chord_tol_m > 0, angle_tol_rad > 0, zone_mm >= 0, approach_m >= 0")
-    robot = data.load_robot()
-    # Controller axis 3 = q2 + q3 where robot.yaml says so (the IRB 2400's J2/J3 linkage).
-    j23 = robot.j23_coupled if j23_coupled is None else j23_coupled
-    if robot.family != "opw":
-        raise ValueError(f"data.robot={data.robot!r}: RAPID export needs an OPW (ABB) robot")
-    dense = densify(data, chord_tol_m, angle_tol_rad)
-    data = dense.data
-    chord_sel, angle_sel = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
-    p_PF, R_PF = data.X_PF[:, :3, 3], data.X_PF[:, :3, :3]
-    sel = select_points(p_PF, R_PF, chord_tol_m=chord_sel, angle_tol_rad=angle_sel)
-    idx, n = sel.indices, len(sel.indices)
-    max_chord, max_angle = dense.bound(sel.max_chord_m, sel.max_angle_rad)
-    conf, speeds = confdata(robot, data.q[idx]), segment_speeds_mms(data, idx)
-    tool = identifier_from("tool", data.tool, max_chars=NAME_MAX)
-    wobj = identifier_from("wobj", data.part, max_chars=NAME_MAX)
-    tail = f", {tool}\\WObj:={wobj};"
-    names = [f"p{i:0{max(4, len(str(n - 1)))}d}" for i in range(n)]
-    z = _list((zone_mm,) * 3 + (zone_mm / 10, zone_mm, zone_mm / 10), 5)[1:-1]
-    zone_decl = [f"LOCAL CONST zonedata zPath := [FALSE,{z}];"] * (zone_mm > 0)
-    vname = {v: f"v{int(round(v * 10)) // 10}_{int(round(v * 10)) % 10}" for v in speeds}
-
-    def part(points: range) -> tuple[list[str], list[str]]:
-        """Declarations and moves of process points, each reached from the one before."""
-        used = sorted({speeds[i - 1] for i in points})
-        decls = [f"LOCAL CONST speeddata {vname[v]} := [{_num(v, 1)},{SPEED_REST}];" for v in used]
-        decls += zone_decl + [_robtarget(names[i], data.X_PF[idx[i]], conf[i]) for i in points]
-        zone = ["zPath", "fine"]
-        return decls, [
-            f"MoveL {names[i]}, {vname[speeds[i - 1]]}, {zone[i == n - 1 or zone_mm == 0]}{tail}"
-            for i in points
-        ]
-
-    # Loads (RAPID TRM loaddata: a stationary tool's tload is the gripper, cog in tool0;
-    # GripLoad's cog is in the object frame of the robot-held wobj, here P).
-    load = payload(data.payload)
-    gripper_load, grip = GRIPPER_LOAD, []
-    if load is not None:
-        gripper_load = _load(load.gripper_mass_kg, load.p_EG)
-        grip = [f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};"]
-    # Start (MoveAbsJ, then the linear approach) and retract.
-    head = [
-        f"PERS tooldata {tool} := [FALSE,{_pose(data.X_BT)},{gripper_load}];",
-        f'PERS wobjdata {wobj} := [TRUE,TRUE,"",{_pose(data.X_EP)},[[0,0,0],[1,0,0,0]]];',
-        _robtarget(names[0], data.X_PF[idx[0]], conf[0]),
-    ]
-    off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
-    (_, q_start), (X_PT_ret, q_ret) = off or [(None, data.q[0]), (None, None)]
-    first = ["ConfJ \\On;", "ConfL \\On;"] + ["GripLoad partLoad;"] * bool(grip)
-    last = []  # the part stays gripped after the program: its load stays set
-    head += grip
-    if off:  # else: out of reach or not wanted, so start at the first process point
-        head.append(_robtarget("pRetract", X_PT_ret, confdata(robot, q_ret[None])[0]))
-        last.append(f"MoveL pRetract, {APPROACH_SPEED}, fine{tail}")
-    start = "jApproach" if off else "jStart"
-    axes = _list(abb_axes_deg(q_start[None], j23_coupled=j23)[0], DEG_DIGITS)
-    head.append(f"LOCAL CONST jointtarget {start} := [{axes},{EXTAX}];")
-    first.append(f"MoveAbsJ {start}\\NoEOffs, {START_SPEED}, fine{tail}")
-    first += [f"MoveL {names[0]}, {APPROACH_SPEED}, fine{tail}"] * bool(off)
-    approach = f"{approach_m * 1e3:g} mm along -y of F" if off else "none"
-
-    conventions = [
-        "Units: mm, deg; quaternions [q1,q2,q3,q4] = [w,x,y,z], q1 >= 0. World = robot base.",
-        "Stationary tool: tframe = tool in world; robot-held wobj: uframe = part in tool0,",
-        "  oframe = I; robtarget = tool on the part; flange = tframe * rt^-1 * uframe^-1.",
-        "Axes: URDF joints" + (", axis 3 = q2 + q3 (J2/J3 linkage)" if j23 else "") + "; conf: "
-        "cf1/4/6 = floor(axis/90 deg), cfx = RAPID confdata table.",
-        f"Points: {n} of {len(data.t)} samples, LIN deviation <= {max_chord * 1e3:.4f} mm, "
-        f"{np.rad2deg(max_angle):.4f} deg ({dense.basis}); v_tcp = planned mean on each segment.",
-        f"Approach/retract: {approach}"
-        + (" (OUT OF REACH)" if approach_m and not off else "")
-        + ", not collision-checked. "
-        + (
-            "tload = gripper, GripLoad partLoad = part (see Payload above)."
-            if load
-            else "tload: PLACEHOLDER 5 kg gripper, no GripLoad (PAYLOAD NOT SET)."
-        ),
-    ]
-    header = header_lines(data, conventions=conventions, forced=forced)
-    head = ["! " + rapid_comment(line) for line in header] + head
-
-    decls, moves = part(range(1, n))
-    texts = {module: _module_text(module, head + decls, {"main": first + moves + last})}
-    if texts[module].count("\n") > line_limit:
-        parts = _parts(speeds, line_limit)
-        procs = [f"{module}_seg{k}" for k in range(1, len(parts) + 1)]
-        if line_limit < _PART_OVERHEAD + 3 or len(procs[-1]) > NAME_MAX:
-            raise ValueError(f"line_limit={line_limit}: too small to split module {module!r}")
-        calls = [proc + ";" for proc in procs]
-        texts = {module: _module_text(module, head, {"main": first + calls + last})}
-        for k, (points, proc) in enumerate(zip(parts, procs, strict=True), start=1):
-            decls, moves = part(points)
-            note = f"! Part {k} of {module}: process points {points[0]}..{points[-1]}."
-            texts[f"{module}_{k}"] = _module_text(f"{module}_{k}", [note] + decls, {proc: moves})
-        if (size := texts[module].count("\n")) > line_limit:
-            raise ValueError(f"line_limit={line_limit}: the main module alone needs {size} lines")
-    assert all(text.count("\n") <= line_limit for text in texts.values())
-
-    files = [Path(out_dir) / f"{name}.mod" for name in texts]
-    for file, text in zip(files, texts.values(), strict=True):
-        write_atomic(file, text)
-    listing = "".join(f"  <Module>{file.name}</Module>\n" for file in files)
-    files.append(Path(out_dir) / f"{module}.pgf")
-    write_atomic(files[-1], f"{PGF_HEAD}<Program>\n{listing}</Program>\n")
-    return RapidResult(tuple(files), n, idx, max_chord, max_angle)

@@ -1,4 +1,5 @@
-"""FANUC conventions: controller axes, configuration strings, W-P-R, LS position text.
+"""FANUC conventions: controller axes, configuration strings, W-P-R, and LS text (the
+program file, its /POS entries and TP remarks).
 
 Sources and assumptions (the LS program writer, :mod:`offline_prog.export.fanuc.fanuc_ls`,
 states them in each program's header):
@@ -22,9 +23,12 @@ states them in each program's header):
 
 from __future__ import annotations
 
+import datetime
+
 import numpy as np
 from pydrake.math import RollPitchYaw, RotationMatrix
 
+from offline_prog.export.text import fanuc_comments
 from offline_prog.robot.model import RobotModel
 
 MM_DIGITS, DEG_DIGITS = 3, 4  # 0.5 µm, 0.00005°
@@ -93,4 +97,30 @@ def joint_pos(index: int, axes_deg: np.ndarray, *, uf: int, ut: int) -> str:
         f"P[{index}]{{\n   GP1:\n\tUF : {uf}, UT : {ut},\n"
         f"\tJ1= {j[0]} deg,\tJ2= {j[1]} deg,\tJ3= {j[2]} deg,\n"
         f"\tJ4= {j[3]} deg,\tJ5= {j[4]} deg,\tJ6= {j[5]} deg\n}};"
+    )
+
+
+def ls_text(name: str, statements: list[str], positions: list[str], comment: str) -> str:
+    """A whole LS file: numbered /MN lines (statements without the closing `` ;``) and
+    the /POS entries."""
+    mn = "".join(f"{k:4d}:{s} ;\n" for k, s in enumerate(statements, start=1))
+    pos = "\n".join(positions)
+    return _attr(name, len(statements), comment) + f"/MN\n{mn}/POS\n{pos}\n/END\n"
+
+
+def remarks(lines: list[str]) -> list[str]:
+    """TP remark statements (``! text``, at most 32 characters each) for header lines."""
+    return [f"  ! {piece}" for line in lines for piece in fanuc_comments(line)]
+
+
+def _attr(name: str, lines: int, comment: str) -> str:
+    now = datetime.datetime.now(datetime.UTC)
+    stamp = f"DATE {now:%y-%m-%d}  TIME {now:%H:%M:%S}"
+    return (
+        f'/PROG  {name}\n/ATTR\nOWNER\t\t= MNEDITOR;\nCOMMENT\t\t= "{comment[:16]}";\n'
+        f"PROG_SIZE\t= 0;\nCREATE\t\t= {stamp};\nMODIFIED\t= {stamp};\nFILE_NAME\t= ;\n"
+        f"VERSION\t\t= 0;\nLINE_COUNT\t= {lines};\nMEMORY_SIZE\t= 0;\nPROTECT\t\t= READ_WRITE;\n"
+        "TCD:  STACK_SIZE\t= 0,\n      TASK_PRIORITY\t= 50,\n      TIME_SLICE\t= 0,\n"
+        "      BUSY_LAMP_OFF\t= 0,\n      ABORT_REQUEST\t= 0,\n      PAUSE_REQUEST\t= 0;\n"
+        "DEFAULT_GROUP\t= 1,*,*,*,*;\nCONTROL_CODE\t= 00000000 00000000;\n"
     )

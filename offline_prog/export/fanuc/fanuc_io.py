@@ -41,13 +41,13 @@ class Samples:
     """A seam's planned samples from its approach's start to its retract's end.
 
     Attributes:
-        sigma: (K,) path position [m], non-decreasing.
+        path_m: (K,) path position [m], non-decreasing.
         t: (K,) job time [s].
         q: (K, 6) URDF joints [rad].
         X_BP: (K, 4, 4) the part P in the robot base B.
     """
 
-    sigma: np.ndarray
+    path_m: np.ndarray
     t: np.ndarray
     q: np.ndarray
     X_BP: np.ndarray
@@ -57,13 +57,15 @@ class Samples:
 class Motion:
     """One ``L`` motion from sample ``start`` to sample ``end`` (indices into Samples):
     ``event`` the digital event it switches (None: none) ``before_end_m`` [m] before
-    its end; ``flow`` the value [V] of the flow output while it runs (None: no flow)."""
+    its end; ``flow`` the value [V] of the flow output while it runs (None: no flow);
+    ``flow_event`` the analog event at its start (None: none)."""
 
     start: int
     end: int
     event: IoEvent | None = None
     before_end_m: float = 0.0
     flow: float | None = None
+    flow_event: IoEvent | None = None
 
 
 def place_events(
@@ -94,9 +96,10 @@ def place_events(
             no ``L`` point can separate them (names the seam and both positions).
     """
     points = sorted(set(points))
-    sigma = samples.sigma
+    sigma = samples.path_m
     analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
-    edges = [(sigma[_split(sigma, points, e.set_path_m)], e.state) for e in analog]
+    split = [(_split(sigma, points, e.set_path_m), e) for e in analog]  # (L point, event)
+    edges = [(sigma[i], e.state) for i, e in split]
     digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.path_m)
     while (pair := _crowded(sigma, points, digital)) is not None:
         first, second = pair
@@ -120,9 +123,8 @@ def place_events(
         a, b = points[i - 1], points[i]
         event = on_motion.get(i)
         before = 0.0 if event is None else float(min(sigma[b] - event.path_m, sigma[b] - sigma[a]))
-        motions.append(
-            Motion(a, b, event, max(before, 0.0), _flow(samples, a, b, edges, io, flow_at))
-        )
+        flow = _flow(samples, a, b, edges, io, flow_at)
+        motions.append(Motion(a, b, event, max(before, 0.0), flow, dict(split).get(a)))
     return motions
 
 
@@ -130,7 +132,7 @@ def _live(samples: Samples, a: int, edges) -> bool:
     """Whether the flow is live on the motion from sample a (the edges before it)."""
     live = False
     for position, state in edges:
-        if position <= samples.sigma[a] + SAME_POINT_M:
+        if position <= samples.path_m[a] + SAME_POINT_M:
             live = state
     return live
 
@@ -155,7 +157,7 @@ def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[in
             start = 0
             for k in range(1, len(values)):
                 span = values[start : k + 1]
-                moved = samples.sigma[a + k - 1] - samples.sigma[out[-1]] > SAME_POINT_M
+                moved = samples.path_m[a + k - 1] - samples.path_m[out[-1]] > SAME_POINT_M
                 step = min(FLOW_STEP_V, FLOW_STEP_SHARE * span.max())
                 if span.max() - span.min() > step and k - 1 > start and moved:
                     start = k - 1  # no L motion of zero length: at rest the flow waits

@@ -1,89 +1,290 @@
-"""FANUC TP programs as LS text (``/PROG … /ATTR … /MN … /POS … /END``) for one seam.
+"""FANUC TP programs of a job as LS text (``/PROG … /ATTR … /MN … /POS … /END``).
 
-Form: **flange-style, dense point list** (KRL's ``flange`` style, ``export.kuka.krl_points``).
-FANUC sells a Remote TCP option for a robot that carries the part past a fixed tool, but
-this writer has no FANUC document at hand to cite for its instructions, so it does not
-use it (the issue's rule: cite the source or write the flange form and say so). The
-tool frame is the part: UTOOL[1] = X_EP (P in the faceplate = URDF tool0, z out of the
-flange), and every position is the part frame X_BP = X_BE · X_EP in a user frame equal
-to the URDF base_link (UFRAME[1] = 0, 0, -c1, 0, 0, 0 in FANUC's world, see
-export.fanuc.fanuc). The controller interpolates P linearly between the points while the
-tool stays fixed, so the points are split until the tool's curve on the part also stays
-within the chord and angle tolerances (``process_points(style="flange")`` after
-``densify``). Speeds are each segment's planned mean speed of P's origin [mm/sec];
-CNT100 between process points, FINE at the ends. By default the program moves only as
-planned: ``J`` (joint represented) to the plan's first joints, then the ``L`` points.
-With ``approach_m`` > 0, as the RAPID writer's option: ``J`` to the approach pose,
-``approach_m`` off the surface along -y of F, ``L`` onto the first point and ``L`` back
-off after the last (moves the plan did not check). This writer serves one-seam plan
-folders written before every cell became a job (``fanuc_job`` writes every new plan).
-Each program holds at most
-``line_limit`` /MN lines; longer ones call sub-programs ``NAME_2 …``.
+Form: **flange-style, dense point list**. FANUC sells a Remote TCP option for a robot
+that carries the part past a fixed tool, but this writer has no FANUC document at hand
+to cite for its instructions, so it does not use it (the issue's rule: cite the source
+or write the flange form and say so). The tool frame is the part: UTOOL[1] = X_EP (P in
+the faceplate = URDF tool0, z out of the flange), and every position is the part frame
+X_BP = X_BE · X_EP in a user frame equal to the URDF base_link (UFRAME[1] = 0, 0, -c1,
+0, 0, 0 in FANUC's world, see export.fanuc.fanuc). The controller interpolates P
+linearly between the points while the tool stays fixed, so the points are split until
+the tool's curve on the part also stays within the chord and angle tolerances
+(``PointRule("flange")``). Speeds are each segment's planned mean speed of P's origin
+[mm/sec]; CNT100 between points, FINE at the ends of each move.
+
+``<name>.ls``: ``J`` home; per seam the link (``J`` through its joint-represented
+points, FINE: the planned, collision-checked joint moves) and ``CALL <name>_S<k>``: the
+approach (``L`` to the seam's first point), the seam's ``L`` moves and the retract
+(``L``), in its own program so that no program grows with the job; home at the end (the
+last link). Every ``L`` point is a planned sample. A seam's moves beyond ``line_limit``
+lines go to ``<name>_S<k>_<j>``, called in turn.
+
+Process I/O, translated from the plan's I/O events (``io_events``), placed by
+:mod:`offline_prog.export.fanuc.fanuc_io`:
+
+- the digital output: FANUC's distance-before motion option on the motion whose end the
+  event precedes, ``L P[i] ... DB d mm,DO[n]=ON`` (the output is set when the TCP comes
+  within d of the destination: on these straight ``L`` moves, d before the end along the
+  path). A motion takes one DB option: where two switches fall on one motion it is
+  split at a planned sample between them.
+- the flow: plain ``AO[n]=value`` statements before the motion they hold for; the value
+  takes effect when the statement runs, as that motion starts (a motion starts at each
+  flow edge: the planned sample nearest it is an ``L`` point). While the output is on
+  (from the plan's flow-live event to its flow-idle event, both ``lag_s`` ahead of the
+  output's switches, since FANUC does not lead by the dispenser's lag itself) each
+  motion's value is the plan's flow (offset + per_mps · v, clipped, at the speed the
+  tool has ``lag_s`` later) within ``fanuc_io.FLOW_STEP_V`` / 2 (a planned sample
+  starts a new motion where the speed changes more); otherwise ``AO[n]`` is the idle
+  value (``ProcessIo.idle``), set once at the program's start.
+A time-before trigger (``TB t sec,...``) is not used: the events are distances.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import datetime
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.abb.rapid import approach_and_retract
-from offline_prog.export.densify import densify
-from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
+from offline_prog.errors import InputError
 from offline_prog.export.fanuc.fanuc import (
     cartesian_pos,
     config_strings,
     fanuc_axes_deg,
     joint_pos,
+    ls_text,
+    remarks,
     wpr_deg,
 )
-from offline_prog.export.header import header_lines
-from offline_prog.export.kuka.krl_points import process_points
+from offline_prog.export.fanuc.fanuc_io import Samples, place_events
 from offline_prog.export.payload import payload
-from offline_prog.export.program import ProgramData
-from offline_prog.export.text import fanuc_comments, identifier
+from offline_prog.export.points import PointRule
+from offline_prog.export.post import ControllerPost, PointOptions
+from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
 
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
 DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
-JOINT_SPEED_PCT = 20  # J moves to the start
-APPROACH_SPEED_MMS = 20  # L moves onto and off the surface
+JOINT_SPEED_PCT = 20  # J moves of the links
 MAX_SPEED_MMS = 2000  # FANUC L moves take at most 2000 mm/sec
 UF, UT = 1, 1
 
 
 @dataclasses.dataclass(frozen=True)
-class FanucResult:
-    """Files written (main program first), the (densified) plan rows behind each process
-    point, and the bounds on the tool's deviation on the part [m, rad]."""
+class FanucOptions(PointOptions):
+    """name: the main program; line_limit: most /MN lines of one program (≥ 8)."""
 
-    files: tuple[Path, ...]
-    indices: np.ndarray
-    max_chord_m: float
-    max_angle_rad: float
+    name: str = "OFFLINE_PROG"
+    line_limit: int = DEFAULT_LINE_LIMIT
 
 
-def _attr(name: str, lines: int, comment: str) -> str:
-    now = datetime.datetime.now(datetime.UTC)
-    stamp = f"DATE {now:%y-%m-%d}  TIME {now:%H:%M:%S}"
-    return (
-        f'/PROG  {name}\n/ATTR\nOWNER\t\t= MNEDITOR;\nCOMMENT\t\t= "{comment[:16]}";\n'
-        f"PROG_SIZE\t= 0;\nCREATE\t\t= {stamp};\nMODIFIED\t= {stamp};\nFILE_NAME\t= ;\n"
-        f"VERSION\t\t= 0;\nLINE_COUNT\t= {lines};\nMEMORY_SIZE\t= 0;\nPROTECT\t\t= READ_WRITE;\n"
-        "TCD:  STACK_SIZE\t= 0,\n      TASK_PRIORITY\t= 50,\n      TIME_SLICE\t= 0,\n"
-        "      BUSY_LAMP_OFF\t= 0,\n      ABORT_REQUEST\t= 0,\n      PAUSE_REQUEST\t= 0;\n"
-        "DEFAULT_GROUP\t= 1,*,*,*,*;\nCONTROL_CODE\t= 00000000 00000000;\n"
+class _Program:
+    """One LS program being written: statements and its own /POS entries."""
+
+    def __init__(self, name: str):
+        self.name, self.lines, self.positions = (
+            name,
+            [f"  UFRAME_NUM={UF}", f"  UTOOL_NUM={UT}"],
+            [],
+        )
+
+    def joint(self, robot, q: np.ndarray) -> None:
+        k = len(self.positions) + 1
+        self.positions.append(joint_pos(k, fanuc_axes_deg(robot, q[None])[0], uf=UF, ut=UT))
+        self.lines.append(f"J P[{k}] {JOINT_SPEED_PCT}% FINE")
+
+    def add(self, items: list) -> None:
+        """Statements: a str as it is, or ((X_BP, config), rest) for ``L P[k] rest``."""
+        for item in items:
+            if isinstance(item, str):
+                self.lines.append(item)
+                continue
+            (X_BP, config), rest = item
+            k = len(self.positions) + 1
+            self.positions.append(cartesian_pos(k, X_BP, config, uf=UF, ut=UT))
+            self.lines.append(f"L P[{k}] {rest}")
+
+    def text(self) -> str:
+        return ls_text(self.name, self.lines, self.positions, "offline_prog")
+
+
+class FanucPost(ControllerPost):
+    """The LS programs of a job (see the module docstring)."""
+
+    FORMAT = "fanuc"
+    Options = FanucOptions
+    NAME_MAX = NAME_MAX - 8
+
+    def __init__(self, job, options: FanucOptions, *, forced: bool = False):
+        super().__init__(job, options, forced=forced)
+        if options.line_limit < 8:
+            raise ValueError(f"line_limit={options.line_limit}: need at least 8 lines per program")
+        self.main, self.seams = _Program(options.name), []
+
+    def point_rule(self) -> PointRule:
+        return PointRule("flange", "X_TP", self.options.chord_tol_m, self.options.angle_tol_rad)
+
+    def conventions(self, record: ProgramRecord) -> list[str]:
+        io, rows, names = record.job.process_io, record.job.job, record.job.seam_names
+        lines = [
+            f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            *frame_conventions(self.robot, rows.X_EP),
+            f"Links: J to joint positions, {JOINT_SPEED_PCT}%, FINE; approach, seams, retract: "
+            "L at the planned speeds of P.",
+        ]
+        if io is not None and io.digital_output is not None:
+            lines.append(
+                f"Process output DO[{io.digital_output}]: DB (distance before), on "
+                f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
+                f"{io.off_lead_m * 1e3:g} mm before its end; one DB per motion (split at "
+                "planned samples)."
+            )
+        if io is not None and io.analog_output is not None:
+            lines.append(
+                f"Flow AO[{io.analog_output}] = {io.offset:g} + {io.per_mps:g} x TCP speed "
+                f"[m/s], in [{io.min:g}, {io.max:g}] while DO is on, {io.idle:g} otherwise; AO "
+                f"statements take effect as the next motion starts, {io.lag_s:g} s ahead."
+            )
+        return lines + payload_conventions(rows)
+
+    def header(self, lines: list[str]) -> None:
+        self.main.lines += remarks(lines)
+
+    def frames(self) -> None:
+        """UFRAME/UTOOL (in every program's head), the payload schedule, the flow idle."""
+        io = self.job.process_io
+        self.main.lines.append("  PAYLOAD[1]")
+        if io is not None and io.analog_output is not None:  # idle until a seam's output
+            self.main.lines.append(self.ao_statement(io.idle))
+
+    def move_joint(self, move: JointMove) -> None:
+        for q in move.targets:
+            self.main.joint(self.robot, q)
+
+    def seam(self, run: SeamRun) -> None:
+        """``CALL`` the seam's program(s): its approach, points and retract as ``L``
+        motions with the I/O on them (``fanuc_io``)."""
+        chain = _Chain(self, run)
+        parts = self._parts(f"{self.options.name}_S{run.number}", chain.lines)
+        self.seams += parts
+        self.main.add([f"  CALL {part.name}" for part in parts])
+
+    def set_output(self, switch: Switch) -> str:
+        """FANUC's distance-before option on the motion the switch is on."""
+        state = "ON" if switch.event.state else "OFF"
+        return f" DB {switch.before_end_m * 1e3:.1f}mm,DO[{switch.event.output}]={state}"
+
+    def follow_speed(self, switch: Switch) -> str:
+        """The flow's value from the motion the statement precedes on (FANUC has no
+        speed-following output: the plan's flow values are written as the tool moves)."""
+        return self.ao_statement(switch.event.value)
+
+    def footer(self, out_dir: Path) -> list[Path]:
+        limit = self.options.line_limit
+        if len(self.main.lines) > limit:
+            raise ValueError(
+                f"line_limit={limit}: the main program alone needs {len(self.main.lines)} lines"
+            )
+        files = []
+        for program in [self.main, *self.seams]:
+            files.append(out_dir / f"{program.name}.ls")
+            write_atomic(files[-1], program.text())
+        return files
+
+    def ao_statement(self, value_v: float) -> str:
+        """``AO[n]=value`` of the flow output [V]."""
+        return f"  AO[{self.job.process_io.analog_output}]={value_v:.3f}"
+
+    def _parts(self, name: str, lines: list) -> list[_Program]:
+        """The seam's statements in programs of at most line_limit lines (``name``, or
+        ``name_1``, ``name_2`` ... called in turn)."""
+        parts = [_Program(name)]
+        for line in lines:
+            if len(parts[-1].lines) + 2 > self.options.line_limit:  # an AO and its move
+                parts.append(_Program(f"{name}_{len(parts) + 1}"))
+            parts[-1].add([line])
+        if len(parts) > 1:
+            parts[0].name = f"{name}_1"
+        return parts
+
+
+class _Chain:
+    """A seam's ``L`` motions (approach, seam, retract) with its I/O events on them, as
+    ``_Program.add`` items in ``lines``."""
+
+    def __init__(self, post: FanucPost, run: SeamRun):
+        job, io, seam = post.job, post.job.process_io, run.seam
+        samples, points, (n_a, n_p) = _samples(job.job, run)
+        try:
+            motions = place_events(
+                samples, points, list(run.events), seam=seam, io=io, flow_at=_flow_at(job)
+            )
+        except ValueError as error:  # the cell's switch positions: one line, exit 2
+            raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
+        configs = config_strings(post.robot, samples.q)
+        speed = job.seams[job.seam_names.index(seam)].process_speed_m_s  # approach, retract
+        process = [m.end for m in motions if n_a < m.end <= n_p]
+        speeds = dict(
+            zip(
+                process,
+                segment_speeds_mms(samples.t, samples.X_BP, np.array([n_a, *process])),
+                strict=True,
+            )
+        )
+        self.lines: list = []
+        current = None if io is None else io.idle
+        for m in motions:
+            if m.flow is not None and f"{m.flow:.3f}" != f"{current:.3f}":
+                if m.flow_event is None:
+                    self.lines.append(post.ao_statement(m.flow))
+                else:  # the flow's event, at the value the plan's flow has on the motion
+                    event = dataclasses.replace(m.flow_event, value=m.flow)
+                    self.lines.append(post.follow_speed(Switch(0, 0.0, event)))
+                current = m.flow
+            last = m.end in (n_a, n_p, len(samples.path_m) - 1)
+            mms = speeds.get(m.end, max(1, int(round(speed * 1e3))))
+            switch = "" if m.event is None else post.set_output(Switch(0, m.before_end_m, m.event))
+            entry = (samples.X_BP[m.end], configs[m.end])
+            self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
+        if current is not None and f"{current:.3f}" != f"{io.idle:.3f}":
+            self.lines.append(post.ao_statement(io.idle))
+
+
+def _samples(rows, run: SeamRun):
+    """The seam's planned samples from its approach's start (the link's end) to its
+    retract's end: the job's approach rows, the seam's densified samples, the job's
+    retract rows; the L points before splitting; the indices of the seam's first and
+    last sample."""
+    segments = {s.kind: s for s in run.segments}
+    dense, idx = run.process.data, run.process.indices
+    approach, retract = segments.get("approach"), segments.get("retract")
+    a_rows = np.arange(approach.start, approach.stop) if approach else np.arange(0)
+    r_rows = np.arange(0)
+    if retract:
+        r_rows = np.arange(retract.start + 1, min(retract.stop, len(rows.t) - 1) + 1)
+    t0 = rows.t[segments["process"].start] - dense.t[0]
+    path_r = rows.path_m[r_rows].copy()
+    if len(path_r) > 1 and np.isnan(path_r[-1]):  # the retract's end: the next link's row
+        gap = np.linalg.norm(rows.X_PT[r_rows[-1], :3, 3] - rows.X_PT[r_rows[-2], :3, 3])
+        path_r[-1] = path_r[-2] + gap
+    samples = Samples(
+        path_m=np.concatenate([rows.path_m[a_rows], dense.path_m, path_r]),
+        t=np.concatenate([rows.t[a_rows], dense.t + t0, rows.t[r_rows]]),
+        q=np.concatenate([rows.q[a_rows], dense.q, rows.q[r_rows]]),
+        X_BP=np.concatenate([rows.X_BE[a_rows], dense.X_BE, rows.X_BE[r_rows]]) @ rows.X_EP,
     )
+    n_a, n_p = len(a_rows) + int(idx[0]), len(a_rows) + int(idx[-1])
+    points = [0, *(len(a_rows) + idx), len(samples.path_m) - 1]
+    return samples, points, (n_a, n_p)
 
 
-def ls_text(name: str, statements: list[str], positions: list[str], comment: str) -> str:
-    """A whole LS file: numbered /MN lines (statements without the closing `` ;``) and
-    the /POS entries."""
-    mn = "".join(f"{k:4d}:{s} ;\n" for k, s in enumerate(statements, start=1))
-    pos = "\n".join(positions)
-    return _attr(name, len(statements), comment) + f"/MN\n{mn}/POS\n{pos}\n/END\n"
+def _flow_at(job):
+    """The live flow [V] at job times (n,) [s]: the plan's flow at the speed the tool
+    has ``lag_s`` later, as the plan's ``ao`` column holds it while live."""
+    io, t, v = job.process_io, job.job.t, job.job.tcp_speed
+    if io is None or io.analog_output is None:
+        return None
+    return lambda times: io.flow(np.interp(np.asarray(times) + io.lag_s, t, v))
 
 
 def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.ndarray:
@@ -95,100 +296,13 @@ def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.n
     return np.clip(np.round(speeds), 1, MAX_SPEED_MMS).astype(int)
 
 
-def write_fanuc(
-    data: ProgramData,
-    out_dir: Path,
-    *,
-    name: str = "OFFLINE_PROG",
-    chord_tol_m: float = DEFAULT_CHORD_TOL_M,
-    angle_tol_rad: float = DEFAULT_ANGLE_TOL_RAD,
-    line_limit: int = DEFAULT_LINE_LIMIT,
-    approach_m: float = 0.0,
-    forced: bool = False,
-) -> FanucResult:
-    """Write ``<name>.ls`` (and ``<name>_<k>.ls`` sub-programs) for a one-seam plan.
-
-    Args:
-        data: the plan, of an OPW robot.
-        chord_tol_m, angle_tol_rad: the tool's largest deviation on the part [m, rad].
-        line_limit: most /MN lines in one program.
-        approach_m: approach / retract distance off the surface [m] (0, the default, or
-            out of reach: none), as the RAPID writer's: J to the approach, L to the first
-            point, and L back off after the last.
-
-    Raises:
-        ValueError: naming the bad argument.
-    """
-    identifier(name, max_chars=NAME_MAX - 4, what="name")
-    if not (chord_tol_m > 0 and angle_tol_rad > 0 and approach_m >= 0) or line_limit < 8:
-        raise ValueError(
-            "need chord_tol_m > 0, angle_tol_rad > 0, approach_m >= 0 and line_limit >= 8"
-        )
-    robot = data.load_robot()
-    if robot.family != "opw":
-        raise ValueError(f"data.robot={data.robot!r}: FANUC export needs an OPW robot")
-    dense = densify(data, chord_tol_m, angle_tol_rad)
-    data = dense.data
-    tolerances = dense.selection_tolerances(chord_tol_m, angle_tol_rad)
-    idx, chord, angle = process_points(data, "flange", *tolerances)
-    max_chord, max_angle = dense.bound(chord, angle)
-    X_BP = data.X_BE @ data.X_EP
-    configs = config_strings(robot, data.q[idx])
-    speeds = segment_speeds_mms(data.t, X_BP, idx)
-    conventions = frame_conventions(robot, data.X_EP) + [
-        f"Points: {len(idx)} of {len(data.t)} samples; the tool on the part within "
-        f"{max_chord * 1e3:.4f} mm, {np.rad2deg(max_angle):.4f} deg of the plan ({dense.basis});",
-        "speeds = the planned mean speed of P per segment. CNT100 between points, FINE at",
-        "the ends: the rounding stays between neighbouring points, which FANUC does not",
-        "bound in mm; lower --chord-tol-mm for denser points.",
-    ]
-    off = approach_and_retract(robot, data, approach_m) if approach_m > 0 else None
-    approach = f"{approach_m * 1e3:g} mm along -y of F" if off else "none"
-    conventions.append(
-        f"Approach/retract: {approach}"
-        + (" (OUT OF REACH)" if approach_m and not off else "")
-        + f", L at {APPROACH_SPEED_MMS} mm/sec, not collision-checked."
-    )
-    conventions += payload_conventions(data)
-    header = header_lines(data, conventions=conventions, forced=forced)
-    start = [
-        f"  UFRAME_NUM={UF}",
-        f"  UTOOL_NUM={UT}",
-        "  PAYLOAD[1]",
-        f"J P[1] {JOINT_SPEED_PCT}% FINE",
-    ]
-    q_start, targets = data.q[idx[0]], []  # (X_BP, config, statement tail) per L move
-    if off is not None:
-        q_start = off[0][1]
-        targets.append((X_BP[idx[0]], configs[0], f"{APPROACH_SPEED_MMS}mm/sec FINE"))
-    for i in range(1, len(idx)):
-        term = "FINE" if i == len(idx) - 1 else "CNT100"
-        targets.append((X_BP[idx[i]], configs[i], f"{speeds[i - 1]}mm/sec {term}"))
-    if off is not None:
-        q_ret = off[1][1]
-        X_BP_ret = robot.forward(q_ret[None])[0] @ data.X_EP
-        targets.append(
-            (X_BP_ret, config_strings(robot, q_ret[None])[0], f"{APPROACH_SPEED_MMS}mm/sec FINE")
-        )
-    positions = {1: joint_pos(1, fanuc_axes_deg(robot, q_start[None])[0], uf=UF, ut=UT)}
-    moves = []
-    for k, (X, config, tail) in enumerate(targets, start=2):
-        moves.append((k, f"L P[{k}] {tail}"))
-        positions[k] = cartesian_pos(k, X, config, uf=UF, ut=UT)
-    texts = _split(name, remarks(header) + start, moves, positions, line_limit)
-    files = []
-    for program, text in texts.items():
-        files.append(Path(out_dir) / f"{program}.ls")
-        write_atomic(files[-1], text)
-    return FanucResult(tuple(files), idx, max_chord, max_angle)
-
-
 def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:
     """Header lines: the program's form, frames, configuration and axis conventions."""
+    frame = ", ".join(f"{v:.3f}" for v in [*(X_EP[:3, 3] * 1e3), *wpr_deg(X_EP[:3, :3])])
     return [
         "FLANGE-STYLE PROGRAM, DENSE POINT LIST: not FANUC Remote TCP (no FANUC document",
         "cited for it). UTOOL[1] = the part frame P in the faceplate (URDF tool0):",
-        f"({_frame(X_EP)}).",
+        f"({frame}).",
         f"UFRAME[1] = URDF base_link = (0,0,{-robot.params.c1 * 1e3:.3f},0,0,0) in FANUC world.",
         "Positions: P in UFRAME[1]; frames (X,Y,Z mm, W,P,R deg about fixed x, y, z).",
         "CONFIG: N/F = J5 <= 0 / > 0, U/D elbow, T/B wrist centre front/back of J1;",
@@ -200,47 +314,13 @@ def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:
     ]
 
 
-def payload_conventions(data: ProgramData) -> list[str]:
+def payload_conventions(rows) -> list[str]:
     """The PAYLOAD[1] header line, when the cell gives the masses."""
-    load = payload(data.payload)
+    load = payload(rows.payload)
     if load is None:
         return []
-    mass, p_EC = load.total(data.X_EP)
+    mass, p_EC = load.total(rows.X_EP)
     return [
         f"PAYLOAD[1]: {mass:.3f} kg at ({', '.join(f'{v * 100:.2f}' for v in p_EC)}) cm "
         "in the faceplate frame: set it in the payload schedule before running."
     ]
-
-
-def remarks(lines: list[str]) -> list[str]:
-    """TP remark statements (``! text``, at most 32 characters each) for header lines."""
-    return [f"  ! {piece}" for line in lines for piece in fanuc_comments(line)]
-
-
-def _frame(X: np.ndarray) -> str:
-    """``x, y, z, w, p, r`` [mm, deg] of a 4x4 transform [m]."""
-    values = [*(X[:3, 3] * 1e3), *wpr_deg(X[:3, :3])]
-    return ", ".join(f"{v:.3f}" for v in values)
-
-
-def _split(name, head, moves, positions, line_limit) -> dict[str, str]:
-    """Programs: main (head + moves, or head + CALLs) and its sub-programs."""
-    comment = "offline_prog"
-    if len(head) + len(moves) <= line_limit:
-        used = [1] + [k for k, _ in moves]
-        return {
-            name: ls_text(name, head + [s for _, s in moves], [positions[k] for k in used], comment)
-        }
-    size = line_limit - 2
-    chunks = [moves[k : k + size] for k in range(0, len(moves), size)]
-    subs = [f"{name}_{k}" for k in range(2, len(chunks) + 2)]
-    main_lines = head + [f"  CALL {sub}" for sub in subs]
-    if len(main_lines) > line_limit:
-        raise ValueError(
-            f"line_limit={line_limit}: the main program alone needs {len(main_lines)} lines"
-        )
-    texts = {name: ls_text(name, main_lines, [positions[1]], comment)}
-    for sub, chunk in zip(subs, chunks, strict=True):
-        lines = [f"  UFRAME_NUM={UF}", f"  UTOOL_NUM={UT}"] + [s for _, s in chunk]
-        texts[sub] = ls_text(sub, lines, [positions[k] for k, _ in chunk], comment)
-    return texts

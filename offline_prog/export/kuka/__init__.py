@@ -1,8 +1,5 @@
-"""KUKA: KRL programs for KSS 8 (``name.src`` + ``name.dat``).
+"""KUKA: KRL programs for KSS 8 (``name.src`` + ``name.dat``, one module per seam).
 
-Single seam: :mod:`.krl` (``write_krl``; external-TCP or flange style). Whole job:
-:mod:`.krl_job` (``write_krl_job``; main program plus one module per seam, with process
-I/O). KUKA conventions (A, B, C, Status, Turn, the flange frame): :mod:`.kuka`; the
-comment header: :mod:`.krl_header`; which plan samples become LIN points:
-:mod:`.krl_points`.
+The writer: :mod:`.krl` (``KrlPost``: external-TCP style, process I/O on the path).
+KUKA conventions (A, B, C, Status, Turn, the flange frame, ``$VEL.CP``): :mod:`.kuka`.
 """

@@ -1,13 +1,13 @@
 """KUKA conventions: A, B, C angles, Status and Turn, and the flange frame.
 
-Used by the KRL writer (``export.kuka.krl``); see its module docstring for sources.
+Used by the KRL writer (``export.kuka.krl``); sources in each function's docstring.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from offline_prog.robot.kinematics_opw import OpwParameters, wrap_to_pi
+from offline_prog.robot.kinematics_opw import OpwParameters
 
 # URDF tool0 E in KUKA's $FLANGE K: the same frame (kuka_experimental marks tool0 as
 # "the $FLANGE coordinate system in KUKA KRC controllers").
@@ -26,7 +26,7 @@ def vel_cp(speed_m_s: float) -> float:
     """
     if not 0.0 <= speed_m_s <= VEL_CP_MAX_M_S:
         raise ValueError(
-            f"write_krl: speed {speed_m_s:g} m/s is beyond $VEL.CP's {VEL_CP_MAX_M_S:g} m/s "
+            f"krl: speed {speed_m_s:g} m/s is beyond $VEL.CP's {VEL_CP_MAX_M_S:g} m/s "
             "(speeds are m/s, not mm/s)"
         )
     return max(np.floor(speed_m_s / VEL_CP_STEP_M_S + 1e-6) * VEL_CP_STEP_M_S, VEL_CP_MIN_M_S)
@@ -60,16 +60,6 @@ def status_turn(params: OpwParameters, q: np.ndarray) -> tuple[np.ndarray, np.nd
     )
     status = (x_wrist < 0) + 2 * (theta[:, 2] + psi3 >= 0) + 4 * (q[:, 4] < 0)
     return status.astype(int), ((q < 0) * (1 << np.arange(6))).sum(axis=1)
-
-
-def joints_near(robot, X_BE, q_ref, data, what: str) -> np.ndarray:
-    """The IK solution (6,) [rad] for X_BE (4, 4) nearest q_ref, within the joint limits."""
-    q = robot.inverse(X_BE[None])[0]
-    q = q_ref + wrap_to_pi(q - q_ref)  # each joint's 2π-equivalent nearest q_ref
-    ok = ~np.isnan(q).any(axis=1) & np.all((q >= data.q_lower) & (q <= data.q_upper), axis=1)
-    if not ok.any():
-        raise ValueError(f"write_krl: the {what} pose is out of reach (approach_m too large?)")
-    return q[ok][np.abs(q[ok] - q_ref).max(axis=1).argmin()]
 
 
 def krl_num(value: float, digits: int) -> str:

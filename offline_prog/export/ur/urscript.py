@@ -1,12 +1,20 @@
-"""Universal Robots URScript: the planned joint trajectory streamed with servoj.
+"""Universal Robots URScript: a job as one ``.script``.
 
-Plain URScript has no remote TCP, so the plan's joint trajectory is resampled to
-the controller period (0.002 s on e-Series) with cubic Hermite interpolation of
-q and q̇ and sent with one ``servoj`` per period. As an option, ``movel`` poses
-of the part frame P (set as the TCP with ``set_tcp``) are written instead, in
-the controller's base frame, which is the URDF ``base_link`` turned π about z.
-URScript units: metres, radians, seconds; poses ``p[x, y, z, rx, ry, rz]`` with a
-rotation vector.
+Plain URScript has no remote TCP, so the program runs the planned joints. Links:
+``movej`` through the link's joint waypoints (the planned, collision-checked straight
+joint moves; the controller's own timing at the joints' common limits). Each seam with
+its approach and retract: the planned joint trajectory resampled to the controller
+period (0.002 s on e-Series) on the plan's straight joint steps and streamed with one
+``servoj`` per period. URScript units: metres, radians, seconds.
+
+Process I/O from the plan's I/O events: an output is set (``set_standard_digital_out``,
+``set_standard_analog_out``) just before the first ``servoj`` whose sample has reached
+the event's time, so the tool is at most v_TCP · period past its position (0.2 mm at
+100 mm/s and 2 ms). The flow, ``set_standard_analog_out(n, value / 10 V)`` (URScript
+takes the output as a fraction of its 0–10 V range), follows the plan's ``ao`` column
+while it is live, interpolated between live samples only (an edge is a step, not a
+ramp), written at each event and whenever it has changed by ``ANALOG_STEP_V`` or by
+``ANALOG_STEP_SHARE`` of its value, and holds the idle value otherwise.
 """
 
 from __future__ import annotations
@@ -15,42 +23,161 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.densify import densify
-from offline_prog.export.header import header_lines
-from offline_prog.export.kuka.krl_points import process_points
 from offline_prog.export.payload import payload
-from offline_prog.export.program import ProgramData
-from offline_prog.export.text import identifier, urscript_comment
+from offline_prog.export.post import ControllerPost
+from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
+from offline_prog.export.text import urscript_comment
+from offline_prog.io_events import Signal
 
 E_SERIES_PERIOD_S = 0.002
 SERVOJ_LOOKAHEAD_S = 0.1
 SERVOJ_GAIN = 300
-NAME_MAX = 63  # our bound for the program's function name
-MOVEL_ACCEL_M_S2 = 1.0
-MOVEL_MIN_SPEED_M_S = 1e-4
-MOVEL_MAX_SPEED_M_S = 3.0  # beyond any UR arm's tool speed (e-Series safety limit: 5 m/s)
-START_SPEED_RAD_S = 0.5  # movej to the start
-START_ACCEL_RAD_S2 = 1.0
-# The controller's base frame C in the URDF base_link B: turned π about z.
-X_BC = np.diag([-1.0, -1.0, 1.0, 1.0])
+ANALOG_RANGE_V = 10.0  # standard analog outputs: 0..10 V as 0..1
+ANALOG_STEP_V = 0.02  # write the flow when it changed by this much
+# ... or by this share of its value (a process model's quality follows the output's
+# value relative to the speed: a bead or a tape at a slow ramp needs fine steps)
+ANALOG_STEP_SHARE = 0.002
 
 
 @dataclasses.dataclass(frozen=True)
-class UrScriptResult:
-    file: Path
-    n_commands: int
-    period_s: float
+class UrScriptOptions:
+    """name: the program's function (≤ 63 characters, our bound); period_s: the servoj
+    period [s] (the controller's)."""
+
+    name: str = "offline_prog"
+    period_s: float = E_SERIES_PERIOD_S
 
 
-def resample_joints(data: ProgramData, period_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """(t (M,), q (M, 6)) on the controller period, on the plan's straight joint steps
-    (:func:`joints_on_steps`)."""
-    t = np.arange(0.0, data.t[-1], period_s)
-    t = np.append(t, data.t[-1]) if data.t[-1] - t[-1] > 1e-9 else t
-    return t, joints_on_steps(data.t, data.q, t)
+class UrScriptPost(ControllerPost):
+    """The URScript program of a job (see the module docstring)."""
+
+    FORMAT = "urscript"
+    Options = UrScriptOptions
+    NAME_MAX = 63
+    OPW_ONLY = False
+
+    def __init__(self, job, options: UrScriptOptions, *, forced: bool = False):
+        super().__init__(job, options, forced=forced)
+        if not options.period_s > 0:
+            raise ValueError(f"period_s={options.period_s}: need a period > 0 s")
+        self.v_link = float(self.robot.qd_max.min())  # movej: the joints' common limits
+        self.a_link = float(self.robot.qdd_max.min())
+        self.lines: list[str] = []
+
+    def conventions(self, record: ProgramRecord) -> list[str]:
+        io, rows, names = record.job.process_io, record.job.job, record.job.seam_names
+        lines = [
+            "Units: m, rad, s. Joint order: " + ", ".join(rows.joint_names) + ".",
+            f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            f"Links: movej through joint waypoints (a={self.a_link:.3f}, v={self.v_link:.3f}); "
+            f"seams with approach and retract: servoj every {self.options.period_s} s "
+            "(resampled from the plan).",
+        ]
+        if io is not None and io.digital_output is not None:
+            lines.append(
+                f"Process output: standard digital out {io.digital_output}, on "
+                f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
+                f"{io.off_lead_m * 1e3:g} mm before its end (at the servoj sample that "
+                "reaches it)."
+            )
+        if io is not None and io.analog_output is not None:
+            lines.append(
+                f"Flow: standard analog out {io.analog_output} = ({io.offset:g} V + "
+                f"{io.per_mps:g} V per m/s x v_TCP) / 10 V, within [{io.min:g}, {io.max:g}] V."
+            )
+        return lines
+
+    def header(self, lines: list[str]) -> None:
+        self.lines += [f"# {urscript_comment(line)}" for line in lines]
+        self.lines.append(f"def {self.options.name}():")
+
+    def frames(self) -> None:
+        """The payload (gripper + part, centre of mass in the flange) when the cell
+        gives it; the program moves the flange's joints, so it sets no TCP."""
+        rows = self.job.job
+        if (load := payload(rows.payload)) is not None:
+            mass, p_EC = load.total(rows.X_EP)
+            self.lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
+
+    def move_joint(self, move: JointMove) -> None:
+        for q in move.targets:
+            self.lines.append(f"  movej({_list(q)}, a={self.a_link:.3f}, v={self.v_link:.3f})")
+
+    def seam(self, run: SeamRun) -> None:
+        """The seam with its approach and retract, streamed (see the module docstring)."""
+        rows, period = self.job.job, self.options.period_s
+        t = rows.t[run.rows]
+        grid = np.arange(0.0, t[-1] - t[0], period)
+        grid = np.append(grid, t[-1] - t[0]) if t[-1] - t[0] - grid[-1] > 1e-9 else grid
+        grid = grid + t[0]  # the job's clock
+        q = joints_on_steps(t, rows.q[run.rows], grid)
+        # An event is set before the first command whose sample is at or past its time.
+        sets: dict[int, list] = {}
+        for event in run.events:
+            i = int(np.searchsorted(grid, event.t_s - 1e-12))
+            sets.setdefault(min(max(i, 1), len(grid) - 1), []).append(event)
+        flow, last = self._flow(run, grid), None
+        for i in range(1, len(grid)):
+            events = sets.get(i, [])
+            self.lines += [
+                self.set_output(Switch(0, 0.0, e)) for e in events if e.signal is Signal.DIGITAL
+            ]
+            analog = [e for e in events if e.signal is Signal.ANALOG]
+            if flow is not None and (
+                last is None
+                or abs(flow[i] - last) >= min(ANALOG_STEP_V, ANALOG_STEP_SHARE * abs(last))
+                or analog
+            ):
+                last = flow[i]
+                if analog:  # the event, at the value the plan's flow has at this sample
+                    event = dataclasses.replace(analog[0], value=float(flow[i]))
+                    self.lines.append(self.follow_speed(Switch(0, 0.0, event)))
+                else:
+                    self.lines.append(self._analog_out(flow[i]))
+            self.lines.append(
+                f"  servoj({_list(q[i])}, t={period}, lookahead_time={SERVOJ_LOOKAHEAD_S}, "
+                f"gain={SERVOJ_GAIN})"
+            )
+
+    def set_output(self, switch: Switch) -> str:
+        state = "True" if switch.event.state else "False"
+        return f"  set_standard_digital_out({switch.event.output}, {state})"
+
+    def follow_speed(self, switch: Switch) -> str:
+        """The flow output at the event's value: the plan's flow, which follows the TCP
+        speed while live (the stream writes its further values)."""
+        return self._analog_out(switch.event.value)
+
+    def footer(self, out_dir: Path) -> list[Path]:
+        name = self.options.name
+        file = out_dir / f"{name}.script"
+        write_atomic(file, "\n".join([*self.lines, "  stopj(2.0)", "end", f"{name}()"]) + "\n")
+        return [file]
+
+    def _analog_out(self, value_v: float) -> str:
+        output = self.job.process_io.analog_output
+        fraction = np.clip(value_v / ANALOG_RANGE_V, 0.0, 1.0)
+        return f"  set_standard_analog_out({output}, {fraction:.4f})"
+
+    def _flow(self, run: SeamRun, grid: np.ndarray) -> np.ndarray | None:
+        """(len(grid),) the flow command at the grid times [V]: the plan's ``ao`` column
+        between its live samples while the flow is live (its analog events), else idle."""
+        io = self.job.process_io
+        if io is None or io.analog_output is None or self.job.analog is None:
+            return None
+        t, value = self.job.job.t[run.rows], self.job.analog[run.rows]
+        events = [e for e in run.events if e.signal is Signal.ANALOG]
+        out = np.full(len(grid), io.idle)
+        for on, off in zip(events[::2], events[1::2], strict=True):
+            live = (t >= on.t_s) & (t < off.t_s)
+            here = (grid >= on.t_s) & (grid < off.t_s)
+            if live.any():
+                out[here] = np.interp(grid[here], t[live], value[live])
+            else:  # a window shorter than a sample: the event's own value
+                out[here] = on.value
+        return out
 
 
 def joints_on_steps(t: np.ndarray, q: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -62,102 +189,3 @@ def joints_on_steps(t: np.ndarray, q: np.ndarray, grid: np.ndarray) -> np.ndarra
 
 def _list(values: np.ndarray, digits: int = 7) -> str:
     return "[" + ", ".join(f"{v:.{digits}f}" for v in values) + "]"
-
-
-def _pose(X: np.ndarray) -> str:
-    rotvec = Rotation.from_matrix(X[:3, :3]).as_rotvec()
-    return "p" + _list(np.concatenate([X[:3, 3], rotvec]))
-
-
-def movel_points(data: ProgramData, chord_tol_m: float, angle_tol_rad: float):
-    """The movel targets and speeds: (X_CP (K, 4, 4) part frame P in the controller
-    base C, v (K-1,) [m/s] on each segment).
-
-    movel moves the set_tcp point (P) in straight lines in C, so the points are chosen
-    as for KRL's flange style (the nozzle's curve on the part within the tolerances,
-    against the continuous plan), and v is what the controller interpolates: the
-    length of the segment of P over its planned duration (keeps the planned timing).
-    """
-    dense = densify(data, chord_tol_m, angle_tol_rad)
-    plan = dense.data
-    idx, _, _ = process_points(
-        plan, "flange", *dense.selection_tolerances(chord_tol_m, angle_tol_rad)
-    )
-    X_CP = np.linalg.inv(X_BC) @ plan.X_BE[idx] @ plan.X_EP
-    v = np.linalg.norm(np.diff(X_CP[:, :3, 3], axis=0), axis=1) / np.diff(plan.t[idx])
-    if not np.all(v <= MOVEL_MAX_SPEED_M_S):  # NaN too
-        raise ValueError(
-            f"URScript movel: v {np.nanmax(v):g} m/s is beyond {MOVEL_MAX_SPEED_M_S:g} m/s "
-            "(the plan's speeds are m/s, not mm/s)"
-        )
-    return X_CP, np.maximum(v, MOVEL_MIN_SPEED_M_S)
-
-
-def urscript_text(
-    data: ProgramData,
-    *,
-    name: str = "offline_prog",
-    mode: str = "servoj",
-    period_s: float = E_SERIES_PERIOD_S,
-    chord_tol_m: float = 0.05e-3,
-    angle_tol_rad: float = np.deg2rad(0.1),
-    forced: bool = False,
-) -> tuple[str, int]:
-    """The program text and its number of motion commands.
-
-    Args:
-        mode: "servoj" (the joint trajectory at the controller period) or "movel"
-            (the part frame as TCP, LIN poses chosen within the tolerances).
-    """
-    conventions = [
-        "Units: m, rad, s. Joint order: " + ", ".join(data.joint_names) + ".",
-        f"Mode: {mode}. "
-        + (
-            f"servoj every {period_s} s (joint trajectory resampled from the plan)."
-            if mode == "servoj"
-            else "movel poses of the part frame (set_tcp) in the controller base frame "
-            "(URDF base_link turned pi about z), rotation vectors. v = speed of the part origin "
-            "(the set_tcp point) on each segment: its length / planned time."
-        ),
-    ]
-    identifier(name, max_chars=NAME_MAX, what="name")
-    header = header_lines(data, conventions=conventions, forced=forced)
-    lines = [f"# {urscript_comment(line)}" for line in header]
-    lines.append(f"def {name}():")
-    if (load := payload(data.payload)) is not None:  # gripper + part, CoG in the flange
-        mass, p_EC = load.total(data.X_EP)
-        lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
-    q0 = data.q[0]
-    lines.append(f"  movej({_list(q0)}, a={START_ACCEL_RAD_S2}, v={START_SPEED_RAD_S})")
-    if mode == "servoj":
-        _, q = resample_joints(data, period_s)
-        lines += [
-            f"  servoj({_list(row)}, t={period_s}, lookahead_time={SERVOJ_LOOKAHEAD_S}, "
-            f"gain={SERVOJ_GAIN})"
-            for row in q[1:]
-        ]
-        lines.append("  stopj(2.0)")
-        count = len(q) - 1
-    elif mode == "movel":
-        lines.append(f"  set_tcp({_pose(data.X_EP)})")  # the part frame P in the flange
-        X_CP, v = movel_points(data, chord_tol_m, angle_tol_rad)
-        for X, speed in zip(X_CP[1:], v, strict=True):
-            lines.append(
-                f"  movel({_pose(X)}, a={MOVEL_ACCEL_M_S2}, v={speed:.5f}, "
-                f"r={min(chord_tol_m, 0.001):.5f})"
-            )
-        count = len(X_CP) - 1
-    else:
-        raise ValueError(f"URScript mode must be 'servoj' or 'movel', got {mode!r}")
-    lines.append("end")
-    lines.append(f"{name}()")
-    return "\n".join(lines) + "\n", count
-
-
-def write_urscript(data: ProgramData, out_dir: Path, **options) -> UrScriptResult:
-    """Write ``out_dir/<name>.script`` (see urscript_text for the options)."""
-    name = options.get("name", "offline_prog")
-    text, count = urscript_text(data, **options)
-    file = Path(out_dir) / f"{name}.script"
-    write_atomic(file, text)
-    return UrScriptResult(file, count, options.get("period_s", E_SERIES_PERIOD_S))
