@@ -248,8 +248,10 @@ class PlaceConfig:
     seed: int = 0
     screen_points: int = 1000  # grid points screened by the analytic path IK, per grasp
     top_k: int = 10  # candidates listed in placement.json
-    # Obstacles that stand with the tool (its stand): moved with X_IT.
+    # Obstacles that stand with the tool (its stand): moved with X_IT, their foot kept
+    # on the floor by their length (placement.stand), up to stand_max_length_mm.
     moves_with_tool: list[str] = dataclasses.field(default_factory=list)
+    stand_max_length_mm: float = 2000.0
 
 
 @dataclasses.dataclass

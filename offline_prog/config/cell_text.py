@@ -152,16 +152,22 @@ def edited_text(text: str, initial: CellValues, state: CellValues) -> str:
     return edits.result()
 
 
-def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> str:
-    """The cell file's ``text`` with transforms and text values replaced in place.
+def with_values(
+    text: str, poses: dict[str, tuple], strings: dict[str, str], numbers: dict | None = None
+) -> str:
+    """The cell file's ``text`` with transforms, text values and numbers replaced in
+    place.
 
     Args:
         poses: {dotted key (``tool.X_IT``, ``obstacles.2.pose``): (p [m], rpy [deg])};
             a key the file leaves out (an obstacle at the origin) is added.
-        strings: {dotted key: new text} (file names: written quoted).
+        strings: {dotted key: new text} (file names: written quoted); a top-level key
+            the file leaves out (``description``) is added.
+        numbers: {dotted key (``obstacles.1.size_mm.2``): new number}.
 
     Raises:
-        ValueError: a key of ``strings`` is not in the text, or a pose's mapping is not.
+        ValueError: a key of ``strings`` or ``numbers`` is not in the text, or a pose's
+            mapping is not.
     """
     root = yaml.compose(text, Loader=yaml.SafeLoader)
     edits = _Edits(text)
@@ -181,10 +187,18 @@ def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> 
             _transform(edits, node, p, rpy_deg)
     for key, value in strings.items():
         node = _find(root, key)
+        if node is None and "." not in key and isinstance(root, yaml.MappingNode):
+            edits.add(root, key, json.dumps(value))
+            continue
         if node is None:
             raise ValueError(f"{key} not found in the cell file")
         if node.value != value:  # unchanged text stays as written
             edits.replace(node, json.dumps(value))
+    for key, value in (numbers or {}).items():
+        node = _find(root, key)
+        if not isinstance(node, yaml.ScalarNode):
+            raise ValueError(f"{key} not found in the cell file")
+        edits.scalar(node, value)
     return edits.result()
 
 

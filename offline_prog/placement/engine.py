@@ -24,12 +24,13 @@ from offline_prog.placement.context import context
 from offline_prog.placement.evaluate import evaluate
 from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import CellPayload
-from offline_prog.placement.screen import screen
+from offline_prog.placement.screen import rank, screen
 from offline_prog.placement.space import Candidate
 
 CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds
-SCREEN_CHUNK = 32  # candidates per screen task (each ~10 ms)
-STAGES = {"screen": screen, "plan": evaluate}
+# Candidates per task: a screen takes ~30 ms a seam, a rank ~0.15 s, a plan ~2 s.
+CHUNKS = {"screen": 16, "rank": 2, "plan": 1}
+STAGES = {"screen": screen, "rank": rank, "plan": evaluate}
 # LocalCluster workers: a candidate is ~0.5 s of Python and Drake. The statistical
 # profiler (a stack sample every 10 ms), glibc trimming every free above 64 kB and the
 # frequent monitors cost 10–20 % of each worker's time on this machine
@@ -45,7 +46,7 @@ WORKER_CONFIG = {
 def run_chunk(
     stage: str, candidates: Sequence[Candidate], payload: CellPayload
 ) -> list[Evaluation]:
-    """Evaluate candidates with ``stage`` ("screen" | "plan") on this process's copy of
+    """Evaluate candidates with ``stage`` ("screen" | "rank" | "plan") on this process's copy of
     the cell (loaded once per payload)."""
     ctx = context(payload)
     judge = STAGES[stage]
@@ -140,7 +141,7 @@ class DaskEngine:
     ) -> list[Evaluation]:
         from dask.distributed import as_completed
 
-        size = SCREEN_CHUNK if stage == "screen" else 1
+        size = CHUNKS[stage]
         chunks = [list(candidates[i : i + size]) for i in range(0, len(candidates), size)]
         futures = self.client.map(
             run_chunk, [stage] * len(chunks), chunks, payload=self.payload, pure=False

@@ -27,7 +27,7 @@ from offline_prog.placement.outputs import placed_text, placement_json, write_js
 from offline_prog.placement.payload import CellPayload, cell_payload
 from offline_prog.placement.search import Placement, search
 from offline_prog.placement.search_map import render_placement_html
-from offline_prog.placement.space import Candidate, SearchSpace, check_place
+from offline_prog.placement.space import Candidate, check_place
 from offline_prog.results.plan_folder import check_out_dir
 from offline_prog.robot.model import ROBOTS_DIR
 
@@ -61,11 +61,11 @@ def place_cell(
     started = time.perf_counter()
     engine = start_engine(payload, workers, scheduler)
     try:
-        result = search(space, place, space.baseline, _runner(engine, space, place, progress))
+        result = search(space, place, space.baseline, _runner(engine, place, progress))
     finally:
         engine.close()
     figures = engine_figures(engine, result, started)
-    data = placement_json(result, space, place, figures, ctx.inputs.cell.tool)
+    data = placement_json(result, space, place, figures, ctx)
     progress("outputs", 0, 1)
     write_folder(out_dir, cell_file, ctx, result, data)
     progress("outputs", 1, 1)
@@ -97,15 +97,17 @@ def start_engine(payload: CellPayload, workers: int | None, scheduler: str | Non
     return DaskEngine(payload, workers=workers, scheduler=scheduler)
 
 
-def _runner(engine, space: SearchSpace, place, progress):
-    """``search``'s ``run``: the engine's map, telling ``progress`` per stage."""
-    totals = {"screen": len(space.grid(place.screen_points)), "plan": place.budget}
-    done = {"screen": 0, "plan": 0}
+def _runner(engine, place, progress):
+    """``search``'s ``run``: the engine's map, telling ``progress`` per stage (the
+    screen's and the rank's totals are their batches'; the plans', the budget)."""
+    done = {"screen": 0, "rank": 0, "plan": 0}
 
     def run(stage: str, candidates: list[Candidate]):
+        total = place.budget if stage == "plan" else done[stage] + len(candidates)
+
         def advance(n: int) -> None:
             done[stage] += n
-            progress(stage, done[stage], totals[stage])
+            progress(stage, done[stage], total)
 
         return engine.map(stage, candidates, advance)
 

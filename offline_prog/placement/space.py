@@ -21,6 +21,7 @@ from offline_prog.config.cell import Cell, PlaceConfig
 from offline_prog.config.edits import rpy_deg_of
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
 from offline_prog.errors import InputError
+from offline_prog.placement.stand import check_stands
 
 MAX_SCREEN_POINTS = 100_000  # per grasp
 MAX_OFFSET_MM = 10_000.0  # a tool stand 10 m from the robot is a typo
@@ -191,6 +192,13 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
             raise InputError(
                 file, f"place.moves_with_tool[{i}]", f"{name!r} is not an obstacle of the cell"
             )
+    if not 0.0 < place.stand_max_length_mm <= MAX_OFFSET_MM:
+        raise InputError(
+            file,
+            "place.stand_max_length_mm",
+            f"{place.stand_max_length_mm:g} is outside (0, {MAX_OFFSET_MM:g}] mm",
+        )
+    check_stands(file, cell, place.moves_with_tool, 1e-3 * place.stand_max_length_mm)
     axes = _axes(file, "X_IT", place.X_IT)
     grasps = (_pose(cell.part.X_PE),)
     if place.X_PE is not None:

@@ -47,11 +47,13 @@ def test_no_feasible_placement_is_exit_1_with_the_closest_reason_and_outputs(tmp
     code = main(["place", str(file), "--out", str(out), "--budget", "3", "--workers", "0"])
     captured = capsys.readouterr()
     err = captured.err.strip().splitlines()
-    assert code == 1 and len(err) == 1 and "no feasible placement in 3 candidates" in err[0]
+    assert code == 1 and len(err) == 1, err
+    assert "no feasible placement in 1 candidate planned (32 by reach screened out)" in err[0]
     assert "out of reach" in err[0]
     data = json.loads((out / "placement.json").read_text())
     assert not data["best"]["feasible"] and data["best"]["failure"] == "out_of_reach"
-    assert data["search"]["failures"] == {"out_of_reach": 3}
+    assert data["search"]["failures"] == {"out_of_reach": 1}  # the cell as given
+    assert data["screening"]["fates"]["reach"] == 32  # the grid: 2 levels ^ 4 axes, 2 grasps
     assert not (out / "best_preview.html").exists()
     said = captured.out.strip().splitlines()[-1]
     assert said.endswith(f"wrote into {out}: placed.yaml, placement.html, placement.json")

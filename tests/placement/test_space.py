@@ -40,6 +40,31 @@ def _variant(tmp_path, old: str, new: str):
             "'stand' is not an obstacle",
         ),
         (
+            "moves_with_tool: [nozzle_stand]",
+            "moves_with_tool: [fence_post]\n  stand_max_length_mm: 1000",
+            "place.stand_max_length_mm",
+            "1000 mm is shorter than 'fence_post' as given (2000 mm)",
+        ),
+        (
+            "moves_with_tool: [nozzle_stand]",
+            "moves_with_tool: [nozzle_stand]\n  stand_max_length_mm: 0",
+            "place.stand_max_length_mm",
+            "outside (0, 10000] mm",
+        ),
+        (
+            "size_mm: [200, 200, 500], pose: {translation: [2.2, 0.4, 0.250]}",
+            "size_mm: [200, 200, 500], pose: {translation: [2.2, 0.4, 0.250], "
+            "rotation: !Rpy {deg: [5, 0, 0]}}",
+            "place.moves_with_tool[0]",
+            "'nozzle_stand' is not upright",
+        ),
+        (
+            "{name: nozzle_stand, shape: box, size_mm: [200, 200, 500],",
+            "{name: nozzle_stand, shape: sphere, radius_mm: 100,",
+            "place.moves_with_tool[0]",
+            "'nozzle_stand' is a sphere: a stand keeps its foot on the floor by its length",
+        ),
+        (
             "  X_PE:   ",
             "  X_PE:\n    rpy_deg: {yaw: [-10, 10]}\n  ",
             "place.X_PE.rpy_deg.yaw",

@@ -1,0 +1,208 @@
+"""The joint paths a placement candidate may take on a seam: every tool turn φ₀ the
+planner tries times the eight IK branches, screened at once on a coarse σ grid.
+
+The planner (``stages.flange_paths``, ``joints.joint_plan.tool_rotations``) lays the
+process frame onto T·R_axis(φ₀) for a symmetric tool, φ₀ ∈ [−bound, bound] in steps of
+ROTATION_STEP_RAD, and plans the best of them on the best IK branch (other turns and
+branches where that one collides). A turn about T's axis turns the whole flange path
+about that axis, so one evaluation of the part's side of the path
+(``fixed_tcp.part_in_tool``: p_TE_T, M = R_TP·R_PE) gives every φ₀:
+
+    p_IE(σ, φ) = p_IT + R_IT R_axis(φ) p_TE_T(σ),   R_IE(σ, φ) = R_IT R_axis(φ) M(σ)
+
+(with ``tool.turn_smoothing_mm`` φ = φ₀ + the smooth turn's φ(σ)). Besides the seam's
+samples, the two points off its ends where the approach starts and the retract ends
+(``job.approach``: the tool δ = d off the end frame along u) are solved on the same
+branch, for the links' lower bound (``placement.bound``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from offline_prog.joints.joint_plan import ROTATION_STEP_RAD, ROTATION_TRIAL_POINTS
+from offline_prog.joints.path_ik import MAX_JOINT_STEP_RAD, base_poses, best_turns
+from offline_prog.path.fixed_tcp import part_in_tool
+from offline_prog.stages import smooth_turn
+
+TWO_PI = 2.0 * np.pi
+# σ samples of a seam's screen: the joint speed bound sums |Δq| between them, which
+# only grows with more samples (it stays a bound however coarse).
+VARIANT_SAMPLES = 64
+
+
+@dataclasses.dataclass(frozen=True)
+class SeamVariants:
+    """Every (tool turn, branch) joint path of one seam at one placement.
+
+    Attributes:
+        angles: (A,) the tool turns φ₀ the planner tries [rad].
+        sigma: (N,) σ samples of the seam [m].
+        q: (A, 8, N + 2, 6) joint paths [rad] (URDF order), unwrapped along σ with the
+            2π turns of the widest limit margin: row 0 the approach's start, rows 1..N
+            the seam, row N + 1 the retract's end (NaN where a branch has no solution).
+        reach_share: (A, 8) the share of rows with a solution.
+        reach: (A, 8) every row has a solution; within: (A, 8) and inside the joint
+            limits (with the 2π turns); flips: (A, 8) a step larger than the planner's
+            continuity test scaled to this grid (a branch swap, by the planner's rule).
+        margin: (A, 8) the smallest joint-limit margin along the seam [rad].
+        reach_excess: (A, N) how far each seam pose lies beyond the arm's reach [m].
+    """
+
+    angles: np.ndarray
+    sigma: np.ndarray
+    q: np.ndarray
+    reach_share: np.ndarray
+    reach: np.ndarray
+    within: np.ndarray
+    flips: np.ndarray
+    margin: np.ndarray
+    reach_excess: np.ndarray
+
+    @property
+    def usable(self) -> np.ndarray:
+        """(A, 8) the variants no planner's path can rule out on this grid: reachable
+        everywhere, inside the limits (a flip is not trusted on a coarse grid)."""
+        return self.reach & self.within
+
+    def planner_choice(self) -> tuple[int, int] | None:
+        """(turn index, branch) the planner's first attempt takes, as it ranks them
+        (``tool_rotations``: feasible first, the widest margin, the smaller |φ₀|; then
+        ``choose_branch``), or None when no variant is feasible."""
+        feasible = self.usable & ~self.flips
+        if not feasible.any():
+            return None
+        margin = np.where(feasible, self.margin, -np.inf)
+        best_branch = np.argmax(margin, axis=1)  # (A,)
+        best = margin[np.arange(len(self.angles)), best_branch]
+        order = np.lexsort((np.abs(self.angles), -best))  # widest margin, then small |φ₀|
+        a = int(order[0])
+        return a, int(best_branch[a])
+
+
+def _angles(bound: float, span) -> np.ndarray:
+    lo, hi = -bound, bound
+    if span is not None:
+        low, high = span
+        scale = min(1.0, 2.0 * bound / max(high - low, 1e-12))
+        lo, hi = -bound - scale * low, bound - scale * high
+        if scale < 1.0:
+            lo = hi = 0.5 * (lo + hi)
+    count = int(np.ceil((hi - lo) / (2.0 * ROTATION_STEP_RAD)))
+    return np.linspace(lo, hi, 2 * count + 1) if count else np.array([lo])
+
+
+def _axis_rotations(axis: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotations by phi (...) [rad] about the unit axis (3,) (Rodrigues)."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(phi)[..., None, None], np.cos(phi)[..., None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def _offsets(seam, p_PF, R_PF, sigma_end: int) -> tuple[float, np.ndarray] | None:
+    """(d [m], u (3,) in P) of the approach (σ = 0) or retract (σ = L) end, or None."""
+    spec = seam.approach if sigma_end == 0 else seam.retract
+    d = spec.distance_mm * 1e-3
+    if spec.kind == "none" or d <= 0.0:
+        return None
+    i = 0 if sigma_end == 0 else -1
+    if spec.kind == "normal":
+        return d, R_PF[i][:, 1]
+    return d, (1.0 if sigma_end == 0 else -1.0) * R_PF[i][:, 0]
+
+
+def seam_variants(view, seam, X_IT, X_PE, *, samples: int = VARIANT_SAMPLES) -> SeamVariants:
+    """Every (tool turn, branch) joint path of a seam at the placement (X_IT, X_PE).
+
+    Args:
+        view: the seam's ``context.SeamView`` (its inputs and fitted path).
+        seam: its SeamConfig (approach and retract).
+        X_IT, X_PE: the candidate's RigidTransforms.
+    """
+    inputs, fit = view.inputs, view.fit
+    robot, tool = inputs.robot, inputs.cell.tool
+    sigma = np.linspace(0.0, fit.path.length, samples)
+    p_PF, R_PF, p_TE_T, _, _, M, _, _ = part_in_tool(fit.path, fit.normal, X_PE, sigma)
+    R_PE = X_PE.rotation().matrix()
+    # The off-end points: p_PT = p_PF − d·u, so p_TE_T grows by d·R_TP u; M stays.
+    rows_p, rows_M = [p_TE_T[:1]], [M[:1]]
+    for end in (0, -1):
+        found = _offsets(seam, p_PF, R_PF, end)
+        base_p, base_M = p_TE_T[end], M[end]
+        if found is not None:
+            d, u = found
+            base_p = base_p + d * (base_M @ R_PE.T @ u)
+        rows_p.append(base_p[None]), rows_M.append(base_M[None])
+    p_all = np.concatenate([rows_p[1], p_TE_T, rows_p[2]])  # (N + 2, 3)
+    M_all = np.concatenate([rows_M[1], M, rows_M[2]])
+    axis = np.eye(3)["xyz".index(tool.symmetry_axis)]
+    angles = np.zeros(1)
+    phi = np.zeros((1, samples + 2))
+    if tool.free_rotation_deg > 0:
+        turn = smooth_turn(inputs, fit)
+        bound = np.deg2rad(tool.free_rotation_deg)
+        angles = _angles(bound, None if turn is None else turn.span_rad)
+        phi = np.repeat(angles[:, None], samples + 2, axis=1)
+        if turn is not None:
+            scale = min(1.0, 2.0 * bound / max(np.ptp(turn.span_rad), 1e-12))
+            along = np.concatenate([[0.0], sigma, [fit.path.length]])
+            for a, phi0 in enumerate(angles):
+                phi[a] = turn.with_offset(float(phi0), scale)(along)[0]
+    G = X_IT.rotation().matrix() @ _axis_rotations(axis, phi)  # (A, N + 2, 3, 3)
+    p_IE = X_IT.translation() + np.einsum("anij,nj->ani", G, p_all)
+    R_IE = G @ M_all
+    A, rows = phi.shape
+    X_BE = base_poses(inputs.X_IB, p_IE.reshape(-1, 3), R_IE.reshape(-1, 3, 3))
+    solutions = robot.inverse(X_BE).reshape(A, rows, 8, 6).transpose(0, 2, 1, 3)
+    return _judged(robot, angles, sigma, solutions, X_BE.reshape(A, rows, 4, 4))
+
+
+def _judged(robot, angles, sigma, solutions, X_BE) -> SeamVariants:
+    """The verdicts of (A, 8, N + 2, 6) solutions (``path_ik.branch_results`` for every
+    variant at once)."""
+    from offline_prog.joints.path_ik import reach_excess
+
+    A, _, rows, _ = solutions.shape
+    reachable = ~np.isnan(solutions).any(axis=-1)  # (A, 8, rows)
+    filled = np.where(reachable[..., None], solutions, 0.0)
+    step = np.diff(filled, axis=2)
+    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
+    q = np.concatenate([filled[:, :, :1], filled[:, :, :1] + np.cumsum(step, axis=2)], axis=2)
+    seam = slice(1, rows - 1)
+    flat = q.reshape(A * 8, rows, 6)
+    mask = reachable.reshape(A * 8, rows, 1)
+    # The 2π turns of the widest margin along the seam (as the planner picks them);
+    # the approach's start and the retract's end follow the seam continuously.
+    offsets, margins = best_turns(
+        robot.controller_joints(np.where(mask, flat, np.nan)[:, seam]),
+        robot.q_lower,
+        robot.q_upper,
+    )
+    q = (flat + offsets[:, None, :]).reshape(A, 8, rows, 6)
+    q = np.where(reachable[..., None], q, np.nan)
+    margin = margins.min(axis=1).reshape(A, 8)
+    q_c = robot.controller_joints(q[:, :, [0, -1]])
+    with np.errstate(invalid="ignore"):
+        ends_inside = ((q_c >= robot.q_lower) & (q_c <= robot.q_upper)).all(axis=(-1, -2))
+    # The planner tests continuity on ROTATION_TRIAL_POINTS samples: the same rate of
+    # turn [rad/m] on this grid (a flip is a jump of about π, far beyond it).
+    spacing = sigma[1] - sigma[0] if len(sigma) > 1 else 1.0
+    trial = sigma[-1] / (ROTATION_TRIAL_POINTS - 1) if sigma[-1] > 0 else spacing
+    limit = min(np.pi / 2, MAX_JOINT_STEP_RAD * spacing / trial)
+    steps = np.abs(step[:, :, 1 : rows - 2]).max(axis=-1)  # the seam's own steps
+    both = reachable[:, :, 1 : rows - 2] & reachable[:, :, 2 : rows - 1]
+    flips = ((steps > limit) & both).any(axis=-1)
+    excess = reach_excess(robot, X_BE[:, seam].reshape(-1, 4, 4)).reshape(A, -1)
+    return SeamVariants(
+        angles=angles,
+        sigma=sigma,
+        q=q,
+        reach_share=reachable.mean(axis=-1),
+        reach=reachable.all(axis=-1),
+        within=(margin >= 0.0) & ends_inside,
+        flips=flips,
+        margin=margin,
+        reach_excess=excess,
+    )
