@@ -28,6 +28,7 @@ from offline_prog.placement.screen import rank, screen
 from offline_prog.placement.space import Candidate
 
 CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds
+LOST_RETRIES = 3  # rounds of tasks run again after their worker was lost
 # Candidates per task: a screen takes ~30 ms a seam, a rank ~0.15 s, a plan ~2 s.
 CHUNKS = {"screen": 16, "rank": 2, "plan": 1}
 STAGES = {"screen": screen, "rank": rank, "plan": evaluate}
@@ -87,7 +88,8 @@ class DaskEngine:
     ``scheduler``.
 
     Raises:
-        InputError: the scheduler cannot be reached within CONNECT_TIMEOUT_S.
+        InputError: the scheduler cannot be reached, or has no worker, within
+            CONNECT_TIMEOUT_S.
     """
 
     def __init__(
@@ -120,18 +122,36 @@ class DaskEngine:
                 )
             self.client = Client(self.cluster)
             self.scheduler = "LocalCluster"
+        self.source = payload
         try:
-            addresses = list(self.client.scheduler_info()["workers"])
-            self.workers = len(addresses)
-            self.payload = self.client.scatter(payload, broadcast=True, hash=False)
-            # Every worker loads the cell now, in parallel (not on its first candidate).
-            loads = [
-                self.client.submit(_load, self.payload, workers=[a], pure=False) for a in addresses
-            ]
-            self.client.gather(loads)
+            self.workers = self._send_cell()
         except BaseException:  # Ctrl-C or a worker's error: no cluster left running
             self.close()
             raise
+
+    def _send_cell(self) -> int:
+        """Scatter the cell to every worker and have each load it now, in parallel (not
+        on its first candidate); the number of workers.
+
+        Raises:
+            InputError: no worker joins the scheduler within CONNECT_TIMEOUT_S.
+        """
+        try:
+            with contextlib.redirect_stderr(io.StringIO()):
+                self.client.wait_for_workers(1, timeout=CONNECT_TIMEOUT_S)
+        except TimeoutError:
+            raise InputError(
+                self.scheduler,
+                "--scheduler",
+                f"no worker joined it within {CONNECT_TIMEOUT_S} s: start "
+                f"`dask worker {self.scheduler} --nthreads 1` where offline_prog is installed",
+            ) from None
+        addresses = list(self.client.scheduler_info()["workers"])
+        self.payload = self.client.scatter(self.source, broadcast=True, hash=False)
+        self.client.gather(
+            [self.client.submit(_load, self.payload, workers=[a], pure=False) for a in addresses]
+        )
+        return len(addresses)
 
     def map(
         self,
@@ -139,21 +159,66 @@ class DaskEngine:
         candidates: Sequence[Candidate],
         done: Callable[[int], None] = lambda n: None,
     ) -> list[Evaluation]:
-        from dask.distributed import as_completed
+        """The evaluations in the candidates' order. A task whose worker was lost (the
+        task or the cell with it: ``KilledWorker``, a cancelled future) is run again on
+        the workers left, the cell sent to them again, up to LOST_RETRIES rounds.
 
+        Raises:
+            InputError: every worker is gone (none joins within CONNECT_TIMEOUT_S).
+        """
         size = CHUNKS[stage]
         chunks = [list(candidates[i : i + size]) for i in range(0, len(candidates), size)]
-        futures = self.client.map(
-            run_chunk, [stage] * len(chunks), chunks, payload=self.payload, pure=False
+        results: list = [None] * len(chunks)
+        todo = list(range(len(chunks)))
+        for _ in range(LOST_RETRIES + 1):
+            todo = self._run(stage, chunks, todo, results, done)
+            if not todo:
+                return [e for chunk in results for e in chunk]
+            self.workers = self._send_cell()  # the cell again, to the workers left
+        raise InputError(
+            self.scheduler, "--scheduler", f"workers kept being lost ({LOST_RETRIES} rounds)"
         )
+
+    def _run(self, stage, chunks, todo, results, done) -> list[int]:
+        """Run the chunks ``todo`` into ``results``; the indices whose worker was lost.
+
+        Raises:
+            InputError: no worker is left to run them (for 2 × CONNECT_TIMEOUT_S).
+        """
+        from concurrent.futures import CancelledError
+
+        from dask.distributed import KilledWorker, wait
+
+        futures = {
+            self.client.submit(run_chunk, stage, chunks[i], self.payload, pure=False): i
+            for i in todo
+        }
+        pending, lost, idle = set(futures), [], 0
         try:
-            for future in as_completed(futures):
-                future.result()  # a worker's exception is raised here
-                done(len(chunks[futures.index(future)]))
+            while pending:
+                try:
+                    finished, pending = wait(
+                        pending, timeout=CONNECT_TIMEOUT_S, return_when="FIRST_COMPLETED"
+                    )
+                except TimeoutError:  # nothing finished: is anyone still working?
+                    idle = 0 if self.client.scheduler_info()["workers"] else idle + 1
+                    if idle >= 2:
+                        raise InputError(
+                            self.scheduler, "--scheduler", "every worker was lost"
+                        ) from None
+                    continue
+                for future in sorted(finished, key=futures.get):
+                    i = futures[future]
+                    try:
+                        results[i] = future.result()  # a worker's exception is raised here
+                    except (KilledWorker, CancelledError):
+                        lost.append(i)
+                        continue
+                    done(len(chunks[i]))
         except BaseException:
-            self.client.cancel(futures)
+            self.client.cancel(list(futures))
             raise
-        return [e for chunk in self.client.gather(futures) for e in chunk]
+        return sorted(lost)
 
     def close(self) -> None:
         with contextlib.suppress(Exception), contextlib.redirect_stderr(io.StringIO()):
