@@ -23,12 +23,15 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
+
 from offline_prog.config.cell_text import with_values
 from offline_prog.placement.context import Context, placed_stands, pose_of
 from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import data_file_keys
 from offline_prog.placement.search import FATES, Placement
 from offline_prog.placement.space import Pose, SearchSpace
+from offline_prog.placement.top_view import Layout
 
 CUT_TARGET = 0.15  # the cycle-time cut a placement search should find (issue 16)
 
@@ -175,6 +178,32 @@ def cycle_time_cut(result: Placement, tool=None) -> dict:
             )
     out["why_not_more"] = why
     return out
+
+
+def layout_of(ctx: Context, best: Evaluation) -> Layout:
+    """The top view's robot base, its reach and the best's stands (``top_view``)."""
+    robot, p_IB = ctx.inputs.robot, ctx.inputs.X_IB.translation()
+    params = robot.params
+    if robot.family == "opw":
+        reach = params.a1 + params.c2 + math.hypot(params.a2, params.c3)
+    elif robot.family == "ur":
+        reach = abs(params.a2) + abs(params.a3) + abs(params.d5)
+    else:
+        reach = 0.0
+    stands = []
+    obstacles = ctx.inputs.cell.obstacles
+    for stand in placed_stands(ctx, best.candidate):
+        shape = obstacles[stand.stand.index]
+        if shape.shape == "box":
+            hx, hy = 0.5e-3 * shape.size_mm[0], 0.5e-3 * shape.size_mm[1]
+            local = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+        else:
+            angle = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
+            local = 1e-3 * shape.radius_mm * np.column_stack([np.cos(angle), np.sin(angle)])
+        R = stand.X_IO.rotation().matrix()[:2, :2]
+        corners = 1e3 * (local @ R.T + stand.X_IO.translation()[:2])
+        stands.append((stand.stand.name, corners))
+    return Layout((1e3 * p_IB[0], 1e3 * p_IB[1]), 1e3 * reach, stands)
 
 
 def placement_json(

@@ -23,7 +23,7 @@ from offline_prog.placement.context import Context, keep, load_context
 from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.evaluate import plan_candidate
 from offline_prog.placement.objective import Evaluation
-from offline_prog.placement.outputs import placed_text, placement_json, write_json
+from offline_prog.placement.outputs import layout_of, placed_text, placement_json, write_json
 from offline_prog.placement.payload import CellPayload, cell_payload
 from offline_prog.placement.search import Placement, search
 from offline_prog.placement.search_map import render_placement_html
@@ -141,7 +141,8 @@ def write_folder(out_dir: Path, cell_file: Path, ctx: Context, result: Placement
             preview = "best_preview.html"
         write_json(folder / "placement.json", data)
         (folder / "placement.html").write_text(
-            render_placement_html(result, data, preview), encoding="utf-8"
+            render_placement_html(result, data, preview, layout_of(ctx, result.best)),
+            encoding="utf-8",
         )
         write_manifest(folder, {"plan": sorted(p.name for p in folder.iterdir())})
 
