@@ -196,7 +196,7 @@ def singularity_distances(robot: RobotModel, q: np.ndarray, X_BE: np.ndarray) ->
     return {"wrist": wrist, "elbow": elbow, "shoulder": shoulder}
 
 
-def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
+def reach_excess(robot: RobotModel, X_BE: np.ndarray, *, inner: bool = True) -> np.ndarray:
     """How far each flange pose is out of the arm's reach [m] (0 inside it): the wrist
     centre's distance from the shoulder (axis 2) beyond the arm's longest stretch, or
     inside its shortest. A measure that keeps growing where the closed form only says
@@ -204,6 +204,9 @@ def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
 
     Args:
         X_BE: (N, 4, 4) flange poses in the robot base.
+        inner: count a wrist centre inside the shortest stretch too (an estimate:
+            the closed form reaches some such poses); without it, a pose with any
+            excess has no solution (the longest stretch is exact).
 
     Returns:
         (N,) [m]; zeros for a robot without a closed form.
@@ -227,4 +230,4 @@ def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
     radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - lateral**2, 0.0))
     h = c[:, 2] - height
     d = np.minimum(np.hypot(radial - offset, h), np.hypot(radial + offset, h))  # front, back
-    return np.maximum(d - longest, 0.0) + np.maximum(shortest - d, 0.0)
+    return np.maximum(d - longest, 0.0) + (np.maximum(shortest - d, 0.0) if inner else 0.0)

@@ -23,7 +23,12 @@ import dataclasses
 import numpy as np
 
 from offline_prog.joints.joint_plan import ROTATION_STEP_RAD, ROTATION_TRIAL_POINTS
-from offline_prog.joints.path_ik import MAX_JOINT_STEP_RAD, base_poses, best_turns
+from offline_prog.joints.path_ik import (
+    MAX_JOINT_STEP_RAD,
+    base_poses,
+    best_turns,
+    reach_excess,
+)
 from offline_prog.path.fixed_tcp import part_in_tool
 from offline_prog.stages import smooth_turn
 
@@ -31,6 +36,9 @@ TWO_PI = 2.0 * np.pi
 # σ samples of a seam's screen: the joint speed bound sums |Δq| between them, which
 # only grows with more samples (it stays a bound however coarse).
 VARIANT_SAMPLES = 64
+# A pose this far beyond the arm's stretch [m] has no IK solution (reach_excess is the
+# closed form's own test, on the wrist centre; the margin covers its rounding).
+UNREACHABLE_M = 1e-3
 
 
 @dataclasses.dataclass(frozen=True)
@@ -155,15 +163,36 @@ def seam_variants(view, seam, X_IT, X_PE, *, samples: int = VARIANT_SAMPLES) -> 
     R_IE = G @ M_all
     A, rows = phi.shape
     X_BE = base_poses(inputs.X_IB, p_IE.reshape(-1, 3), R_IE.reshape(-1, 3, 3))
+    excess = reach_excess(robot, X_BE).reshape(A, rows)
+    beyond = reach_excess(robot, X_BE, inner=False).reshape(A, rows) > UNREACHABLE_M
+    if beyond.all(axis=0).any():  # a row beyond the arm's stretch on every turn
+        return _unreachable(angles, sigma, excess)
     solutions = robot.inverse(X_BE).reshape(A, rows, 8, 6).transpose(0, 2, 1, 3)
-    return _judged(robot, angles, sigma, solutions, X_BE.reshape(A, rows, 4, 4))
+    return _judged(robot, angles, sigma, solutions, excess)
 
 
-def _judged(robot, angles, sigma, solutions, X_BE) -> SeamVariants:
+def _unreachable(angles, sigma, excess) -> SeamVariants:
+    """The variants of a seam with a row beyond the arm's reach on every tool turn:
+    no IK needed to rule it out (``reach_excess`` without the closed form)."""
+    A, rows = excess.shape
+    none = np.zeros((A, 8), dtype=bool)
+    share = np.repeat((excess <= 0.0).mean(axis=1)[:, None], 8, axis=1)
+    return SeamVariants(
+        angles=angles,
+        sigma=sigma,
+        q=np.full((A, 8, rows, 6), np.nan),
+        reach_share=share,
+        reach=none,
+        within=none,
+        flips=none,
+        margin=np.full((A, 8), -np.inf),
+        reach_excess=excess[:, 1:-1],
+    )
+
+
+def _judged(robot, angles, sigma, solutions, excess) -> SeamVariants:
     """The verdicts of (A, 8, N + 2, 6) solutions (``path_ik.branch_results`` for every
-    variant at once)."""
-    from offline_prog.joints.path_ik import reach_excess
-
+    variant at once); excess: (A, N + 2) each pose's distance beyond reach [m]."""
     A, _, rows, _ = solutions.shape
     reachable = ~np.isnan(solutions).any(axis=-1)  # (A, 8, rows)
     filled = np.where(reachable[..., None], solutions, 0.0)
@@ -194,7 +223,6 @@ def _judged(robot, angles, sigma, solutions, X_BE) -> SeamVariants:
     steps = np.abs(step[:, :, 1 : rows - 2]).max(axis=-1)  # the seam's own steps
     both = reachable[:, :, 1 : rows - 2] & reachable[:, :, 2 : rows - 1]
     flips = ((steps > limit) & both).any(axis=-1)
-    excess = reach_excess(robot, X_BE[:, seam].reshape(-1, 4, 4)).reshape(A, -1)
     return SeamVariants(
         angles=angles,
         sigma=sigma,
@@ -204,5 +232,5 @@ def _judged(robot, angles, sigma, solutions, X_BE) -> SeamVariants:
         within=(margin >= 0.0) & ends_inside,
         flips=flips,
         margin=margin,
-        reach_excess=excess,
+        reach_excess=excess[:, seam],
     )
