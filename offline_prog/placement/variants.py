@@ -22,17 +22,16 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.joints.joint_plan import ROTATION_STEP_RAD, ROTATION_TRIAL_POINTS
+from offline_prog.joints.joint_plan import ROTATION_STEP_RAD, rotation_trial_points
 from offline_prog.joints.path_ik import (
     MAX_JOINT_STEP_RAD,
     base_poses,
-    best_turns,
+    branch_table,
     reach_excess,
 )
 from offline_prog.path.fixed_tcp import part_in_tool
 from offline_prog.stages import smooth_turn
 
-TWO_PI = 2.0 * np.pi
 # σ samples of a seam's screen: the joint speed bound sums |Δq| between them, which
 # only grows with more samples (it stays a bound however coarse).
 VARIANT_SAMPLES = 64
@@ -167,7 +166,7 @@ def seam_variants(view, seam, X_IT, X_PE, *, samples: int = VARIANT_SAMPLES) -> 
     beyond = reach_excess(robot, X_BE, inner=False).reshape(A, rows) > UNREACHABLE_M
     if beyond.all(axis=0).any():  # a row beyond the arm's stretch on every turn
         return _unreachable(angles, sigma, excess)
-    solutions = robot.inverse(X_BE).reshape(A, rows, 8, 6).transpose(0, 2, 1, 3)
+    solutions = robot.inverse(X_BE).reshape(A, rows, 8, 6)
     return _judged(robot, angles, sigma, solutions, excess)
 
 
@@ -191,46 +190,29 @@ def _unreachable(angles, sigma, excess) -> SeamVariants:
 
 
 def _judged(robot, angles, sigma, solutions, excess) -> SeamVariants:
-    """The verdicts of (A, 8, N + 2, 6) solutions (``path_ik.branch_results`` for every
-    variant at once); excess: (A, N + 2) each pose's distance beyond reach [m]."""
-    A, _, rows, _ = solutions.shape
-    reachable = ~np.isnan(solutions).any(axis=-1)  # (A, 8, rows)
-    filled = np.where(reachable[..., None], solutions, 0.0)
-    step = np.diff(filled, axis=2)
-    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
-    q = np.concatenate([filled[:, :, :1], filled[:, :, :1] + np.cumsum(step, axis=2)], axis=2)
+    """The verdicts of (A, N + 2, 8, 6) solutions (``path_ik.branch_table``, the turns
+    and margins along the seam's rows); excess: (A, N + 2) each pose's distance beyond
+    reach [m]."""
+    rows = solutions.shape[1]
+    # The planner tests continuity on rotation_trial_points samples: the same rate of
+    # turn [rad/m] on this grid (a flip is a jump of about π, far beyond it).
+    spacing = sigma[1] - sigma[0] if len(sigma) > 1 else 1.0
+    trial = sigma[-1] / (rotation_trial_points(sigma[-1]) - 1) if sigma[-1] > 0 else spacing
+    limit = min(np.pi / 2, MAX_JOINT_STEP_RAD * spacing / trial)
     seam = slice(1, rows - 1)
-    flat = q.reshape(A * 8, rows, 6)
-    mask = reachable.reshape(A * 8, rows, 1)
-    # The 2π turns of the widest margin along the seam (as the planner picks them);
-    # the approach's start and the retract's end follow the seam continuously.
-    offsets, margins = best_turns(
-        robot.controller_joints(np.where(mask, flat, np.nan)[:, seam]),
-        robot.q_lower,
-        robot.q_upper,
-    )
-    q = (flat + offsets[:, None, :]).reshape(A, 8, rows, 6)
-    q = np.where(reachable[..., None], q, np.nan)
-    margin = margins.min(axis=1).reshape(A, 8)
+    table = branch_table(robot, solutions, max_step=limit, rows=seam)
+    q = np.where(table.reachable[..., None], table.q, np.nan)
     q_c = robot.controller_joints(q[:, :, [0, -1]])
     with np.errstate(invalid="ignore"):
         ends_inside = ((q_c >= robot.q_lower) & (q_c <= robot.q_upper)).all(axis=(-1, -2))
-    # The planner tests continuity on ROTATION_TRIAL_POINTS samples: the same rate of
-    # turn [rad/m] on this grid (a flip is a jump of about π, far beyond it).
-    spacing = sigma[1] - sigma[0] if len(sigma) > 1 else 1.0
-    trial = sigma[-1] / (ROTATION_TRIAL_POINTS - 1) if sigma[-1] > 0 else spacing
-    limit = min(np.pi / 2, MAX_JOINT_STEP_RAD * spacing / trial)
-    steps = np.abs(step[:, :, 1 : rows - 2]).max(axis=-1)  # the seam's own steps
-    both = reachable[:, :, 1 : rows - 2] & reachable[:, :, 2 : rows - 1]
-    flips = ((steps > limit) & both).any(axis=-1)
     return SeamVariants(
         angles=angles,
         sigma=sigma,
         q=q,
-        reach_share=reachable.mean(axis=-1),
-        reach=reachable.all(axis=-1),
-        within=(margin >= 0.0) & ends_inside,
-        flips=flips,
-        margin=margin,
+        reach_share=table.reachable.mean(axis=-1),
+        reach=table.reachable.all(axis=-1),
+        within=(table.margin >= 0.0) & ends_inside,
+        flips=table.first_jump >= 0,
+        margin=table.margin,
         reach_excess=excess[:, seam],
     )
