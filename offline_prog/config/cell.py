@@ -244,7 +244,7 @@ class PlaceConfig:
 
     X_IT: PoseRanges = dataclasses.field(default_factory=PoseRanges)
     X_PE: GraspRanges | None = None
-    budget: int = 200  # full evaluations (the planning pipeline minus the exports)
+    budget: int = 16  # candidates planned in full (the planning pipeline minus the exports)
     seed: int = 0
     screen_points: int = 1000  # grid points screened by the analytic path IK, per grasp
     top_k: int = 10  # candidates listed in placement.json

@@ -201,7 +201,7 @@ def tool_rotations(
         return flanges
     # Every φ₀'s trial poses through the analytic IK at once (per-call overhead, not
     # arithmetic, dominates 400 poses), then each φ₀'s branches.
-    X_BE = np.concatenate([base_poses(X_IB, *flange.poses(s)) for _, flange in flanges])
+    X_BE = _trial_poses(flanges, s, X_IB, X_PE, fixed_turn=smooth_turn is None)
     solutions = robot.inverse(X_BE).reshape(len(flanges), len(s), 8, 6)
     table = branch_table(robot, solutions)  # every turn's branches at once
     ranked = []
@@ -209,6 +209,25 @@ def tool_rotations(
         ranked.append((_turn_score(robot, table, a), -abs(phi), phi, flange))
     ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)
     return [(phi, flange) for _, _, phi, flange in ranked]
+
+
+def _trial_poses(flanges, s: np.ndarray, X_IB, X_PE, *, fixed_turn: bool) -> np.ndarray:
+    """(A·N, 4, 4) every turn's flange poses X_BE at s (N,): each FlangePath's own
+    ``poses`` numbers; for fixed turns from one look-up of the part's side of the path
+    (``part_in_tool``) instead of one per turn."""
+    from offline_prog.path.fixed_tcp import part_in_tool
+
+    if not fixed_turn:
+        return np.concatenate([base_poses(X_IB, *flange.poses(s)) for _, flange in flanges])
+    path, normal = flanges[0][1].path, flanges[0][1].normal
+    _, _, p_TE_T, _, _, M, _, _ = part_in_tool(path, normal, X_PE, s)
+    poses = []
+    for _, flange in flanges:  # FlangePath.poses' own arithmetic (einsum's rounding
+        # depends on its operands' layout): bit for bit the same poses
+        G = np.broadcast_to(flange.X_IT.rotation().matrix(), (len(s), 3, 3))
+        p_IE = flange.X_IT.translation() + np.einsum("nij,nj->ni", G, p_TE_T)
+        poses.append(base_poses(X_IB, p_IE, G @ M))
+    return np.concatenate(poses)
 
 
 def _turn_score(robot: RobotModel, table, a: int) -> tuple:

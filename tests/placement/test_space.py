@@ -29,7 +29,7 @@ def _variant(tmp_path, old: str, new: str):
         ("x: [700, 1900]", "x: []", "place.X_IT.translation_mm.x", "expected [low, high]"),
         ("yaw: [0, 60]", "yaw: [60, 0]", "place.X_IT.rpy_deg.yaw", "inverted range"),
         ("yaw: [0, 60]", "spin: [0, 60]", "place.X_IT.rpy_deg.spin", "unknown key"),
-        ("budget: 200", "budget: 0", "place.budget", "outside 1..100,000"),
+        ("budget: 16", "budget: 0", "place.budget", "outside 1..100,000"),
         # numpy takes seeds below 2³², and CMA-ES gets seed + 1 + its restarts
         ("seed: 0", "seed: 4294967295", "place.seed", "outside 0..2,147,483,647"),
         ("seed: 0", "seed: -1", "place.seed", "outside 0..2,147,483,647"),
