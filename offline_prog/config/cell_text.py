@@ -41,7 +41,8 @@ def _find(root, dotted: str):
     node = root
     for part in dotted.split("."):
         if part.isdigit():
-            node = node.value[int(part)] if isinstance(node, yaml.SequenceNode) else None
+            items = node.value if isinstance(node, yaml.SequenceNode) else []
+            node = items[int(part)] if int(part) < len(items) else None
         else:
             node = _child(node, part)
         if node is None:
