@@ -118,6 +118,9 @@ class DaskEngine:
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
+                    # The scheduler's HTTP server on a free port: on 8787, taken by
+                    # another cluster, it warns on stderr (place says one line there).
+                    scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
                     silence_logs=quiet,
                 )
             self.client = Client(self.cluster)
