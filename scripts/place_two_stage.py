@@ -84,7 +84,7 @@ def compare(file: Path, screen_points: int, workers: int) -> bool:
         two, two_wall, two_cpu = timed(
             engine, lambda: search(space, place, space.baseline, engine.map)
         )
-        grid = [space.baseline, *space.grid(screen_points)]
+        grid = [space.baseline, *space.grid(screen_points, place.seed)]
         every, full_wall, full_cpu = timed(engine, lambda: engine.map("plan", grid))
     finally:
         engine.close()

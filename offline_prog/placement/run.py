@@ -4,8 +4,8 @@ gripper should hold the part (the paper's outlook), one named stage per line.
 1. ``load``: the cell and its ``place:`` block checked (bad input: one line, exit 2).
 2. ``engine``: a Dask LocalCluster (one worker per core), the cluster at
    ``--scheduler``, or this process (``--workers 0``); the cell sent to it once.
-3. ``search``: the grid screen and CMA-ES on the planning pipeline
-   (:mod:`~offline_prog.placement.search`).
+3. ``search``: the grid screened, its best ranked by a cheaper law, the few that can
+   win planned in full (:mod:`~offline_prog.placement.search`).
 4. ``outputs``: placement.json, placed.yaml, best_preview.html and placement.html,
    written into a fresh folder that replaces ``--out`` only when all are written.
 """

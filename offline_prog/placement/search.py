@@ -1,7 +1,8 @@
 """The placement search in two stages: every candidate screened cheaply and soundly, a
 few planned in full (issue 40).
 
-1. ``screen``: a regular grid over the ranges, every grasp (``SearchSpace.grid``),
+1. ``screen``: a regular grid over the ranges, every grasp (``SearchSpace.grid``:
+   the seed shifts it within its cells),
    each candidate by ``placement.screen`` (~30 ms a seam): ruled out where no tool
    turn and branch the planner may take reaches the path or keeps it inside the
    joint limits, or its stand cannot stand; else its cycle time's lower bound and a
@@ -106,7 +107,7 @@ def search(
         run: evaluates a batch with a stage ("screen" | "rank" | "plan"), in order.
     """
     start = time.perf_counter()
-    base_screen, *screened = run("screen", [baseline, *space.grid(place.screen_points)])
+    base_screen, *screened = run("screen", [baseline, *space.grid(place.screen_points, place.seed)])
     fates = [e.screened_out for e in screened]
     open_ = sorted(
         (i for i, e in enumerate(screened) if not e.screened_out),

@@ -98,18 +98,21 @@ class SearchSpace:
         X_IT, X_PE = (_rounded(poses[k]) for k in ("X_IT", "X_PE"))
         return Candidate(tuple(float(u) for u in x), int(grasp), X_IT, X_PE)
 
-    def grid(self, points_per_grasp: int) -> list[Candidate]:
+    def grid(self, points_per_grasp: int, seed: int = 0) -> list[Candidate]:
         """A regular grid of about ``points_per_grasp`` points (k levels per axis,
-        k^d ≤ points, k ≥ 2, cell-centred) for every grasp."""
+        k^d ≤ points, k ≥ 2) for every grasp: cell-centred for seed 0, the whole
+        lattice shifted within its cell by a seeded offset (each axis its own, up to
+        half a cell) for another seed, so seeds sample other placements."""
         d = self.dimensions
         if d == 0:
             return [self.candidate([], g) for g in range(len(self.grasps))]
         k = max(2, int(math.floor(points_per_grasp ** (1.0 / d) + 1e-9)))
-        levels = (np.arange(k) + 0.5) / k
+        shift = np.zeros(d) if seed == 0 else np.random.default_rng(seed).uniform(-0.5, 0.5, d)
+        levels = (np.arange(k)[:, None] + 0.5 + shift[None, :]) / k  # (k, d)
         return [
-            self.candidate(x, g)
+            self.candidate(levels[list(index), range(d)], g)
             for g in range(len(self.grasps))
-            for x in itertools.product(levels, repeat=d)
+            for index in itertools.product(range(k), repeat=d)
         ]
 
 
