@@ -11,9 +11,10 @@ budget and the same grid of candidates (``--screen-points`` per grasp):
 2. every candidate of that grid (and the cell as given) planned in full.
 
 Printed: each one's best objective (feasible, quality share within the band, cycle
-time to its resolution), wall time and CPU time (this process and the workers), the
-machine's load; whether the two objectives are equal and the two-stage search's share
-of the full one's wall time (the acceptance: equal, at most a third).
+time), wall time and CPU time (this process and the workers), the machine's load;
+whether the two objectives are equal (the share and the cycle time each within its
+resolution) and the two-stage search's share of the full one's wall time (the
+acceptance: equal, at most a third).
 """
 
 from __future__ import annotations
@@ -44,13 +45,19 @@ ROOT = Path(__file__).resolve().parents[1]
 DEMOS = sorted((ROOT / "cells" / "placement").glob("*.yaml"))
 
 
-def objective(e: Evaluation) -> tuple:
-    """What the acceptance compares: feasible, quality share and cycle time, each to
-    its resolution (the margins that break ties are left out)."""
-    if not e.feasible:
-        return (False,)
-    share = e.quality_share if math.isfinite(e.quality_share) else 1.0
-    return (True, round(share / QUALITY_RESOLUTION), round(e.cycle_time_s / CYCLE_RESOLUTION_S))
+def same_objective(a: Evaluation, b: Evaluation) -> bool:
+    """What the acceptance compares: both feasible or not; the quality share within the
+    band and the cycle time each within its resolution of the other (the margins that
+    break ties are left out)."""
+    if a.feasible != b.feasible:
+        return False
+    if not a.feasible:
+        return True
+    share_a, share_b = (e.quality_share if math.isfinite(e.quality_share) else 1.0 for e in (a, b))
+    return (
+        abs(share_a - share_b) <= QUALITY_RESOLUTION
+        and abs(a.cycle_time_s - b.cycle_time_s) <= CYCLE_RESOLUTION_S
+    )
 
 
 def cpu_s(engine: DaskEngine) -> float:
@@ -89,7 +96,7 @@ def compare(file: Path, screen_points: int, workers: int) -> bool:
     finally:
         engine.close()
     best = min(every, key=Evaluation.key)
-    same = objective(two.best) == objective(best)
+    same = same_objective(two.best, best)
     print(f"== {file.stem}: {len(grid)} candidates, budget {place.budget}, seed {place.seed}")
     print(
         f"  two stages:     {describe(two.best):<36} {two_wall:7.1f} s wall {two_cpu:7.1f} s CPU"
