@@ -139,28 +139,17 @@ def _serve_preview(plan, args, console: Console) -> None:
         time.sleep(0.2)
 
 
+OUT = ("reach", "joint_limit", "stand", "collision")  # placement's screened-out fates
+
+
 def _run_place(args, console: Console, errors: Console) -> str:
     """``place``: the search with a progress bar on stderr, then a short summary.
     Returns "" or, when no candidate was feasible, the one line saying so."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
-
+    from offline_prog.cli_progress import PlaceProgress
     from offline_prog.placement.run import place_cell
 
     out = args.out or Path("out") / f"{args.cell.stem}_place"
-    labels = {
-        "screen": "screening (path IK)",
-        "plan": "planning candidates",
-        "outputs": "writing outputs",
-    }
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
-    with Progress(*columns, console=errors, transient=True) as bar:
-        tasks = {}
-
-        def progress(stage: str, done: int, total: int) -> None:
-            if stage not in tasks:
-                tasks[stage] = bar.add_task(labels[stage], total=total)
-            bar.update(tasks[stage], completed=done)
-
+    with PlaceProgress(errors, console) as progress:
         data = place_cell(
             args.cell,
             out,
@@ -191,7 +180,8 @@ def _run_place(args, console: Console, errors: Console) -> str:
     if cut.get("why_not_more"):
         console.print(f"  why not more: {cut['why_not_more']}", highlight=False, markup=False)
     console.print(
-        f"{engine['candidates_evaluated']} candidates planned, {engine['screened']} screened, "
+        f"{engine['candidates_evaluated']} candidates planned in full of {engine['screened']} "
+        "screened, "
         f"{engine['wall_time_s']:.1f} s on {engine['workers']} worker(s) "
         f"({engine['scheduler']}); wrote into {out}: {wrote}",
         highlight=False,
@@ -199,9 +189,13 @@ def _run_place(args, console: Console, errors: Console) -> str:
     )
     if best["feasible"]:
         return ""
+    fates, planned = data["screening"]["fates"], engine["candidates_evaluated"]
+    out_by = ", ".join(f"{n} by {k.replace('_', ' ')}" for k, n in fates.items() if n and k in OUT)
     return (
-        f"error: {args.cell}: no feasible placement in {engine['candidates_evaluated']} "
-        f"candidates; the closest: {best['reason']} (see {out}/placement.html)"
+        f"error: {args.cell}: no feasible placement in {planned} candidate"
+        f"{'' if planned == 1 else 's'} planned"
+        + (f" ({out_by} screened out)" if out_by else "")
+        + f"; the closest: {best['reason']} (see {out}/placement.html)"
     )
 
 

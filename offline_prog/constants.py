@@ -46,10 +46,10 @@ MAX_SPEED_M_S = 2.0  # motion.speed: process speeds are mm/s to ~1 m/s; above is
 MAX_VALUE_CHARS = 80  # a value quoted in an error message is cut to this
 MAX_PAYLOAD_KG = 1000.0  # gripper.mass_kg, part.mass_kg: beyond any arm this package drives
 MAX_CENTER_OF_MASS_MM = 5000.0  # |center_of_mass_mm| from its frame's origin
-# place.budget / --budget: full evaluations; 10⁵ × ~0.5 s is a day on one core.
+# place.budget / --budget: candidates planned in full; 10⁵ × ~2 s is days on one core.
 MAX_PLACE_BUDGET = 100_000
-# place.seed / --seed: the search seeds CMA-ES with seed + 1 + its restarts (at most one
-# per evaluation), and numpy takes seeds below 2³²: this bound leaves room for them.
+# place.seed / --seed: seeds the shift of the placement search's grid (numpy takes seeds
+# below 2³²; the bound is the one the search has always had).
 MAX_PLACE_SEED = 2**31 - 1
 # A work cell is smaller than this across: a mesh larger, or a pose farther from its
 # frame's origin, is a unit slip (mm read as m: 1000×; config.unit_slips).

@@ -1,13 +1,15 @@
 """Benchmark: the placement search (issue 16), its acceptance figures.
 
-Run: ``python scripts/bench_place.py [--budget 200] [--seeds 5] [--candidates 32]``
-(``python scripts/bench.py --only place``). In one process, on this machine:
+Run: ``python scripts/bench_place.py [--budget 16] [--seeds 5] [--candidates 32]
+[--only demo]`` (``python scripts/bench.py --only place``). On this machine:
 
+0. the README's demo command in a fresh process on 2 workers: wall and CPU time, and
+   the load average (the machine may be shared);
 1. a poor X_IT (cells/placement/seal_out_of_reach_kr16.yaml: the nozzle beyond reach):
    ``place`` finds a feasible placement and ``plan`` on placed.yaml succeeds;
 2. feasible cells: the cut of the cycle time (≥ 15 %, or the report's reason why not)
    on cells/placement/seal_far_kr16.yaml, on the seal demo with a place: block and on
-   the whole job cells/placement/seal_job_far_kr16.yaml (budget ≤ 60);
+   the whole job cells/placement/seal_job_far_kr16.yaml (budget ≤ 12);
 3. five seeds on seal_far: the best objectives' spread (≤ 2 %);
 4. candidates per second through the planning pipeline, in this process and on a
    2-worker LocalCluster (after each worker has loaded the cell), the parallel
@@ -20,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -38,7 +42,7 @@ CELLS = ROOT / "cells"
 OUT_OF_REACH = CELLS / "placement" / "seal_out_of_reach_kr16.yaml"
 FAR = CELLS / "placement" / "seal_far_kr16.yaml"
 JOB = CELLS / "placement" / "seal_job_far_kr16.yaml"
-JOB_BUDGET = 60  # a job's candidate is ~3 s
+JOB_BUDGET = 12  # a job's candidate is ~4 s
 SEEDS = range(5)
 THROUGHPUT_CANDIDATES = 32
 
@@ -113,7 +117,7 @@ def bad_input(folder: Path) -> None:
     cases = {
         "empty range": text.replace("x: [700, 1900]", "x: [700, 700]"),
         "inverted range": text.replace("x: [700, 1900]", "x: [1900, 700]"),
-        "budget 0 (file)": text.replace("budget: 200", "budget: 0"),
+        "budget 0 (file)": text.replace("budget: 16", "budget: 0"),
     }
     runs = []
     for name, variant in cases.items():
@@ -137,6 +141,31 @@ def bad_input(folder: Path) -> None:
         )
 
 
+def demo(folder: Path) -> None:
+    """The README's demo as a user runs it (a fresh process, 2 workers, output piped):
+    its wall time, the CPU time of it and its worker processes, and the machine's
+    load average before and after (the machine may be shared)."""
+    before = os.getloadavg()
+    start_cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    command = [sys.executable, "-m", "offline_prog", "place", str(OUT_OF_REACH)]
+    done = subprocess.run(
+        [*command, "--out", str(folder / "demo"), "--workers", "2"],
+        capture_output=True,
+        text=True,
+    )
+    wall = time.perf_counter() - start
+    end_cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (end_cpu.ru_utime - start_cpu.ru_utime) + (end_cpu.ru_stime - start_cpu.ru_stime)
+    after = os.getloadavg()
+    print(f"  exit {done.returncode}: {done.stdout.strip().splitlines()[-2]}")
+    print(
+        f"  wall {wall:.1f} s (acceptance < 60 s), CPU {cpu:.1f} s (the command and its "
+        f"workers); load average {before[0]:.2f} before, {after[0]:.2f} after on "
+        f"{os.cpu_count()} cores"
+    )
+
+
 def replanned(placed: Path) -> str:
     """``plan`` of a placed.yaml: feasible and cycle time, or why there is none."""
     if not placed.is_file():
@@ -147,7 +176,7 @@ def replanned(placed: Path) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--budget", type=int, default=200, help="candidates per search (200)")
+    parser.add_argument("--budget", type=int, default=16, help="candidates per search (16)")
     parser.add_argument("--seeds", type=int, default=len(SEEDS), help="seeds on seal_far (5)")
     parser.add_argument(
         "--candidates",
@@ -155,9 +184,14 @@ def main() -> None:
         default=THROUGHPUT_CANDIDATES,
         help=f"candidates of the throughput figure ({THROUGHPUT_CANDIDATES})",
     )
+    parser.add_argument("--only", choices=["demo"], help="only the README's demo command")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
+        print("== the demo: offline-prog place seal_out_of_reach_kr16.yaml, 2 workers ==")
+        demo(folder)
+        if args.only:
+            return
         print(f"== place: budget {args.budget}, 2-worker LocalCluster ==")
         data = search(OUT_OF_REACH, folder / "oor", args.budget)
         show("seal_out_of_reach_kr16", data)

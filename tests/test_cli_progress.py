@@ -101,3 +101,43 @@ def test_plan_shows_progress_on_a_terminal_and_not_in_a_pipe(tmp_path):
     assert piped.returncode == 0
     assert "seam 1/4" not in piped.stdout + piped.stderr
     assert piped.stderr == "" and piped.stdout.startswith("seal_job_kr16")
+
+
+def test_place_says_where_it_is_in_plain_lines_when_piped():
+    """Piped (not a terminal), ``place``'s progress is a plain line per stage at its
+    start, every LINE_INTERVAL_S while it runs and at its end, on the line console
+    (stdout): a log shows it is alive; stderr keeps its one line for an error."""
+    from offline_prog.cli_progress import LINE_INTERVAL_S, PlaceProgress
+
+    bars, lines = io.StringIO(), io.StringIO()
+    now = [0.0]
+    progress = PlaceProgress(
+        Console(file=bars, force_terminal=False),
+        Console(file=lines, force_terminal=False, width=200),
+        clock=lambda: now[0],
+    )
+    with progress:
+        for done in range(1, 101):  # the screen: a candidate every 0.5 s
+            now[0] += 0.5
+            progress("screen", done, 100)
+        progress("plan", 1, 16)
+    said = lines.getvalue().splitlines()
+    screen = [line for line in said if "screening" in line]
+    assert screen[0].startswith("place: screening") and screen[0].endswith("1/100 (0 s)")
+    assert screen[-1].endswith("100/100 (50 s)")
+    assert len(screen) == 2 + int(50 / LINE_INTERVAL_S) - 1  # start, every 10 s, end
+    assert said[-1].startswith("place: planning candidates in full 1/16")
+    assert bars.getvalue() == ""  # no bar drawn into a pipe
+
+
+def test_place_draws_bars_on_a_terminal_and_no_lines():
+    from offline_prog.cli_progress import PlaceProgress
+
+    bars, lines = io.StringIO(), io.StringIO()
+    with PlaceProgress(
+        Console(file=bars, force_terminal=True, width=120), Console(file=lines)
+    ) as p:
+        p("screen", 10, 100)
+        p.bar.refresh()
+    assert "screening" in bars.getvalue() and "10/100" in bars.getvalue()
+    assert lines.getvalue() == ""

@@ -54,7 +54,7 @@ TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlappi
 OWNER_ORDER = ("part", "tool", "robot", "obstacle")
 
 
-class _Pairs:
+class CheckedPairs:
     """The unfiltered geometry pairs g of a cell, grouped into shape pairs s, and their
     signed distances at a joint vector (Drake) or on the original shapes (FCL)."""
 
@@ -176,7 +176,7 @@ def check_trajectory(
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"{name}: expected a distance >= 0 m, got {value!r}")
     start = time.perf_counter()
-    pairs, rho = _Pairs(cell, fixed_layout=True), cell.motion_radii()
+    pairs, rho = CheckedPairs(cell, fixed_layout=True), cell.motion_radii()
     clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
     clear_s = np.where(pairs.is_fixed, 0.0, clear_s)  # a base on its floor touches it
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from offline_prog.collision.check import _Pairs
+from offline_prog.collision.check import CheckedPairs
 from offline_prog.scene.drake_cell import DrakeCell
 
 REACH_M = 0.25  # pairs farther apart than this are not measured at a configuration
@@ -33,7 +33,7 @@ class MotionChecker:
     """
 
     def __init__(self, cell: DrakeCell, *, clearance: float, self_clearance: float):
-        self.pairs = pairs = _Pairs(cell, fixed_layout=True)
+        self.pairs = pairs = CheckedPairs(cell, fixed_layout=True)
         clear_s = np.where(pairs.is_self, self_clearance, clearance)
         moving = pairs.c > 0  # the fixed layout does not move: checked with the seams
         clear_g = clear_s[pairs.shape_of]

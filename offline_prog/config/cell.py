@@ -252,12 +252,14 @@ class PlaceConfig:
 
     X_IT: PoseRanges = dataclasses.field(default_factory=PoseRanges)
     X_PE: GraspRanges | None = None
-    budget: int = 200  # full evaluations (the planning pipeline minus the exports)
+    budget: int = 16  # candidates planned in full (the planning pipeline minus the exports)
     seed: int = 0
     screen_points: int = 1000  # grid points screened by the analytic path IK, per grasp
     top_k: int = 10  # candidates listed in placement.json
-    # Obstacles that stand with the tool (its stand): moved with X_IT.
+    # Obstacles that stand with the tool (its stand): moved with X_IT, their foot kept
+    # on the floor by their length (placement.stand), up to stand_max_length_mm.
     moves_with_tool: list[str] = dataclasses.field(default_factory=list)
+    stand_max_length_mm: float = 2000.0
 
 
 @dataclasses.dataclass

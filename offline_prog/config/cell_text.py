@@ -44,7 +44,8 @@ def _find(root, dotted: str):
     node = root
     for part in dotted.split("."):
         if part.isdigit():
-            node = node.value[int(part)] if isinstance(node, yaml.SequenceNode) else None
+            items = node.value if isinstance(node, yaml.SequenceNode) else []
+            node = items[int(part)] if int(part) < len(items) else None
         else:
             node = _child(node, part)
         if node is None:
@@ -155,16 +156,22 @@ def edited_text(text: str, initial: CellValues, state: CellValues) -> str:
     return edits.result()
 
 
-def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> str:
-    """The cell file's ``text`` with transforms and text values replaced in place.
+def with_values(
+    text: str, poses: dict[str, tuple], strings: dict[str, str], numbers: dict | None = None
+) -> str:
+    """The cell file's ``text`` with transforms, text values and numbers replaced in
+    place.
 
     Args:
         poses: {dotted key (``tool.X_IT``, ``obstacles.2.pose``): (p [m], rpy [deg])};
             a key the file leaves out (an obstacle at the origin) is added.
-        strings: {dotted key: new text} (file names: written quoted).
+        strings: {dotted key: new text} (file names: written quoted); a top-level key
+            the file leaves out (``description``) is added.
+        numbers: {dotted key (``obstacles.1.size_mm.2``): new number}.
 
     Raises:
-        ValueError: a key of ``strings`` is not in the text, or a pose's mapping is not.
+        ValueError: a key of ``strings`` or ``numbers`` is not in the text, or a pose's
+            mapping is not.
     """
     root = yaml.compose(text, Loader=yaml.SafeLoader)
     edits = _Edits(text)
@@ -184,10 +191,18 @@ def with_values(text: str, poses: dict[str, tuple], strings: dict[str, str]) -> 
             _transform(edits, node, p, rpy_deg)
     for key, value in strings.items():
         node = _find(root, key)
+        if node is None and "." not in key and isinstance(root, yaml.MappingNode):
+            edits.add(root, key, json.dumps(value))
+            continue
         if node is None:
             raise ValueError(f"{key} not found in the cell file")
         if node.value != value:  # unchanged text stays as written
             edits.replace(node, json.dumps(value))
+    for key, value in (numbers or {}).items():
+        node = _find(root, key)
+        if not isinstance(node, yaml.ScalarNode):
+            raise ValueError(f"{key} not found in the cell file")
+        edits.scalar(node, value)
     return edits.result()
 
 
@@ -218,20 +233,29 @@ def data_file_keys(cell: Cell) -> dict[str, str]:
     return keys
 
 
-def relocated_text(cell_file: Path, cell: Cell, out_dir: Path, poses: dict[str, tuple]) -> str:
-    """The cell file's text with ``poses`` written in (see :func:`with_values`), to be
-    written into ``out_dir``: its data files and ``robot.robots_dir`` re-pointed from
-    there (unchanged when ``out_dir`` is the cell file's own folder)."""
+def relocated_text(
+    cell_file: Path,
+    cell: Cell,
+    out_dir: Path,
+    poses: dict[str, tuple],
+    strings: dict[str, str] | None = None,
+    numbers: dict | None = None,
+) -> str:
+    """The cell file's text with ``poses``, ``strings`` and ``numbers`` written in (see
+    :func:`with_values`), to be written into ``out_dir``: its data files and
+    ``robot.robots_dir`` re-pointed from there (unchanged when ``out_dir`` is the cell
+    file's own folder)."""
     source, target = Path(cell_file).resolve().parent, Path(out_dir).resolve()
     names = dict(data_file_keys(cell))
     if cell.robot.robots_dir is not None:
         names["robot.robots_dir"] = cell.robot.robots_dir
-    strings = {
+    relocated = {
         key: os.path.relpath(source / name, target)
         for key, name in names.items()
         if source != target  # the same folder: every name stays as written
     }
-    return with_values(Path(cell_file).read_text(encoding="utf-8"), poses, strings)
+    text = Path(cell_file).read_text(encoding="utf-8")
+    return with_values(text, poses, relocated | (strings or {}), numbers)
 
 
 MAX_SAVES = 10_000

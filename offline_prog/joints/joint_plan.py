@@ -25,7 +25,9 @@ from offline_prog.joints.path_ik import (
     BranchResult,
     base_poses,
     branch_results,
+    branch_table,
     choose_branch,
+    first_outside,
     singularity_distances,
 )
 from offline_prog.process.timing_bound import ProcessCaps
@@ -136,9 +138,20 @@ class BranchPath:
         return JointRates(sigma, q, dq, ddq)
 
 
-# Step between tried tool rotations [rad] and the σ grid for trying them [points].
+# Step between tried tool rotations [rad] and the σ grid for trying them: a point every
+# ROTATION_TRIAL_SPACING_M, from ROTATION_MIN_TRIAL_POINTS (the continuity test sees a
+# full turn of the wrist in 3.6° steps) to ROTATION_TRIAL_POINTS (a long seam).
 ROTATION_STEP_RAD = np.deg2rad(5.0)
 ROTATION_TRIAL_POINTS = 400
+ROTATION_MIN_TRIAL_POINTS = 100
+ROTATION_TRIAL_SPACING_M = 3e-3
+
+
+def rotation_trial_points(length_m: float) -> int:
+    """How many σ samples :func:`tool_rotations` tries each turn on, for a path of
+    ``length_m`` [m]: the rotations' IK is most of a short seam's planning."""
+    wanted = int(np.ceil(length_m / ROTATION_TRIAL_SPACING_M)) + 1
+    return int(np.clip(wanted, ROTATION_MIN_TRIAL_POINTS, ROTATION_TRIAL_POINTS))
 
 
 def tool_rotations(
@@ -174,7 +187,7 @@ def tool_rotations(
             lo = hi = 0.5 * (lo + hi)
     count = int(np.ceil((hi - lo) / (2.0 * ROTATION_STEP_RAD)))
     angles = np.linspace(lo, hi, 2 * count + 1) if count else np.array([lo])
-    s = np.linspace(0.0, path.length, ROTATION_TRIAL_POINTS)
+    s = np.linspace(0.0, path.length, rotation_trial_points(path.length))
     flanges = []
     for phi in sorted(angles, key=abs):
         if smooth_turn is None:
@@ -188,15 +201,53 @@ def tool_rotations(
         return flanges
     # Every φ₀'s trial poses through the analytic IK at once (per-call overhead, not
     # arithmetic, dominates 400 poses), then each φ₀'s branches.
-    X_BE = np.concatenate([base_poses(X_IB, *flange.poses(s)) for _, flange in flanges])
+    X_BE = _trial_poses(flanges, s, X_IB, X_PE, fixed_turn=smooth_turn is None)
     solutions = robot.inverse(X_BE).reshape(len(flanges), len(s), 8, 6)
+    table = branch_table(robot, solutions)  # every turn's branches at once
     ranked = []
-    for (phi, flange), solved in zip(flanges, solutions, strict=True):
-        result = choose_branch(branch_results(robot, solutions=solved))
-        score = (result.feasible, result.margin_rad if result.feasible else result.sample)
-        ranked.append((score, -abs(phi), phi, flange))
+    for a, (phi, flange) in enumerate(flanges):
+        ranked.append((_turn_score(robot, table, a), -abs(phi), phi, flange))
     ranked.sort(key=lambda r: (r[0], r[1]), reverse=True)
     return [(phi, flange) for _, _, phi, flange in ranked]
+
+
+def _trial_poses(flanges, s: np.ndarray, X_IB, X_PE, *, fixed_turn: bool) -> np.ndarray:
+    """(A·N, 4, 4) every turn's flange poses X_BE at s (N,): each FlangePath's own
+    ``poses`` numbers; for fixed turns from one look-up of the part's side of the path
+    (``part_in_tool``) instead of one per turn."""
+    from offline_prog.path.fixed_tcp import part_in_tool
+
+    if not fixed_turn:
+        return np.concatenate([base_poses(X_IB, *flange.poses(s)) for _, flange in flanges])
+    path, normal = flanges[0][1].path, flanges[0][1].normal
+    _, _, p_TE_T, _, _, M, _, _ = part_in_tool(path, normal, X_PE, s)
+    poses = []
+    for _, flange in flanges:  # FlangePath.poses' own arithmetic (einsum's rounding
+        # depends on its operands' layout): bit for bit the same poses
+        G = np.broadcast_to(flange.X_IT.rotation().matrix(), (len(s), 3, 3))
+        p_IE = flange.X_IT.translation() + np.einsum("nij,nj->ni", G, p_TE_T)
+        poses.append(base_poses(X_IB, p_IE, G @ M))
+    return np.concatenate(poses)
+
+
+def _turn_score(robot: RobotModel, table, a: int) -> tuple:
+    """(feasible, its margin, or how far it gets) of turn a's best branch, as
+    ``choose_branch(branch_results(...))`` scores it, from the turns' BranchTable."""
+    feasible = table.feasible[a]
+    if feasible.any():
+        return True, float(table.margin[a][feasible].max())
+    best = None
+    for b in range(8):
+        margin = float(table.margin[a, b])
+        if not table.reachable[a, b].all():
+            sample, margin = int(table.first_unreachable[a, b]), -np.inf
+        elif table.first_jump[a, b] >= 0:
+            sample = int(table.first_jump[a, b])
+        else:  # a joint limit
+            joint = int(np.argmin(table.margins[a, b]))
+            sample = first_outside(robot, table.q[a, b], joint)
+        best = max(best or (sample, margin), (sample, margin))
+    return False, best[0]
 
 
 def _time_at(law: Sin2TimeLaw, sigma: float) -> float:

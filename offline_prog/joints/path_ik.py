@@ -85,6 +85,77 @@ def best_turns(q: np.ndarray, lower: np.ndarray, upper: np.ndarray):
     return offsets, np.take_along_axis(margin, best[..., None], axis=-1)[..., 0]
 
 
+@dataclasses.dataclass(frozen=True)
+class BranchTable:
+    """Every branch of one or many joint paths at once (the numbers of
+    :func:`branch_results`), leading batch dimensions ``...``.
+
+    Attributes:
+        q: (..., 8, N, 6) each branch unwrapped along the path with the 2π turns of its
+            widest limit margin [rad] (URDF order).
+        reachable: (..., 8, N) the sample has a solution on the branch.
+        margins: (..., 8, 6) each joint's smallest margin to its limits [rad] (over the
+            samples that choose the turns); margin: (..., 8) the smallest of them.
+        first_unreachable: (..., 8) the first sample without a solution (0 if none).
+        first_jump: (..., 8) the sample after the first step beyond ``max_step`` between
+            two solved samples (-1 if none).
+    """
+
+    q: np.ndarray
+    reachable: np.ndarray
+    margins: np.ndarray
+    margin: np.ndarray
+    first_unreachable: np.ndarray
+    first_jump: np.ndarray
+
+    @property
+    def feasible(self) -> np.ndarray:
+        """(..., 8) reachable everywhere, continuous and inside the limits."""
+        return self.reachable.all(axis=-1) & (self.first_jump < 0) & (self.margin >= 0)
+
+
+def branch_table(
+    robot: RobotModel,
+    solutions: np.ndarray,
+    *,
+    max_step: float = MAX_JOINT_STEP_RAD,
+    rows: slice = slice(None),
+) -> BranchTable:
+    """The branches of joint paths from their IK solutions (..., N, 8, 6) [rad]
+    (``robot.inverse``): each unwrapped along the path, each step taken as its
+    equivalent in [−π, π); the 2π turns with the widest margin over the samples
+    ``rows`` (the limits apply to the controller's axes: ABB's axis 3 = q2 + q3), and
+    the continuity test (``max_step``) on the steps between them (rows: consecutive
+    samples)."""
+    solutions = np.swapaxes(solutions, -3, -2)  # (..., 8, N, 6)
+    reachable = ~np.isnan(solutions).any(axis=-1)
+    filled = np.where(reachable[..., None], solutions, 0.0)
+    step = np.diff(filled, axis=-2)
+    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
+    q = np.concatenate([filled[..., :1, :], filled[..., :1, :] + np.cumsum(step, axis=-2)], axis=-2)
+    shape = q.shape
+    flat = q.reshape(-1, *shape[-2:])
+    chosen = np.where(reachable.reshape(-1, shape[-2])[..., None], flat, np.nan)[:, rows]
+    offsets, margins = best_turns(robot.controller_joints(chosen), robot.q_lower, robot.q_upper)
+    q = (flat + offsets[:, None, :]).reshape(shape)
+    margins = margins.reshape(*shape[:-2], 6)
+    n = shape[-2]
+    index = np.arange(n)[rows]
+    inside = index[1:]  # the steps between the samples of rows
+    jumps = (row_max(np.abs(step[..., inside - 1, :])) > max_step) & (
+        reachable[..., inside] & reachable[..., inside - 1]
+    )
+    first_jump = np.where(jumps.any(axis=-1), inside[np.argmax(jumps, axis=-1)], -1)
+    return BranchTable(
+        q,
+        reachable,
+        margins,
+        margins.min(axis=-1),
+        np.argmin(reachable, axis=-1),
+        first_jump,
+    )
+
+
 def branch_results(
     robot: RobotModel, X_BE: np.ndarray | None = None, *, solutions: np.ndarray | None = None
 ) -> list[BranchResult]:
@@ -92,30 +163,17 @@ def branch_results(
     ``solutions`` (N, 8, 6) [rad] (``robot.inverse(X_BE)``) when given."""
     if solutions is None:
         solutions = robot.inverse(X_BE)
-    solutions = np.swapaxes(solutions, 0, 1)  # (8, N, 6)
-    reachable = ~np.isnan(solutions).any(axis=-1)  # (8, N)
-    filled = np.where(reachable[..., None], solutions, 0.0)
-    # Unwrap along the path: each step taken as its equivalent in [−π, π).
-    step = np.diff(filled, axis=1)
-    step -= TWO_PI * np.floor((step + np.pi) / TWO_PI)
-    q = np.concatenate([filled[:, :1], filled[:, :1] + np.cumsum(step, axis=1)], axis=1)
-    # Limits apply to the joints as the controller counts them (ABB: axis 3 = q2 + q3).
-    offsets, margins = best_turns(
-        robot.controller_joints(np.where(reachable[..., None], q, np.nan)),
-        robot.q_lower,
-        robot.q_upper,
-    )
-    q = q + offsets[:, None, :]
-    steps = row_max(np.abs(step))  # (8, N−1)
+    table = branch_table(robot, solutions)
     results = []
     for b in range(8):
-        margin = float(margins[b].min())
-        if not reachable[b].all():
-            first = int(np.argmin(reachable[b]))
+        margin = float(table.margin[b])
+        q = table.q[b]
+        if not table.reachable[b].all():
+            first = int(table.first_unreachable[b])
             results.append(
                 BranchResult(
                     b,
-                    np.full_like(q[b], np.nan),
+                    np.full_like(q, np.nan),
                     False,
                     -np.inf,
                     "out of reach",
@@ -124,42 +182,43 @@ def branch_results(
                 )
             )
             continue
-        jumps = np.flatnonzero(
-            (steps[b] > MAX_JOINT_STEP_RAD) & reachable[b, 1:] & reachable[b, :-1]
-        )
-        if jumps.size:
+        if table.first_jump[b] >= 0:
             results.append(
                 BranchResult(
                     b,
-                    q[b],
+                    q,
                     False,
                     margin,
                     "singularity (the configuration flips)",
-                    int(jumps[0]) + 1,
+                    int(table.first_jump[b]),
                     Failure.SINGULARITY,
                 )
             )
             continue
         if margin < 0:
-            joint = int(np.argmin(margins[b]))
-            q_c = robot.controller_joints(q[b])
-            outside = (q_c[:, joint] < robot.q_lower[joint]) | (
-                q_c[:, joint] > robot.q_upper[joint]
-            )
+            joint = int(np.argmin(table.margins[b]))
             results.append(
                 BranchResult(
                     b,
-                    q[b],
+                    q,
                     False,
                     margin,
                     f"joint limit on axis {joint + 1}",
-                    int(np.argmax(outside)),
+                    first_outside(robot, q, joint),
                     Failure.JOINT_LIMIT,
                 )
             )
             continue
-        results.append(BranchResult(b, q[b], True, margin, "", -1))
+        results.append(BranchResult(b, q, True, margin, "", -1))
     return results
+
+
+def first_outside(robot: RobotModel, q: np.ndarray, joint: int) -> int:
+    """The first sample of a joint path q (N, 6) [rad] where ``joint`` is outside its
+    limits (the controller's axes)."""
+    q_c = robot.controller_joints(q)
+    outside = (q_c[:, joint] < robot.q_lower[joint]) | (q_c[:, joint] > robot.q_upper[joint])
+    return int(np.argmax(outside))
 
 
 def choose_branch(results: list[BranchResult]) -> BranchResult:
@@ -196,7 +255,7 @@ def singularity_distances(robot: RobotModel, q: np.ndarray, X_BE: np.ndarray) ->
     return {"wrist": wrist, "elbow": elbow, "shoulder": shoulder}
 
 
-def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
+def reach_excess(robot: RobotModel, X_BE: np.ndarray, *, inner: bool = True) -> np.ndarray:
     """How far each flange pose is out of the arm's reach [m] (0 inside it): the wrist
     centre's distance from the shoulder (axis 2) beyond the arm's longest stretch, or
     inside its shortest. A measure that keeps growing where the closed form only says
@@ -204,6 +263,9 @@ def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
 
     Args:
         X_BE: (N, 4, 4) flange poses in the robot base.
+        inner: count a wrist centre inside the shortest stretch too (an estimate:
+            the closed form reaches some such poses); without it, a pose with any
+            excess has no solution (the longest stretch is exact).
 
     Returns:
         (N,) [m]; zeros for a robot without a closed form.
@@ -227,4 +289,4 @@ def reach_excess(robot: RobotModel, X_BE: np.ndarray) -> np.ndarray:
     radial = np.sqrt(np.maximum(c[:, 0] ** 2 + c[:, 1] ** 2 - lateral**2, 0.0))
     h = c[:, 2] - height
     d = np.minimum(np.hypot(radial - offset, h), np.hypot(radial + offset, h))  # front, back
-    return np.maximum(d - longest, 0.0) + np.maximum(shortest - d, 0.0)
+    return np.maximum(d - longest, 0.0) + (np.maximum(shortest - d, 0.0) if inner else 0.0)

@@ -4,7 +4,7 @@ A worker unpacks the payload once (``payload.unpack``), loads it as ``plan`` doe
 fits each seam's path once: the seams do not move on the part, whatever the placement.
 A candidate's cell is the loaded one with its X_IT and X_PE (``session.state.apply``,
 which keeps every other value), and the obstacles that stand with the tool
-(``place.moves_with_tool``) moved with it.
+(``place.moves_with_tool``) moved with it, their foot on the floor (``placement.stand``).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from offline_prog.config.edits import CellValues, apply, initial_values, schema_
 from offline_prog.job.seams import job_seams, seam_inputs
 from offline_prog.placement.payload import CellPayload, unpack
 from offline_prog.placement.space import Candidate, Pose
+from offline_prog.placement.stand import PlacedStand, Stand, place_stands, stands
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import FittedPath, Inputs, fit_path, load_inputs
 
@@ -42,8 +43,8 @@ class Context:
     Attributes:
         inputs: the cell as given (a job's, for a job).
         seams: every seam (one for a ``path:`` cell, a one-seam job).
-        initial: the cell's own editable values; carried: indices of the obstacles
-            that stand with the tool.
+        initial: the cell's own editable values; stands: the obstacles that stand
+            with the tool, as given; stand_max_m: how long a stand may be made [m].
         fits: (seam index, reversed) ↦ fitted path, for ``plan_loaded_job``: each seam
             is fitted once per direction in this process, whatever the placement.
     """
@@ -51,7 +52,8 @@ class Context:
     inputs: Inputs
     seams: list[SeamView]
     initial: CellValues
-    carried: tuple[int, ...]
+    stands: list[Stand]
+    stand_max_m: float
     fits: dict[tuple[int, bool], FittedPath] = dataclasses.field(default_factory=dict)
 
 
@@ -72,10 +74,9 @@ def load_context(cell_file: Path) -> Context:
     inputs = load_inputs(cell_file, ROBOTS_DIR)
     cell = inputs.cell
     seams = [_seam(seam_inputs(inputs, k)) for k in range(len(job_seams(cell)))]
-    names = set(cell.place.moves_with_tool) if cell.place else set()
-    carried = tuple(i for i, shape in enumerate(cell.obstacles) if shape.name in names)
     fits = {(k, False): seam.fit for k, seam in enumerate(seams)}
-    return Context(inputs, seams, initial_values(cell), carried, fits)
+    limit = 1e-3 * cell.place.stand_max_length_mm if cell.place else 0.0
+    return Context(inputs, seams, initial_values(cell), stands(cell), limit, fits)
 
 
 def context(payload: CellPayload) -> Context:
@@ -107,15 +108,18 @@ def pose_of(X: RigidTransform) -> Pose:
     return p, tuple(round(float(np.rad2deg(a)), 6) + 0.0 for a in rpy)
 
 
-def moved_obstacles(ctx: Context, candidate: Candidate) -> dict[int, Pose]:
-    """{obstacle index: its pose in I} of the obstacles that stand with the tool, moved
-    with it: X_IO' = X_IT' · X_IT⁻¹ · X_IO."""
-    X_TT = rigid(candidate.X_IT) @ ctx.inputs.X_IT.inverse()  # old tool pose → new
-    return {i: pose_of(X_TT @ transform(ctx.inputs.cell.obstacles[i].pose)) for i in ctx.carried}
+def placed_stands(ctx: Context, candidate: Candidate) -> list[PlacedStand]:
+    """The stands at the candidate's tool pose, their foot on the floor (poses and
+    lengths rounded as :func:`pose_of` rounds: placed.yaml holds these numbers)."""
+    placed = place_stands(ctx.stands, ctx.inputs.X_IT, rigid(candidate.X_IT), ctx.stand_max_m)
+    return [
+        dataclasses.replace(s, X_IO=rigid(pose_of(s.X_IO)), length_m=round(s.length_m, 6))
+        for s in placed
+    ]
 
 
 def placed_cell(ctx: Context, candidate: Candidate) -> Cell:
-    """The cell with the candidate's X_IT and X_PE and the carried obstacles moved."""
+    """The cell with the candidate's X_IT and X_PE and its stands placed."""
     state = dataclasses.replace(
         ctx.initial,
         p_IT=candidate.X_IT[0],
@@ -124,12 +128,13 @@ def placed_cell(ctx: Context, candidate: Candidate) -> Cell:
         rpy_PE_deg=candidate.X_PE[1],
     )
     cell = apply(ctx.inputs.cell, ctx.initial, state)
-    moved = moved_obstacles(ctx, candidate)
-    if not moved:
+    placed = placed_stands(ctx, candidate)
+    if not placed:
         return cell
     obstacles = list(cell.obstacles)
-    for i, pose in moved.items():
-        obstacles[i] = dataclasses.replace(obstacles[i], pose=schema_transform(*pose))
+    for stand in placed:
+        i = stand.stand.index
+        obstacles[i] = stand.shape(obstacles[i], schema_transform(*pose_of(stand.X_IO)))
     return dataclasses.replace(cell, obstacles=obstacles)
 
 

@@ -24,12 +24,14 @@ from offline_prog.placement.context import context
 from offline_prog.placement.evaluate import evaluate
 from offline_prog.placement.objective import Evaluation
 from offline_prog.placement.payload import CellPayload
-from offline_prog.placement.screen import screen
+from offline_prog.placement.screen import rank, screen
 from offline_prog.placement.space import Candidate
 
 CONNECT_TIMEOUT_S = 5  # an unreachable scheduler is an error within seconds
-SCREEN_CHUNK = 32  # candidates per screen task (each ~10 ms)
-STAGES = {"screen": screen, "plan": evaluate}
+LOST_RETRIES = 3  # rounds of tasks run again after their worker was lost
+# Candidates per task: a screen takes ~30 ms a seam, a rank ~0.15 s, a plan ~2 s.
+CHUNKS = {"screen": 16, "rank": 2, "plan": 1}
+STAGES = {"screen": screen, "rank": rank, "plan": evaluate}
 # LocalCluster workers: a candidate is ~0.5 s of Python and Drake. The statistical
 # profiler (a stack sample every 10 ms), glibc trimming every free above 64 kB and the
 # frequent monitors cost 10–20 % of each worker's time on this machine
@@ -45,7 +47,7 @@ WORKER_CONFIG = {
 def run_chunk(
     stage: str, candidates: Sequence[Candidate], payload: CellPayload
 ) -> list[Evaluation]:
-    """Evaluate candidates with ``stage`` ("screen" | "plan") on this process's copy of
+    """Evaluate candidates with ``stage`` ("screen" | "rank" | "plan") on this process's copy of
     the cell (loaded once per payload)."""
     ctx = context(payload)
     judge = STAGES[stage]
@@ -86,7 +88,8 @@ class DaskEngine:
     ``scheduler``.
 
     Raises:
-        InputError: the scheduler cannot be reached within CONNECT_TIMEOUT_S.
+        InputError: the scheduler cannot be reached, or has no worker, within
+            CONNECT_TIMEOUT_S.
     """
 
     def __init__(
@@ -115,22 +118,43 @@ class DaskEngine:
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
+                    # The scheduler's HTTP server on a free port: on 8787, taken by
+                    # another cluster, it warns on stderr (place says one line there).
+                    scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
                     silence_logs=quiet,
                 )
             self.client = Client(self.cluster)
             self.scheduler = "LocalCluster"
+        self.source = payload
         try:
-            addresses = list(self.client.scheduler_info()["workers"])
-            self.workers = len(addresses)
-            self.payload = self.client.scatter(payload, broadcast=True, hash=False)
-            # Every worker loads the cell now, in parallel (not on its first candidate).
-            loads = [
-                self.client.submit(_load, self.payload, workers=[a], pure=False) for a in addresses
-            ]
-            self.client.gather(loads)
+            self.workers = self._send_cell()
         except BaseException:  # Ctrl-C or a worker's error: no cluster left running
             self.close()
             raise
+
+    def _send_cell(self) -> int:
+        """Scatter the cell to every worker and have each load it now, in parallel (not
+        on its first candidate); the number of workers.
+
+        Raises:
+            InputError: no worker joins the scheduler within CONNECT_TIMEOUT_S.
+        """
+        try:
+            with contextlib.redirect_stderr(io.StringIO()):
+                self.client.wait_for_workers(1, timeout=CONNECT_TIMEOUT_S)
+        except TimeoutError:
+            raise InputError(
+                self.scheduler,
+                "--scheduler",
+                f"no worker joined it within {CONNECT_TIMEOUT_S} s: start "
+                f"`dask worker {self.scheduler} --nthreads 1` where offline_prog is installed",
+            ) from None
+        addresses = list(self.client.scheduler_info()["workers"])
+        self.payload = self.client.scatter(self.source, broadcast=True, hash=False)
+        self.client.gather(
+            [self.client.submit(_load, self.payload, workers=[a], pure=False) for a in addresses]
+        )
+        return len(addresses)
 
     def map(
         self,
@@ -138,21 +162,66 @@ class DaskEngine:
         candidates: Sequence[Candidate],
         done: Callable[[int], None] = lambda n: None,
     ) -> list[Evaluation]:
-        from dask.distributed import as_completed
+        """The evaluations in the candidates' order. A task whose worker was lost (the
+        task or the cell with it: ``KilledWorker``, a cancelled future) is run again on
+        the workers left, the cell sent to them again, up to LOST_RETRIES rounds.
 
-        size = SCREEN_CHUNK if stage == "screen" else 1
+        Raises:
+            InputError: every worker is gone (none joins within CONNECT_TIMEOUT_S).
+        """
+        size = CHUNKS[stage]
         chunks = [list(candidates[i : i + size]) for i in range(0, len(candidates), size)]
-        futures = self.client.map(
-            run_chunk, [stage] * len(chunks), chunks, payload=self.payload, pure=False
+        results: list = [None] * len(chunks)
+        todo = list(range(len(chunks)))
+        for _ in range(LOST_RETRIES + 1):
+            todo = self._run(stage, chunks, todo, results, done)
+            if not todo:
+                return [e for chunk in results for e in chunk]
+            self.workers = self._send_cell()  # the cell again, to the workers left
+        raise InputError(
+            self.scheduler, "--scheduler", f"workers kept being lost ({LOST_RETRIES} rounds)"
         )
+
+    def _run(self, stage, chunks, todo, results, done) -> list[int]:
+        """Run the chunks ``todo`` into ``results``; the indices whose worker was lost.
+
+        Raises:
+            InputError: no worker is left to run them (for 2 × CONNECT_TIMEOUT_S).
+        """
+        from concurrent.futures import CancelledError
+
+        from dask.distributed import KilledWorker, wait
+
+        futures = {
+            self.client.submit(run_chunk, stage, chunks[i], self.payload, pure=False): i
+            for i in todo
+        }
+        pending, lost, idle = set(futures), [], 0
         try:
-            for future in as_completed(futures):
-                future.result()  # a worker's exception is raised here
-                done(len(chunks[futures.index(future)]))
+            while pending:
+                try:
+                    finished, pending = wait(
+                        pending, timeout=CONNECT_TIMEOUT_S, return_when="FIRST_COMPLETED"
+                    )
+                except TimeoutError:  # nothing finished: is anyone still working?
+                    idle = 0 if self.client.scheduler_info()["workers"] else idle + 1
+                    if idle >= 2:
+                        raise InputError(
+                            self.scheduler, "--scheduler", "every worker was lost"
+                        ) from None
+                    continue
+                for future in sorted(finished, key=futures.get):
+                    i = futures[future]
+                    try:
+                        results[i] = future.result()  # a worker's exception is raised here
+                    except (KilledWorker, CancelledError):
+                        lost.append(i)
+                        continue
+                    done(len(chunks[i]))
         except BaseException:
-            self.client.cancel(futures)
+            self.client.cancel(list(futures))
             raise
-        return [e for chunk in self.client.gather(futures) for e in chunk]
+        return sorted(lost)
 
     def close(self) -> None:
         with contextlib.suppress(Exception), contextlib.redirect_stderr(io.StringIO()):

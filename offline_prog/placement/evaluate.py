@@ -7,6 +7,7 @@ and back and the whole job's collision check. The terms are those of
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -14,7 +15,7 @@ import numpy as np
 
 from offline_prog.errors import Failure, InputError, PlanFailedError
 from offline_prog.job.records import JobPlan, Plan
-from offline_prog.placement.context import Context, placed_inputs
+from offline_prog.placement.context import Context, placed_inputs, placed_stands
 from offline_prog.placement.objective import (
     CANNOT_FOLLOW,
     COLLIDES,
@@ -65,8 +66,11 @@ def _seam_terms(plans: list[Plan]) -> dict:
 
 
 def evaluate(ctx: Context, candidate: Candidate) -> Evaluation:
-    """The candidate through :func:`plan_candidate`, judged."""
+    """The candidate through :func:`plan_candidate`, judged (a stand that cannot stand
+    there makes it infeasible before any plan: ``placement.stand``)."""
     start = time.perf_counter()
+    if any(stand.reason for stand in placed_stands(ctx, candidate)):
+        return dataclasses.replace(screen(ctx, candidate), stage="plan")
     try:
         plan = plan_candidate(ctx, candidate)
     except PlanFailedError as error:

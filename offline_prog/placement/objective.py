@@ -6,8 +6,9 @@
    start: tier 1 collides (violation: depth below the clearance [m]), tier 2 cannot
    follow the path (violation: share of the path out of reach plus the mean distance
    beyond reach [m] (``path_ik.reach_excess``), share on a flipping branch, joint-limit
-   excess / π [rad], and the share of the path not done), tier 3 makes geometry the
-   method refuses (violation 1).
+   excess / π [rad], and the share of the path not done), tier 3 needs a stand longer
+   than ``place.stand_max_length_mm`` or shorter than none (violation: by how much
+   [m]), tier 4 makes geometry the method refuses (violation 1).
 2. with a process model (``process:``): the share of the dispensed process length whose
    predicted quality lies within the band (larger is better), resolved to
    QUALITY_RESOLUTION (without a model every candidate scores 1), then
@@ -26,7 +27,7 @@ from offline_prog.placement.space import Candidate
 
 CYCLE_RESOLUTION_S = 0.01  # cycle times closer than this tie; the margins decide
 QUALITY_RESOLUTION = 0.001  # shares within the band closer than this tie; the cycle decides
-FEASIBLE, COLLIDES, CANNOT_FOLLOW, REFUSED = range(4)  # tiers
+FEASIBLE, COLLIDES, CANNOT_FOLLOW, STAND, REFUSED = range(5)  # tiers
 
 
 @dataclasses.dataclass(frozen=True)
@@ -35,14 +36,18 @@ class Evaluation:
 
     Attributes:
         candidate: what was evaluated.
-        stage: "screen" (analytic path IK only) or "plan" (the planning pipeline).
-        tier: FEASIBLE, COLLIDES, CANNOT_FOLLOW or REFUSED; violation: how far from
+        stage: "screen" (the analytic path IK of every tool turn and branch, the
+            lower bound and the steady-speed estimate), "rank" (the cheaper law:
+            TOPP-RA on the planner's variant, a coarse collision check) or "plan" (the
+            planning pipeline).
+        tier: FEASIBLE, COLLIDES, CANNOT_FOLLOW, STAND or REFUSED; violation: how far from
             feasible within the tier (0 when feasible).
         reason: why it is infeasible, one line ("" when feasible).
         failure: its kind: a :class:`~offline_prog.errors.Failure` value
             ("out_of_reach", "joint_limit", "singularity", "collision", ...) or
             "refused" (geometry the method refuses); "" when feasible.
-        cycle_time_s: the seam's duration [s] (NaN without a plan).
+        cycle_time_s: the job's duration, home to home [s]: planned ("plan"), or the
+            stage's estimate ("screen", "rank"); NaN without either.
         joint_limit_margin_deg: smallest distance of a joint to its limits [deg].
         singularity_margin_deg: smallest wrist or elbow angle from singular [deg].
         clearance_mm: smallest distance of a checked pair [mm] (NaN without a plan).
@@ -55,6 +60,12 @@ class Evaluation:
         quality_share: with a process model, the share of the dispensed process length
             within the quality band (process.quality; NaN: no model or no plan).
         seconds: the evaluation's wall time [s].
+        bound_s: no plan of the candidate is faster [s] (``placement.bound``; NaN
+            without a screen, ∞ when no variant is usable).
+        screened_out: why the screen rules the candidate out whatever the planner
+            does ("reach", "joint_limit", "collision", "stand"; "" when it does not).
+        collides: the coarse collision check found the planner's first variant below
+            the clearances ("rank" only).
     """
 
     candidate: Candidate
@@ -74,6 +85,9 @@ class Evaluation:
     limiting_axis: int = 0
     quality_share: float = math.nan
     seconds: float = 0.0
+    bound_s: float = math.nan
+    screened_out: str = ""
+    collides: bool = False
 
     @property
     def feasible(self) -> bool:

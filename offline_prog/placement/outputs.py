@@ -4,11 +4,13 @@
   ``X_IT`` and ``X_PE`` as ``{translation [m], rpy_deg}``, ``feasible``,
   ``cycle_time_s``, every objective term and the failure reason when infeasible;
   ``baseline`` (the cell as given), ``cycle_time_cut`` (the cut and, when it is under
-  CUT_TARGET, why), ``search`` and ``engine`` (scheduler, workers, candidates
-  evaluated, wall time).
-* ``placed.yaml``: the cell file's text with the best X_IT and X_PE written in (and
-  the obstacles that stand with the tool moved), data files re-pointed from the new
-  folder: ``offline-prog plan placed.yaml`` plans it.
+  CUT_TARGET, why), ``stands`` (how each stand changed for the best), ``screening``
+  (every screened candidate's fate: planned, screened out and by what, or why it was
+  not planned), ``search`` and ``engine`` (scheduler, workers, candidates evaluated,
+  wall time).
+* ``placed.yaml``: the cell file's text with the best X_IT and X_PE written in (the
+  stands moved and lengthened, the description saying what was placed), data files
+  re-pointed from the new folder: ``offline-prog plan placed.yaml`` plans it.
 * ``placement.html``: a top view of the search (screened grid, evaluated candidates
   coloured by cycle time, failures by reason), the top-k table and the best plan.
 """
@@ -20,11 +22,14 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
+
 from offline_prog.config.cell_text import relocated_text
-from offline_prog.placement.context import Context, moved_obstacles
+from offline_prog.placement.context import Context, placed_stands, pose_of
 from offline_prog.placement.objective import Evaluation
-from offline_prog.placement.search import Placement
+from offline_prog.placement.search import FATES, Placement
 from offline_prog.placement.space import Pose, SearchSpace
+from offline_prog.placement.top_view import Layout
 
 CUT_TARGET = 0.15  # the cycle-time cut a placement search should find (issue 16)
 
@@ -59,20 +64,68 @@ def terms(e: Evaluation) -> dict:
         "reason": e.reason,
         "failure": e.failure,
         "evaluation_s": e.seconds,
+        "lower_bound_s": _finite(e.bound_s),
     }
 
 
+DISTINCT_M, DISTINCT_DEG = 0.005, 1.0  # candidates closer than this are one in the table
+
+
 def _top(evaluated: list[Evaluation], k: int) -> list[Evaluation]:
-    """The k best distinct candidates (the baseline included when it ranks)."""
-    seen, top = set(), []
+    """The k best distinct candidates (the baseline included when it ranks): each
+    differs from every better one by DISTINCT_M in its tool position, DISTINCT_DEG in
+    its tool rotation, or in its grasp."""
+    top = []
     for e in sorted(evaluated, key=Evaluation.key):
-        key = (e.candidate.X_IT, e.candidate.X_PE)
-        if key not in seen:
-            seen.add(key)
+        if not any(_same(e.candidate, other.candidate) for other in top):
             top.append(e)
         if len(top) == k:
             break
     return top
+
+
+def _same(a, b) -> bool:
+    (p, rpy), (q, rpz) = a.X_IT, b.X_IT
+    near = math.dist(p, q) < DISTINCT_M
+    turned = max(abs((x - y + 180.0) % 360.0 - 180.0) for x, y in zip(rpy, rpz, strict=True))
+    return near and turned < DISTINCT_DEG and a.X_PE == b.X_PE
+
+
+def screening(result: Placement) -> dict:
+    """placement.json's ``screening``: what became of every screened candidate."""
+    counts = collections.Counter(result.fates)
+    return {
+        "fates": {fate: counts.get(fate, 0) for fate in FATES},
+        "meaning": FATES,
+        "candidates": [
+            {
+                "X_IT": _pose(e.candidate.X_IT),
+                "grasp": e.candidate.grasp,
+                "fate": fate,
+                "stage": e.stage,
+                "estimate_s": _finite(e.cycle_time_s) if e.stage != "plan" else None,
+                "lower_bound_s": _finite(e.bound_s),
+                "reason": e.reason,
+            }
+            for e, fate in zip(result.screened, result.fates, strict=True)
+        ],
+    }
+
+
+def stand_changes(ctx: Context, best: Evaluation) -> list[dict]:
+    """placement.json's ``stands``: each stand as given and as placed for the best."""
+    return [
+        {
+            "name": s.stand.name,
+            "length_mm_given": 1e3 * s.stand.length_m,
+            "length_mm": 1e3 * s.length_m,
+            "lengthened_mm": 1e3 * (s.length_m - s.stand.length_m),
+            "foot_z_mm": 1e3 * s.stand.foot_z,
+            "X_IO": _pose(pose_of(s.X_IO)),
+            "reason": s.reason,
+        }
+        for s in placed_stands(ctx, best.candidate)
+    ]
 
 
 WRIST_AXES = (4, 5, 6)
@@ -125,12 +178,43 @@ def cycle_time_cut(result: Placement, tool=None) -> dict:
     return out
 
 
-def placement_json(result: Placement, space: SearchSpace, place, engine: dict, tool=None) -> dict:
+def layout_of(ctx: Context, best: Evaluation) -> Layout:
+    """The top view's robot base, its reach and the best's stands (``top_view``)."""
+    robot, p_IB = ctx.inputs.robot, ctx.inputs.X_IB.translation()
+    params = robot.params
+    if robot.family == "opw":
+        reach = params.a1 + params.c2 + math.hypot(params.a2, params.c3)
+    elif robot.family == "ur":
+        reach = abs(params.a2) + abs(params.a3) + abs(params.d5)
+    else:
+        reach = 0.0
+    stands = []
+    obstacles = ctx.inputs.cell.obstacles
+    for stand in placed_stands(ctx, best.candidate):
+        shape = obstacles[stand.stand.index]
+        if shape.shape == "box":
+            hx, hy = 0.5e-3 * shape.size_mm[0], 0.5e-3 * shape.size_mm[1]
+            local = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+        else:
+            angle = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
+            local = 1e-3 * shape.radius_mm * np.column_stack([np.cos(angle), np.sin(angle)])
+        R = stand.X_IO.rotation().matrix()[:2, :2]
+        corners = 1e3 * (local @ R.T + stand.X_IO.translation()[:2])
+        stands.append((stand.stand.name, corners))
+    return Layout((1e3 * p_IB[0], 1e3 * p_IB[1]), 1e3 * reach, stands)
+
+
+def placement_json(
+    result: Placement, space: SearchSpace, place, engine: dict, ctx: Context
+) -> dict:
+    """placement.json's content (see the module)."""
     return {
         "best": terms(result.best),
         "baseline": terms(result.baseline),
-        "cycle_time_cut": cycle_time_cut(result, tool),
+        "cycle_time_cut": cycle_time_cut(result, ctx.inputs.cell.tool),
         "candidates": [terms(e) for e in _top(result.evaluated, place.top_k)],
+        "stands": stand_changes(ctx, result.best),
+        "screening": screening(result),
         "search": {
             "budget": place.budget,
             "seed": place.seed,
@@ -158,9 +242,32 @@ def placement_json(result: Placement, space: SearchSpace, place, engine: dict, t
 def placed_text(cell_file: Path, ctx: Context, best: Evaluation, out_dir: Path) -> str:
     """The cell file's text with the best placement, to be written into ``out_dir``."""
     poses = {"tool.X_IT": best.candidate.X_IT, "part.X_PE": best.candidate.X_PE}
-    for i, pose in moved_obstacles(ctx, best.candidate).items():
-        poses[f"obstacles.{i}.pose"] = pose
-    return relocated_text(cell_file, ctx.inputs.cell, out_dir, poses)
+    numbers = {}
+    for stand in placed_stands(ctx, best.candidate):
+        poses[f"obstacles.{stand.stand.index}.pose"] = pose_of(stand.X_IO)
+        numbers[stand.length_key()] = round(1e3 * stand.length_m, 3)
+    strings = {"description": placed_description(cell_file, ctx, best)}
+    return relocated_text(cell_file, ctx.inputs.cell, out_dir, poses, strings, numbers)
+
+
+def placed_description(cell_file: Path, ctx: Context, best: Evaluation) -> str:
+    """placed.yaml's ``description``: what was placed, from which cell."""
+    (p, rpy), c = best.candidate.X_IT, best.candidate
+    what = (
+        f"Placed by offline-prog place from {cell_file.name}: the tool at "
+        f"({', '.join(f'{1e3 * v:.1f}' for v in p)}) mm, rpy "
+        f"({', '.join(f'{v:g}' for v in rpy)}) deg"
+    )
+    if c.grasp >= 0:
+        what += f", grasp {c.grasp + 1}"
+    for stand in placed_stands(ctx, c):
+        what += (
+            f"; {stand.stand.name} {1e3 * stand.stand.length_m:.0f} -> "
+            f"{1e3 * stand.length_m:.0f} mm long"
+        )
+    if best.feasible:
+        return what + f"; cycle {best.cycle_time_s:.2f} s home to home."
+    return what + f"; infeasible: {best.reason}."
 
 
 def write_json(file: Path, data: dict) -> None:

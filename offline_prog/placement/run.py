@@ -4,8 +4,8 @@ gripper should hold the part (the paper's outlook), one named stage per line.
 1. ``load``: the cell and its ``place:`` block checked (bad input: one line, exit 2).
 2. ``engine``: a Dask LocalCluster (one worker per core), the cluster at
    ``--scheduler``, or this process (``--workers 0``); the cell sent to it once.
-3. ``search``: the grid screen and CMA-ES on the planning pipeline
-   (:mod:`~offline_prog.placement.search`).
+3. ``search``: the grid screened, its best ranked by a cheaper law, the few that can
+   win planned in full (:mod:`~offline_prog.placement.search`).
 4. ``outputs``: placement.json, placed.yaml, best_preview.html and placement.html,
    written into a fresh folder that replaces ``--out`` only when all are written.
 """
@@ -23,11 +23,11 @@ from offline_prog.placement.context import Context, keep, load_context
 from offline_prog.placement.engine import DaskEngine, SerialEngine
 from offline_prog.placement.evaluate import plan_candidate
 from offline_prog.placement.objective import Evaluation
-from offline_prog.placement.outputs import placed_text, placement_json, write_json
+from offline_prog.placement.outputs import layout_of, placed_text, placement_json, write_json
 from offline_prog.placement.payload import CellPayload, cell_payload
 from offline_prog.placement.search import Placement, search
 from offline_prog.placement.search_map import render_placement_html
-from offline_prog.placement.space import Candidate, SearchSpace, check_place
+from offline_prog.placement.space import Candidate, check_place
 from offline_prog.results.plan_folder import check_out_dir
 from offline_prog.robot.model import ROBOTS_DIR
 
@@ -61,11 +61,11 @@ def place_cell(
     started = time.perf_counter()
     engine = start_engine(payload, workers, scheduler)
     try:
-        result = search(space, place, space.baseline, _runner(engine, space, place, progress))
+        result = search(space, place, space.baseline, _runner(engine, place, progress))
     finally:
         engine.close()
     figures = engine_figures(engine, result, started)
-    data = placement_json(result, space, place, figures, ctx.inputs.cell.tool)
+    data = placement_json(result, space, place, figures, ctx)
     progress("outputs", 0, 1)
     write_folder(out_dir, cell_file, ctx, result, data)
     progress("outputs", 1, 1)
@@ -97,15 +97,17 @@ def start_engine(payload: CellPayload, workers: int | None, scheduler: str | Non
     return DaskEngine(payload, workers=workers, scheduler=scheduler)
 
 
-def _runner(engine, space: SearchSpace, place, progress):
-    """``search``'s ``run``: the engine's map, telling ``progress`` per stage."""
-    totals = {"screen": len(space.grid(place.screen_points)), "plan": place.budget}
-    done = {"screen": 0, "plan": 0}
+def _runner(engine, place, progress):
+    """``search``'s ``run``: the engine's map, telling ``progress`` per stage (the
+    screen's and the rank's totals are their batches'; the plans', the budget)."""
+    done = {"screen": 0, "rank": 0, "plan": 0}
 
     def run(stage: str, candidates: list[Candidate]):
+        total = place.budget if stage == "plan" else done[stage] + len(candidates)
+
         def advance(n: int) -> None:
             done[stage] += n
-            progress(stage, done[stage], totals[stage])
+            progress(stage, done[stage], total)
 
         return engine.map(stage, candidates, advance)
 
@@ -139,7 +141,8 @@ def write_folder(out_dir: Path, cell_file: Path, ctx: Context, result: Placement
             preview = "best_preview.html"
         write_json(folder / "placement.json", data)
         (folder / "placement.html").write_text(
-            render_placement_html(result, data, preview), encoding="utf-8"
+            render_placement_html(result, data, preview, layout_of(ctx, result.best)),
+            encoding="utf-8",
         )
         write_manifest(folder, {"plan": sorted(p.name for p in folder.iterdir())})
 

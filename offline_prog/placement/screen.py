@@ -1,105 +1,188 @@
-"""The screen: a candidate judged by the analytic path IK alone (~10 ms a seam).
+"""The screen: a candidate judged without a plan, cheaply (~30 ms a seam) and soundly.
 
-For each seam, the flange path X_IE = X_IT · X_PF⁻¹ · X_PE at SCREEN_SAMPLES σ (tool
-rotation 0), all eight branches at once (``joints.path_ik``); the branch closest to
-feasible speaks for the seam. A feasible seam gets a cycle-time estimate at steady
-speed (:func:`speed_limited_time`); a job's seams add up.
+``screen``: the stands (``placement.stand``: a length outside its limit rules the
+candidate out), then for every seam the joint paths of every tool turn and branch the
+planner may take (``placement.variants``). A seam that no variant reaches rules the
+candidate out ("reach"); one that no reaching variant keeps inside the joint limits,
+too ("joint_limit"): no plan could follow it. Otherwise the candidate gets the lower
+bound of its cycle time and the steady-speed estimate (``placement.bound``); it is
+feasible for the screen when the planner's first variant is (continuous along the
+path as the planner tests it).
+
+``rank`` (the candidates the screen ranks best): the cheaper law
+(``placement.cheap_law``) on the planner's variant instead of the steady estimate, and
+the coarse collision look (``placement.collision_look``), whose fixed layout in
+contact rules the candidate out ("collision").
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
 import numpy as np
 
-from offline_prog.joints.path_ik import (
-    base_poses,
-    branch_results,
-    reach_excess,
-    singularity_distances,
+from offline_prog.job.seams import job_config, job_seams
+from offline_prog.joints.path_ik import singularity_distances
+from offline_prog.placement.bound import SeamTimes, job_times, seam_times
+from offline_prog.placement.cheap_law import law_seam_s
+from offline_prog.placement.collision_look import collision_look, look_rows
+from offline_prog.placement.context import Context, placed_inputs, placed_stands, rigid
+from offline_prog.placement.objective import (
+    CANNOT_FOLLOW,
+    FEASIBLE,
+    STAND,
+    Evaluation,
 )
-from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.path.process_frames import NormalTangentError
-from offline_prog.placement.context import Context, SeamView, rigid
-from offline_prog.placement.objective import CANNOT_FOLLOW, FEASIBLE, REFUSED, Evaluation
 from offline_prog.placement.space import Candidate
+from offline_prog.placement.variants import SeamVariants, seam_variants
+from offline_prog.stages import build_scene
 
 
-def _screen_seam(seam: SeamView, candidate: Candidate) -> Evaluation:
-    inputs, fit, s = seam.inputs, seam.fit, seam.screen_s
-    robot = inputs.robot
-    try:
-        flange = FlangePath(
-            fit.path, fit.normal, X_IT=rigid(candidate.X_IT), X_PE=rigid(candidate.X_PE)
+def home_c(ctx: Context) -> np.ndarray:
+    """(6,) the job's home in the controller's axes [rad] (``job.home`` or the
+    robot's; ``job.home.home_pose`` checks it when a candidate is planned)."""
+    robot, home = ctx.inputs.robot, job_config(ctx.inputs.cell).home
+    if home is not None:
+        return np.deg2rad(np.asarray(home.joints_deg, dtype=float))
+    return np.asarray(robot.home_c, dtype=float)
+
+
+def _violation(v: SeamVariants) -> float:
+    """How far the seam's closest variant is from feasible: the share of its rows out
+    of reach plus the mean distance beyond reach [m], or its joint-limit excess / π, or
+    0.5 for a flip."""
+    unreachable = 1.0 - v.reach_share + v.reach_excess.mean(axis=1)[:, None]  # (A, 8)
+    beyond = np.where(v.reach, np.maximum(0.0, -v.margin) / math.pi, 0.0)
+    flipped = np.where(v.usable & v.flips, 0.5, 0.0)
+    return float(np.min(unreachable + beyond + flipped))
+
+
+def _seam_verdict(v: SeamVariants) -> tuple[str, str]:
+    """(screened out by: "reach" | "joint_limit" | "", the reason) of one seam."""
+    if not v.reach.any():
+        return "reach", "out of reach"
+    if not v.usable.any():
+        return "joint_limit", "joint limit on every tool turn and branch"
+    if v.planner_choice() is None:
+        return "", "singularity (the configuration flips) on every tool turn and branch"
+    return "", ""
+
+
+def _variants(ctx: Context, candidate: Candidate) -> list[tuple[SeamVariants, SeamTimes]]:
+    X_IT, X_PE = rigid(candidate.X_IT), rigid(candidate.X_PE)
+    found = []
+    for view, seam in zip(ctx.seams, job_seams(ctx.inputs.cell), strict=True):
+        v = seam_variants(view, seam, X_IT, X_PE)
+        found.append((v, seam_times(v, view.inputs, seam)))
+    return found
+
+
+def screen(ctx: Context, candidate: Candidate) -> Evaluation:
+    """The candidate screened (see the module)."""
+    return _judged(ctx, candidate, time.perf_counter())[0]
+
+
+def _judged(ctx: Context, candidate: Candidate, start: float):
+    """(the screen's Evaluation, each seam's (variants, times) or [] for a stand)."""
+    stands = [s for s in placed_stands(ctx, candidate) if s.reason]
+    if stands:
+        excess = sum(max(s.length_m - ctx.stand_max_m, -s.length_m, 0.0) for s in stands)
+        judged = Evaluation(
+            candidate,
+            "screen",
+            STAND,
+            excess,
+            stands[0].reason,
+            "stand",
+            screened_out="stand",
+            bound_s=math.inf,
+            seconds=time.perf_counter() - start,
         )
-        f = flange(s)
-    except NormalTangentError as error:
-        return Evaluation(candidate, "screen", REFUSED, 1.0, str(error), "refused")
-    X_BE = base_poses(inputs.X_IB, f.p_IE, f.R_IE)
-    results = branch_results(robot, X_BE)
-    reach = ~np.isnan(robot.inverse(X_BE)).any(axis=-1)  # (N, 8)
-    excess = float(reach_excess(robot, X_BE).mean())  # [m]
-
-    def violation(r) -> float:
-        if r.feasible:
-            return 0.0
-        unreachable = 1.0 - reach[:, r.branch].mean() + excess
-        flipped = (1.0 - r.sample / len(s)) if r.reason.startswith("singularity") else 0.0
-        beyond = max(0.0, -r.margin_rad) if math.isfinite(r.margin_rad) else math.pi
-        return float(unreachable + flipped + beyond / math.pi)
-
-    best = min(results, key=lambda r: (violation(r), -r.margin_rad))
-    if not best.feasible:
-        kind = best.kind.value
-        return Evaluation(candidate, "screen", CANNOT_FOLLOW, violation(best), best.reason, kind)
-    d = singularity_distances(robot, best.q, X_BE)
-    singular = float(np.rad2deg(np.arcsin(min(1.0, d["wrist"].min(), d["elbow"].min()))))
-    return Evaluation(
+        return judged, []
+    seams = _variants(ctx, candidate)
+    verdicts = [_seam_verdict(v) for v, _ in seams]
+    bound, estimate = job_times([t for _, t in seams], home_c(ctx), ctx.inputs.robot)
+    out = next((by for by, _ in verdicts if by), "")
+    reason = next((why for _, why in verdicts if why), "")
+    if reason:
+        kinds = {"reach": "out_of_reach", "joint_limit": "joint_limit"}
+        judged = Evaluation(
+            candidate,
+            "screen",
+            CANNOT_FOLLOW,
+            sum(_violation(v) for v, _ in seams),
+            reason,
+            kinds.get(out, "singularity"),
+            screened_out=out,
+            bound_s=math.inf if out else bound,
+            seconds=time.perf_counter() - start,
+        )
+        return judged, seams
+    margins, singular = [], []
+    for v, t in seams:
+        margins.append(v.margin[t.choice])
+        singular.append(_singularity_deg(ctx, v, t))
+    judged = Evaluation(
         candidate,
         "screen",
         FEASIBLE,
         0.0,
         "",
-        cycle_time_s=speed_limited_time(seam, best.q),
-        joint_limit_margin_deg=float(np.rad2deg(best.margin_rad)),
-        singularity_margin_deg=singular,
-    )
-
-
-def screen(ctx: Context, candidate: Candidate) -> Evaluation:
-    """Every seam screened; the candidate's tier is its worst seam's, violations and
-    cycle-time estimates add up, margins are the smallest."""
-    start = time.perf_counter()
-    seams = [_screen_seam(seam, candidate) for seam in ctx.seams]
-    worst = max(seams, key=lambda e: (e.tier, e.violation))
-    return Evaluation(
-        candidate,
-        "screen",
-        worst.tier,
-        float(sum(e.violation for e in seams)),
-        worst.reason,
-        worst.failure,
-        cycle_time_s=float(sum(e.cycle_time_s for e in seams)),
-        joint_limit_margin_deg=min(e.joint_limit_margin_deg for e in seams),
-        singularity_margin_deg=min(e.singularity_margin_deg for e in seams),
+        cycle_time_s=estimate,
+        joint_limit_margin_deg=float(np.rad2deg(min(margins))),
+        singularity_margin_deg=min(singular),
+        tool_rotation_deg=float(np.rad2deg(seams[0][0].angles[seams[0][1].choice[0]])),
+        bound_s=bound,
         seconds=time.perf_counter() - start,
     )
+    return judged, seams
 
 
-def speed_limited_time(seam: SeamView, q: np.ndarray) -> float:
-    """The screen's cycle-time estimate of a seam [s]: ∫ dσ / v(σ) with v the process
-    speed, lowered where a joint would pass its speed or acceleration limit at steady
-    speed, v ≤ q̇max_j / |q′_j(σ)| and v ≤ √(q̈max_j / |q″_j(σ)|) (q′, q″ by differences
-    of the (N, 6) joint path q [rad] on the screen's σ grid). The time law's ramps are
-    left out: it ranks candidates, ``evaluate`` times them."""
-    s, robot = seam.screen_s, seam.inputs.robot
-    ds = np.diff(s)
-    d1 = np.diff(q, axis=0) / ds[:, None]  # q′ [rad/m] between samples, (N−1, 6)
-    d2 = np.zeros_like(d1)
-    d2[1:] = np.diff(d1, axis=0) / ((ds[1:] + ds[:-1]) / 2)[:, None]  # q″ [rad/m²]
-    with np.errstate(divide="ignore"):
-        by_speed = np.min(robot.qd_max / np.abs(d1), axis=1)
-        by_acceleration = np.min(np.sqrt(robot.qdd_max / np.abs(d2)), axis=1)
-    v = np.minimum(seam.inputs.speed.v_m_s, np.minimum(by_speed, by_acceleration))
-    return float(np.sum(ds / v))
+def _singularity_deg(ctx: Context, v: SeamVariants, t: SeamTimes) -> float:
+    """The smallest wrist or elbow angle from singular on the planner's variant [deg]."""
+    robot = ctx.inputs.robot
+    q = v.q[t.choice][1:-1]
+    X_BE = robot.forward(q)
+    d = singularity_distances(robot, q, X_BE)
+    return float(np.rad2deg(np.arcsin(min(1.0, d["wrist"].min(), d["elbow"].min()))))
+
+
+def rank(ctx: Context, candidate: Candidate) -> Evaluation:
+    """The screen with the cheaper law's estimate and the coarse collision look."""
+    start = time.perf_counter()
+    screened, seams = _judged(ctx, candidate, start)
+    if not screened.feasible:
+        return dataclasses.replace(screened, stage="rank")
+    X_IT, X_PE = rigid(candidate.X_IT), rigid(candidate.X_PE)
+    times = []
+    for view, (v, t) in zip(ctx.seams, seams, strict=True):
+        law = law_seam_s(view, v, X_IT, X_PE)
+        times.append(dataclasses.replace(t, estimate_s=law + t.moves_s))
+    _, estimate = job_times(times, home_c(ctx), ctx.inputs.robot)
+    inputs = placed_inputs(ctx, candidate)
+    motion = inputs.cell.motion
+    rows = np.concatenate([look_rows(v.q[t.choice]) for v, t in seams])
+    look = collision_look(
+        build_scene(inputs), rows, clearance=motion.clearance, self_clearance=motion.self_clearance
+    )
+    ranked = dataclasses.replace(
+        screened,
+        stage="rank",
+        cycle_time_s=estimate,
+        collides=look.first_collides,
+        seconds=time.perf_counter() - start,
+    )
+    if not look.layout:
+        return ranked
+    return dataclasses.replace(
+        ranked,
+        tier=CANNOT_FOLLOW,
+        violation=1.0,
+        reason=f"the layout collides: {look.layout}",
+        failure="collision",
+        screened_out="collision",
+        bound_s=math.inf,
+        cycle_time_s=math.nan,
+    )

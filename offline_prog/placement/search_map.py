@@ -1,107 +1,42 @@
-"""placement.html: a top view of the search, the top-k table and the best plan.
-
-The map is an SVG of the tool positions p_IT in the x–y plane of I [mm]: screened
-grid points small (grey: the path IK can follow the path, red: it cannot), evaluated
-candidates as circles coloured by cycle time (feasible) or red with the reason as
-tooltip, the cell as given as a square and the best as a star. The best placement's
-animated MeshCat scene (best_preview.html) is embedded below it.
-"""
+"""placement.html: the top view of the search (``placement.top_view``), what the
+screen did, the best distinct candidates and the best plan (its animated MeshCat
+scene, best_preview.html, embedded below)."""
 
 from __future__ import annotations
 
 import html
-import math
 
-from offline_prog.placement.objective import Evaluation
-from offline_prog.placement.search import Placement
-
-SIZE, PAD = 560, 50  # SVG size and margin [px]
-# Cycle-time colour scale: fastest to slowest feasible candidate (viridis ends).
-FAST, SLOW = (68, 1, 84), (253, 231, 37)
-# Infeasible candidates by failure kind (errors.Failure values, "refused").
-FAILURE_COLORS = {
-    "out_of_reach": "#d62728",
-    "joint_limit": "#ff7f0e",
-    "joint_rate_limit": "#bcbd22",
-    "singularity": "#9467bd",
-    "collision": "#8c564b",
-    "refused": "#7f7f7f",
-}
-
-
-def _colour(t: float, low: float, high: float) -> str:
-    u = 0.0 if high <= low else (t - low) / (high - low)
-    r, g, b = (round(a + u * (b - a)) for a, b in zip(FAST, SLOW, strict=True))
-    return f"rgb({r},{g},{b})"
-
-
-def _map_svg(result: Placement) -> str:
-    points = [e.candidate.X_IT[0] for e in result.screened + result.evaluated]
-    xs = [1e3 * p[0] for p in points]
-    ys = [1e3 * p[1] for p in points]
-    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
-    span = max(x1 - x0, y1 - y0, 1.0)
-    scale = (SIZE - 2 * PAD) / span
-
-    def at(e: Evaluation) -> tuple[float, float]:
-        p = e.candidate.X_IT[0]
-        return PAD + (1e3 * p[0] - x0) * scale, SIZE - PAD - (1e3 * p[1] - y0) * scale
-
-    feasible = [e.cycle_time_s for e in result.evaluated if e.feasible]
-    low, high = (min(feasible), max(feasible)) if feasible else (0.0, 1.0)
-    items = []
-    for e in result.screened:
-        x, y = at(e)
-        colour = "#bbb" if e.feasible else "#f3a0a0"
-        items.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="2" fill="{colour}"/>')
-    for e in result.evaluated[1:]:
-        x, y = at(e)
-        if e.feasible:
-            tip = f"{e.cycle_time_s:.2f} s, margin {e.joint_limit_margin_deg:.1f}°"
-            fill = _colour(e.cycle_time_s, low, high)
-        else:
-            tip, fill = e.reason, FAILURE_COLORS.get(e.failure, "#d62728")
-        items.append(
-            f'<circle cx="{x:.1f}" cy="{y:.1f}" r="5" fill="{fill}" stroke="#333" '
-            f'stroke-width="0.5"><title>{html.escape(tip)}</title></circle>'
-        )
-    x, y = at(result.baseline)
-    items.append(
-        f'<rect x="{x - 6:.1f}" y="{y - 6:.1f}" width="12" height="12" fill="none" '
-        'stroke="#000" stroke-width="2"><title>the cell as given</title></rect>'
-    )
-    x, y = at(result.best)
-    star = " ".join(
-        f"{x + r * math.sin(k * math.pi / 5):.1f},{y - r * math.cos(k * math.pi / 5):.1f}"
-        for k, r in zip(range(10), [11, 4.5] * 5, strict=True)
-    )
-    items.append(
-        f'<polygon points="{star}" fill="#ff7f0e" stroke="#000"><title>best</title></polygon>'
-    )
-    axes = (
-        f'<text x="{SIZE / 2}" y="{SIZE - 12}" text-anchor="middle">x of I [mm] '
-        f"{x0:.0f} … {x0 + span:.0f}</text>"
-        f'<text x="14" y="{SIZE / 2}" transform="rotate(-90 14 {SIZE / 2})" '
-        f'text-anchor="middle">y of I [mm] {y0:.0f} … {y0 + span:.0f}</text>'
-    )
-    return (
-        f'<svg id="search-map" width="{SIZE}" height="{SIZE}" viewBox="0 0 {SIZE} {SIZE}" '
-        f'xmlns="http://www.w3.org/2000/svg"><rect width="100%" height="100%" fill="#fff" '
-        f'stroke="#ccc"/>{"".join(items)}{axes}</svg>'
-    )
+from offline_prog.placement.search import FATES, Placement
+from offline_prog.placement.top_view import FAILURE_COLORS, FATE_COLORS, Layout, top_view_svg
 
 
 def _row(cells: list) -> str:
-    return "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>"
+    return "<tr>" + "".join(f"<td>{html.escape(_text(c))}</td>" for c in cells) + "</tr>"
 
 
-def render_placement_html(result: Placement, data: dict, preview: str | None) -> str:
-    """The page, from the search result and placement.json's ``data``."""
+def _text(value) -> str:
+    """A cell's text: yes / no for a boolean (not Python's True)."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    return str(value)
+
+
+def render_placement_html(
+    result: Placement, data: dict, preview: str | None, layout: Layout
+) -> str:
+    """The page, from the search result, placement.json's ``data`` and the layout."""
     cut = data["cycle_time_cut"]
     best = data["best"]
     legend = ", ".join(
         f'<span style="color:{colour}">●</span> {kind.replace("_", " ")}'
         for kind, colour in FAILURE_COLORS.items()
+    )
+    fates = data["screening"]["fates"]
+    fate_legend = ", ".join(
+        f'<span style="color:{FATE_COLORS[fate]}">●</span> {html.escape(FATES[fate])} '
+        f"({fates[fate]})"
+        for fate in FATE_COLORS
+        if fates.get(fate)
     )
     summary = (
         f"best: {'feasible' if best['feasible'] else 'infeasible: ' + best['reason']}"
@@ -119,6 +54,7 @@ def render_placement_html(result: Placement, data: dict, preview: str | None) ->
         "limit margin [°]",
         "singularity [°]",
         "clearance [mm]",
+        "lower bound [s]",
         "X_IT translation [m]",
         "X_IT rpy [°]",
         "grasp",
@@ -137,9 +73,10 @@ def render_placement_html(result: Placement, data: dict, preview: str | None) ->
                 number(c["joint_limit_margin_deg"], 1),
                 number(c["singularity_margin_deg"], 1),
                 number(c["clearance_mm"], 1),
+                number(c["lower_bound_s"]),
                 ", ".join(f"{v:.4f}" for v in c["X_IT"]["translation"]),
                 ", ".join(f"{v:.2f}" for v in c["X_IT"]["rpy_deg"]),
-                c["grasp"],
+                "as given" if c["grasp"] < 0 else c["grasp"] + 1,
                 c["reason"],
             ]
         )
@@ -163,16 +100,18 @@ def render_placement_html(result: Placement, data: dict, preview: str | None) ->
 td,th{{border:1px solid #ccc;padding:2px 6px;font-size:13px}}</style></head><body>
 <h1>Placement search</h1>
 <p id="summary">{html.escape(summary)}</p>{why}
-<p>{engine["candidates_evaluated"]} candidates through the planning pipeline and
-{engine["screened"]} screened by the path IK in {engine["wall_time_s"]:.1f} s on
+<p>{engine["screened"]} candidates screened (every tool turn and branch by the analytic
+IK, a lower bound of the cycle time), the best ranked by a cheaper law, and
+{engine["candidates_evaluated"]} planned in full, in {engine["wall_time_s"]:.1f} s on
 {engine["workers"]} worker(s) ({html.escape(engine["scheduler"])}).</p>
 <h2>Tool positions (top view)</h2>
-<p>Small dots: screened grid (grey: the path IK follows the path; red: it cannot).
-Circles: evaluated, feasible from dark (fast) to yellow (slow); infeasible by why
-({legend}; hover for the whole reason).
-Square: the cell as given. Star: best.</p>
-{_map_svg(result)}
-<h2>Best candidates</h2>
+<p>Dots: screened candidates by what became of them ({fate_legend}).
+Circles: planned in full, feasible coloured by cycle time on the scale at the right;
+infeasible by why ({legend}; hover for the whole reason).
+Square: the cell as given. Star: best, with its stand's footprint. Dashed: the reach of
+the robot's wrist centre at its shoulder's height.</p>
+{top_view_svg(result, layout)}
+<h2>Best candidates (distinct)</h2>
 <table id="candidates"><tr>{"".join(f"<th>{h}</th>" for h in header)}</tr>{"".join(rows)}</table>
 {frame}
 </body></html>

@@ -21,6 +21,7 @@ from offline_prog.config.cell import Cell, PlaceConfig
 from offline_prog.config.edits import rpy_deg_of
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
 from offline_prog.errors import InputError
+from offline_prog.placement.stand import check_stands
 
 MAX_SCREEN_POINTS = 100_000  # per grasp
 MAX_OFFSET_MM = 10_000.0  # a tool stand 10 m from the robot is a typo
@@ -97,18 +98,21 @@ class SearchSpace:
         X_IT, X_PE = (_rounded(poses[k]) for k in ("X_IT", "X_PE"))
         return Candidate(tuple(float(u) for u in x), int(grasp), X_IT, X_PE)
 
-    def grid(self, points_per_grasp: int) -> list[Candidate]:
+    def grid(self, points_per_grasp: int, seed: int = 0) -> list[Candidate]:
         """A regular grid of about ``points_per_grasp`` points (k levels per axis,
-        k^d ≤ points, k ≥ 2, cell-centred) for every grasp."""
+        k^d ≤ points, k ≥ 2) for every grasp: cell-centred for seed 0, the whole
+        lattice shifted within its cell by a seeded offset (each axis its own, up to
+        half a cell) for another seed, so seeds sample other placements."""
         d = self.dimensions
         if d == 0:
             return [self.candidate([], g) for g in range(len(self.grasps))]
         k = max(2, int(math.floor(points_per_grasp ** (1.0 / d) + 1e-9)))
-        levels = (np.arange(k) + 0.5) / k
+        shift = np.zeros(d) if seed == 0 else np.random.default_rng(seed).uniform(-0.5, 0.5, d)
+        levels = (np.arange(k)[:, None] + 0.5 + shift[None, :]) / k  # (k, d)
         return [
-            self.candidate(x, g)
+            self.candidate(levels[list(index), range(d)], g)
             for g in range(len(self.grasps))
-            for x in itertools.product(levels, repeat=d)
+            for index in itertools.product(range(k), repeat=d)
         ]
 
 
@@ -191,6 +195,13 @@ def check_place(file: Path, cell: Cell, *, budget: int | None = None, seed: int 
             raise InputError(
                 file, f"place.moves_with_tool[{i}]", f"{name!r} is not an obstacle of the cell"
             )
+    if not 0.0 < place.stand_max_length_mm <= MAX_OFFSET_MM:
+        raise InputError(
+            file,
+            "place.stand_max_length_mm",
+            f"{place.stand_max_length_mm:g} is outside (0, {MAX_OFFSET_MM:g}] mm",
+        )
+    check_stands(file, cell, place.moves_with_tool, 1e-3 * place.stand_max_length_mm)
     axes = _axes(file, "X_IT", place.X_IT)
     grasps = (_pose(cell.part.X_PE),)
     if place.X_PE is not None:

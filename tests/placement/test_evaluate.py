@@ -7,12 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from pydrake.math import RollPitchYaw
 
 from offline_prog.config.cell import load_cell, transform
 from offline_prog.joints.path_ik import reach_excess
 from offline_prog.placement.context import context, placed_cell
 from offline_prog.placement.evaluate import evaluate
-from offline_prog.placement.objective import CANNOT_FOLLOW, COLLIDES, FEASIBLE, Evaluation
+from offline_prog.placement.objective import CANNOT_FOLLOW, COLLIDES, FEASIBLE, STAND, Evaluation
 from offline_prog.placement.payload import cell_payload, unpack
 from offline_prog.placement.screen import screen
 from offline_prog.placement.space import Candidate, check_place
@@ -78,25 +79,54 @@ def test_out_of_reach_grows_with_the_distance(seal):
     assert far.tier == CANNOT_FOLLOW and "out of reach" in far.reason and far.violation > 0
 
 
-def test_the_stand_moves_with_the_tool():
+def _stand(cell):
+    return next(o for o in cell.obstacles if o.name == "nozzle_stand")
+
+
+def test_the_stand_stands_with_the_tool_its_foot_on_the_floor():
+    """The stand's top keeps its place under the tool (turned with the tool's yaw), its
+    foot stays on the floor and its length makes up the difference; the other
+    obstacles stay where they are."""
     cell = load_cell(DEMO)
     _, space = check_place(DEMO, cell)
     ctx = context(cell_payload(DEMO, cell))
-    candidate = space.candidate([0.3, 0.7, 0.5, 0.4], 1)
-    moved = placed_cell(ctx, candidate)
-    X_IT, X_IT_new = transform(cell.tool.X_IT), transform(moved.tool.X_IT)
-    stand = [o for o in cell.obstacles if o.name == "nozzle_stand"][0]
-    stand_new = [o for o in moved.obstacles if o.name == "nozzle_stand"][0]
-    X_TO = X_IT.inverse() @ transform(stand.pose)
-    X_TO_new = X_IT_new.inverse() @ transform(stand_new.pose)
-    assert np.allclose(X_TO.GetAsMatrix4(), X_TO_new.GetAsMatrix4(), atol=2e-6)
-    others = [o.pose for o in moved.obstacles if o.name != "nozzle_stand"]
-    assert [transform(p).GetAsMatrix4().tolist() for p in others] == [
-        transform(o.pose).GetAsMatrix4().tolist()
-        for o in cell.obstacles
-        if o.name != "nozzle_stand"
-    ]
+    stand = _stand(cell)
+    X_IO = transform(stand.pose)
+    X_IT = transform(cell.tool.X_IT)
+    p_TO_top = X_IT.inverse().multiply(X_IO.translation() + [0.0, 0.0, 0.25])  # its top in T
+    for x in ([0.3, 0.7, 0.5, 0.4], [0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 0.0]):
+        candidate = space.candidate(x, 1)
+        moved = placed_cell(ctx, candidate)
+        placed = _stand(moved)
+        X_IO_new, X_IT_new = transform(placed.pose), transform(moved.tool.X_IT)
+        length = 1e-3 * placed.size_mm[2]
+        top = X_IO_new.translation() + [0.0, 0.0, length / 2]
+        foot = X_IO_new.translation()[2] - length / 2
+        assert foot == pytest.approx(0.0, abs=1e-6)  # on the floor, as given
+        assert np.allclose(X_IT_new.inverse().multiply(top), p_TO_top, atol=2e-6)
+        assert length == pytest.approx(0.5 + X_IT_new.translation()[2] - 0.7, abs=2e-6)
+        yaw = candidate.X_IT[1][2]
+        assert RollPitchYaw(X_IO_new.rotation()).vector() == pytest.approx(
+            [0.0, 0.0, np.deg2rad(yaw)], abs=1e-8
+        )
+        others = [repr(o) for o in moved.obstacles if o.name != "nozzle_stand"]
+        assert others == [repr(o) for o in cell.obstacles if o.name != "nozzle_stand"]
     assert moved.part.X_PE.rotation.value.deg.tolist() == [180.0, 0.0, 90.0]
+
+
+def test_a_stand_beyond_its_limit_makes_the_candidate_infeasible():
+    """A tool 2.4 m above the floor needs a 2.2 m stand, beyond the default 2 m; one
+    below the stand's foot, a stand shorter than none: both screened out and
+    infeasible, before any plan."""
+    cell = load_cell(DEMO)
+    ctx = context(cell_payload(DEMO, cell))
+    X_PE = ((0.0, 0.0, 0.1), (180.0, 0.0, 0.0))
+    for z, words in ((2.4, "beyond place.stand_max_length_mm (2000 mm)"), (0.1, "too low")):
+        candidate = Candidate((), -1, ((1.0, 0.0, z), (90.0, 0.0, 0.0)), X_PE)
+        screened, planned = screen(ctx, candidate), evaluate(ctx, candidate)
+        for e in (screened, planned):
+            assert e.tier == STAND and e.failure == "stand" and words in e.reason
+        assert screened.screened_out == "stand" and screened.violation > 0
 
 
 def test_the_payload_carries_the_cell_and_its_data_files():
@@ -195,7 +225,7 @@ def test_why_not_more_names_the_fixed_tool_turn():
         limiting_axis=6,
     )
     base = dataclasses.replace(run, cycle_time_s=14.5)
-    result = Placement(run, base, [base, run], [], 1.0)
+    result = Placement(run, base, [base, run], [], [], 1.0)
     fixed = ToolConfig(free_rotation_deg=90.0)
     why = cycle_time_cut(result, fixed)["why_not_more"]
     assert "limited by axis 6" in why and "tool.turn_smoothing_mm" in why
@@ -203,6 +233,6 @@ def test_why_not_more_names_the_fixed_tool_turn():
     assert "tool.turn_smoothing_mm" not in cycle_time_cut(result, turning)["why_not_more"]
     # A slowdown at the shoulder is not the part's turn: no hint.
     shoulder = [dataclasses.replace(e, limiting_axis=2) for e in (run, base)]
-    result = Placement(shoulder[0], shoulder[1], shoulder[::-1], [], 1.0)
+    result = Placement(shoulder[0], shoulder[1], shoulder[::-1], [], [], 1.0)
     why = cycle_time_cut(result, fixed)["why_not_more"]
     assert "limited by axis 2" in why and "tool.turn_smoothing_mm" not in why

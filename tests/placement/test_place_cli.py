@@ -13,6 +13,7 @@ import time
 import pytest
 
 from offline_prog.cli import main
+from offline_prog.config.cell import load_cell, transform
 from offline_prog.plan import plan_job
 
 from conftest import CELLS
@@ -28,6 +29,26 @@ CONTRACT = {
     "clearance_mm",
     "reason",
 }
+
+
+def assert_stands_on_the_floor(placed):
+    """Every stand of a placed.yaml has its foot on the floor: on z = 0 of I, where the
+    demo cells stand it (their floor slab's top is 1 mm under it), whatever its length."""
+    cell = load_cell(placed)
+    floor = next(o for o in cell.obstacles if o.name == "floor")
+    floor_top = transform(floor.pose).translation()[2] + 0.5e-3 * floor.size_mm[2]
+    assert cell.place.moves_with_tool
+    for name in cell.place.moves_with_tool:
+        stand = next(o for o in cell.obstacles if o.name == name)
+        X_IO = transform(stand.pose)
+        length = 1e-3 * (stand.size_mm[2] if stand.shape == "box" else stand.length_mm)
+        assert abs(X_IO.rotation().matrix()[2, 2]) == pytest.approx(1.0)  # upright
+        foot = X_IO.translation()[2] - length / 2
+        assert foot == pytest.approx(0.0, abs=1e-6), (name, foot)
+        assert 0.0 <= foot - floor_top <= 1e-3 + 1e-6  # on the floor
+        top = X_IO.translation()[2] + length / 2
+        tool_z = cell.tool.X_IT.translation[2]
+        assert top == pytest.approx(tool_z - 0.2, abs=1e-6)  # 0.2 m under the nozzle's tip
 
 
 def small_search(tmp_path, screen_points: int = 100):
@@ -47,14 +68,17 @@ def test_no_feasible_placement_is_exit_1_with_the_closest_reason_and_outputs(tmp
     code = main(["place", str(file), "--out", str(out), "--budget", "3", "--workers", "0"])
     captured = capsys.readouterr()
     err = captured.err.strip().splitlines()
-    assert code == 1 and len(err) == 1 and "no feasible placement in 3 candidates" in err[0]
+    assert code == 1 and len(err) == 1, err
+    assert "no feasible placement in 1 candidate planned (32 by reach screened out)" in err[0]
     assert "out of reach" in err[0]
     data = json.loads((out / "placement.json").read_text())
     assert not data["best"]["feasible"] and data["best"]["failure"] == "out_of_reach"
-    assert data["search"]["failures"] == {"out_of_reach": 3}
+    assert data["search"]["failures"] == {"out_of_reach": 1}  # the cell as given
+    assert data["screening"]["fates"]["reach"] == 32  # the grid: 2 levels ^ 4 axes, 2 grasps
     assert not (out / "best_preview.html").exists()
     said = captured.out.strip().splitlines()[-1]
     assert said.endswith(f"wrote into {out}: placed.yaml, placement.html, placement.json")
+    assert_stands_on_the_floor(out / "placed.yaml")
 
 
 @pytest.mark.slow  # ~25 s: two searches of 10 candidates, a LocalCluster, one plan
@@ -80,6 +104,11 @@ def test_place_makes_an_out_of_reach_cell_feasible_the_same_on_any_workers(tmp_p
     # placed.yaml: the cell's text (comments kept) with the best placement; plan agrees.
     placed = (serial / "placed.yaml").read_text()
     assert "# Deliberately poor: 2.2 m from the robot base" in placed
+    assert_stands_on_the_floor(serial / "placed.yaml")
+    assert_stands_on_the_floor(dask / "placed.yaml")
+    description = load_cell(serial / "placed.yaml").description  # says what was placed
+    assert description.startswith("Placed by offline-prog place from out_of_reach.yaml")
+    assert "nozzle_stand 500 -> " in description and f"{best['cycle_time_s']:.2f} s" in description
     plan = plan_job(serial / "placed.yaml")  # a path: cell: a one-seam job, home to home
     assert plan.feasible
     assert plan.samples.t[-1] == pytest.approx(best["cycle_time_s"], abs=1e-9)
@@ -167,4 +196,76 @@ def test_a_whole_job_is_placed_and_plan_agrees(tmp_path):
 
     job = plan_job(out / "placed.yaml")
     assert job.feasible
+    assert_stands_on_the_floor(out / "placed.yaml")
     assert job.samples.t[-1] - job.samples.t[0] == pytest.approx(best["cycle_time_s"], abs=1e-9)
+
+
+@pytest.fixture
+def scheduler(tmp_path):
+    """A Dask scheduler on this machine (no workers yet): its address."""
+    file = tmp_path / "scheduler.json"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "dask", "scheduler", "--scheduler-file", str(file), "--port", "0"]
+        + ["--dashboard-address", ":0"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 60
+    while not file.exists() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    time.sleep(0.5)  # written whole
+    try:
+        yield json.loads(file.read_text())["address"]
+    finally:
+        process.kill()
+        process.wait()
+
+
+def _worker(address: str) -> subprocess.Popen:
+    """A worker process without a nanny (killed, it stays dead)."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "dask", "worker", address, "--nthreads", "1", "--no-nanny"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+
+
+@pytest.mark.slow  # a scheduler started; the wait for a worker: 5 s
+def test_a_scheduler_without_workers_is_one_line_exit_2(tmp_path, capsys, scheduler):
+    code = main(["place", str(DEMO), "--out", str(tmp_path / "o"), "--scheduler", scheduler])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert scheduler in err[0] and "no worker joined it" in err[0]
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow  # ~2 min: a scheduler, two workers, a search, and the same search here
+def test_a_worker_killed_mid_run_leaves_the_same_best_placement(tmp_path, scheduler):
+    file = small_search(tmp_path)
+    workers = [_worker(scheduler) for _ in range(2)]
+    out = tmp_path / "cluster"
+    command = [sys.executable, "-m", "offline_prog", "place", str(file), "--out", str(out)]
+    process = subprocess.Popen(
+        [*command, "--budget", "8", "--scheduler", scheduler],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        for line in process.stdout:  # piped: the progress lines
+            if "planning candidates in full 1/" in line:
+                workers[0].kill()  # mid-run: the other plans are still to come
+                break
+        _, err = process.communicate(timeout=600)
+    finally:
+        process.kill()
+        for worker in workers:
+            worker.kill()
+            worker.wait()
+    assert workers[0].returncode is not None and workers[0].returncode != 0
+    assert process.returncode == 0, err
+    serial = tmp_path / "serial"
+    assert main(["place", str(file), "--out", str(serial), "--budget", "8", "--workers", "0"]) == 0
+    ours, theirs = (json.loads((d / "placement.json").read_text()) for d in (out, serial))
+    assert ours["best"] == {**theirs["best"], "evaluation_s": ours["best"]["evaluation_s"]}
+    assert_stands_on_the_floor(out / "placed.yaml")

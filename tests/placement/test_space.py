@@ -29,8 +29,8 @@ def _variant(tmp_path, old: str, new: str):
         ("x: [700, 1900]", "x: []", "place.X_IT.translation_mm.x", "expected [low, high]"),
         ("yaw: [0, 60]", "yaw: [60, 0]", "place.X_IT.rpy_deg.yaw", "inverted range"),
         ("yaw: [0, 60]", "spin: [0, 60]", "place.X_IT.rpy_deg.spin", "unknown key"),
-        ("budget: 200", "budget: 0", "place.budget", "outside 1..100,000"),
-        # numpy takes seeds below 2³², and CMA-ES gets seed + 1 + its restarts
+        ("budget: 16", "budget: 0", "place.budget", "outside 1..100,000"),
+        # numpy takes seeds below 2³²
         ("seed: 0", "seed: 4294967295", "place.seed", "outside 0..2,147,483,647"),
         ("seed: 0", "seed: -1", "place.seed", "outside 0..2,147,483,647"),
         (
@@ -38,6 +38,31 @@ def _variant(tmp_path, old: str, new: str):
             "moves_with_tool: [stand]",
             "place.moves_with_tool[0]",
             "'stand' is not an obstacle",
+        ),
+        (
+            "moves_with_tool: [nozzle_stand]",
+            "moves_with_tool: [fence_post]\n  stand_max_length_mm: 1000",
+            "place.stand_max_length_mm",
+            "1000 mm is shorter than 'fence_post' as given (2000 mm)",
+        ),
+        (
+            "moves_with_tool: [nozzle_stand]",
+            "moves_with_tool: [nozzle_stand]\n  stand_max_length_mm: 0",
+            "place.stand_max_length_mm",
+            "outside (0, 10000] mm",
+        ),
+        (
+            "size_mm: [200, 200, 500], pose: {translation: [2.2, 0.4, 0.250]}",
+            "size_mm: [200, 200, 500], pose: {translation: [2.2, 0.4, 0.250], "
+            "rotation: !Rpy {deg: [5, 0, 0]}}",
+            "place.moves_with_tool[0]",
+            "'nozzle_stand' is not upright",
+        ),
+        (
+            "{name: nozzle_stand, shape: box, size_mm: [200, 200, 500],",
+            "{name: nozzle_stand, shape: sphere, radius_mm: 100,",
+            "place.moves_with_tool[0]",
+            "'nozzle_stand' is a sphere: a stand keeps its foot on the floor by its length",
         ),
         (
             "  X_PE:   ",
@@ -110,3 +135,20 @@ def test_unit_coordinates_map_onto_the_named_ranges_only(rng):
     grid = space.grid(place.screen_points)
     assert len(grid) == 2 * 5**4  # 5 levels of 4 axes ≤ 1000 points, per grasp
     assert len({c.X_IT for c in grid}) == 5**4
+    levels = np.unique(np.round(np.array([c.x for c in grid]), 9))
+    assert np.allclose(levels, [0.1, 0.3, 0.5, 0.7, 0.9])  # cell-centred for seed 0
+    shifted = space.grid(place.screen_points, seed=7)
+    steps = np.array([c.x for c in shifted]) - np.array([c.x for c in grid])
+    assert np.allclose(steps, steps[0]) and 0 < np.abs(steps[0]).max() <= 0.1  # one shift
+    assert [c.X_IT for c in space.grid(place.screen_points, seed=7)] == [c.X_IT for c in shifted]
+
+
+@pytest.mark.parametrize("file", sorted((CELLS / "placement").glob("*.yaml")), ids=lambda f: f.stem)
+def test_every_placement_demo_is_valid_and_its_stands_stand(file):
+    from offline_prog.placement.stand import stands
+
+    cell = load_cell(file)
+    place, space = check_place(file, cell)
+    assert space.dimensions >= 4 and place.budget <= 16
+    for stand in stands(cell):
+        assert stand.foot_z == pytest.approx(0.0, abs=1e-9)  # on the floor (z = 0 of I)
