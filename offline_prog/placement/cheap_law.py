@@ -72,7 +72,7 @@ def law_seam_s(view, variants: SeamVariants, X_IT: RigidTransform, X_PE: RigidTr
         controller,
         qd_max=robot.qd_max,
         qdd_max=robot.qdd_max,
-        v_cap=run.nominal.v_max,
-        a_path=run.nominal.a_max,
+        v_cap=run.limits.v_process,
+        a_path=run.limits.a_max,
     )
     return float(profile.duration) if profile.ok else float("nan")
