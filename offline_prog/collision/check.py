@@ -51,7 +51,7 @@ N_WORST_PAIRS = 5
 MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drake's, noted
 MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
 TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
-OWNER_ORDER = ("part", "tool", "robot", "obstacle")
+OWNER_ORDER = ("part", "gripper", "tool", "robot", "obstacle")
 
 
 class _Pairs:
@@ -396,4 +396,5 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         stats,
         self_clearance,
         cell.skipped_self_pairs,
+        cell.held_contacts,
     )

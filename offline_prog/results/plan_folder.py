@@ -29,12 +29,12 @@ from offline_prog.constants import TimeLaw
 from offline_prog.errors import InputError
 from offline_prog.export.densify import dense_grid
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
-from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.job.records import Plan
 from offline_prog.results.report import report
 from offline_prog.robot.dense_joints import dense_joints
 from offline_prog.robot.record import robot_record
+from offline_prog.scene.payload import payload_record
 from offline_prog.timing.trajectory import CSV_COLUMNS
 from offline_prog.viz.preview import write_preview_html
 from offline_prog.viz.report_html import write_report_html
@@ -115,7 +115,7 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "j23_factor": robot.j23_factor,
         "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
-        "payload": payload_record(cell),
+        "payload": payload_record(cell, cell_file),
         "robot_record": robot_record(robot),
     }
 
