@@ -29,7 +29,7 @@ def shape_outline(kind: str, size_m) -> list[np.ndarray]:
     """Polylines (K, 3) [m] outlining a shape in its own frame G (centred on G)."""
     if kind in ("box", "mesh"):
         half = np.asarray(size_m, float) / 2
-        corners = half * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]])
+        corners = half[:2] * np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]])
         lines = [np.column_stack([corners, np.full(5, z)]) for z in (-half[2], half[2])]
         lines += [np.array([[x, y, -half[2]], [x, y, half[2]]]) for x, y in corners[:4]]
         return lines

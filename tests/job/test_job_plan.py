@@ -6,6 +6,7 @@ import csv
 
 import numpy as np
 import pytest
+from gripper_clearance import GRIPPER_CLEARANCE_TOL_M, gripper_clearance
 
 from offline_prog.config.cell import load_cell
 from offline_prog.robot.model import load_robot
@@ -215,3 +216,12 @@ def test_a_link_not_found_in_time_ends_with_exit_1_naming_it_reports_written(tmp
     assert failed and failed[0]["name"] in line
     assert (out / "trajectory.csv").is_file() and (out / "collisions.json").is_file()
     assert not (out / "programs").exists()
+
+
+def test_the_gripper_is_clear_by_a_second_library(planned_job):
+    """The job's gripper keeps the clearance from the tool and the obstacles on every row
+    (python-fcl on shapes built from the cell file, tests/gripper_clearance.py)."""
+    _, folder = planned_job(JOB)
+    distance, pair, row = gripper_clearance(CELLS / f"{JOB}.yaml", folder / "trajectory.csv")
+    clearance = load_cell(CELLS / f"{JOB}.yaml").motion.clearance
+    assert distance >= clearance - GRIPPER_CLEARANCE_TOL_M, (distance, pair, row)
