@@ -159,3 +159,35 @@ def test_placement_demos_plan_with_their_grippers(tmp_path, name):
     assert "payload" not in done.stdout  # no payload warning: the cell gives the masses
     distance, pair, row = gripper_clearance(cell, out / "trajectory.csv")
     assert distance >= load_cell(cell).motion.clearance - GRIPPER_CLEARANCE_TOL_M, (pair, row)
+
+
+def test_a_gripper_mesh_is_a_shape_in_E_with_its_mass_properties(tmp_path):
+    """``gripper.mesh`` (here a box in mm, off the flange axis) is the shape "gripper" on
+    the gripper body, posed in E; its centre of mass is the box's; a placement worker
+    gets the file."""
+    import trimesh
+
+    from offline_prog.placement.payload import cell_payload, data_file_keys
+    from offline_prog.robot.model import load_robot
+    from offline_prog.scene.payload import payload_record
+
+    box = trimesh.creation.box([80, 60, 40])
+    box.apply_translation([10, 0, 20])
+    box.export(tmp_path / "gripper.stl")
+    text = (CELLS / f"{DEMO}.yaml").read_text(encoding="utf-8")
+    start, end = text.index("\ngripper:") + 1, text.index("\npart:\n") + 1
+    gripper = "gripper:\n  mass_kg: 2\n  mesh: gripper.stl\n  mesh_units: mm\n"
+    file = tmp_path / "mesh.yaml"
+    file.write_text(text[:start] + gripper + text[end:], encoding="utf-8")
+    cell = load_cell(file)
+    scene = build_cell_model(cell, file, load_robot(cell.robot.model))
+    (label,) = [lb for lb in scene.labels.values() if lb.owner == "gripper"]
+    assert (label.name, label.body) == ("gripper", "gripper")
+    inspector = scene.diagram.scene_graph().model_inspector()
+    (g,) = [g for g, lb in scene.labels.items() if lb.owner == "gripper"]
+    X_EG = inspector.GetPoseInFrame(g)  # the mesh's frame is E
+    np.testing.assert_allclose(X_EG.GetAsMatrix4(), np.eye(4), atol=1e-12)
+    record = payload_record(cell, file)
+    np.testing.assert_allclose(record["gripper_com_E_m"], [0.01, 0, 0.02], atol=1e-9)
+    assert data_file_keys(cell)["gripper.mesh"] == "gripper.stl"
+    assert any(name.endswith("gripper.stl") for name, _ in cell_payload(file, cell).files)
