@@ -9,6 +9,7 @@ import re
 
 import numpy as np
 import pytest
+from gripper_clearance import GRIPPER_CLEARANCE_TOL_M, gripper_clearance
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
@@ -207,3 +208,14 @@ def test_demo_cells_plan_clear_at_the_default_clearances_with_vendor_meshes(plan
     skipped = report["self_collision_pairs_skipped"]
     assert skipped and all(p["class"] != "check" and p["reason"] for p in skipped)
     assert {p["class"] for p in skipped} <= {"adjacent", "always", "constant", "never"}
+
+
+def test_the_gripper_is_clear_by_a_second_library(request, planned_job_csv, planned_job):
+    """The demo's gripper keeps the clearance from the tool and the obstacles on every
+    row of trajectory.csv, measured with python-fcl on shapes built from the cell file
+    (tests/gripper_clearance.py), not the planner's SceneGraph."""
+    cell_file = planned_job_csv[0]
+    _, folder = planned_job(cell_file.stem)
+    distance, pair, row = gripper_clearance(cell_file, folder / "trajectory.csv")
+    clearance = load_cell(cell_file).motion.clearance
+    assert distance >= clearance - GRIPPER_CLEARANCE_TOL_M, (distance, pair, row)

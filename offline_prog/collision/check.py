@@ -7,11 +7,10 @@ with python-fcl (:func:`~offline_prog.scene.exact_distance.exact_distance`), whi
 
 Motion bound (Schwarzer, Saha & Latombe, "Adaptive dynamic collision checking for single
 and multiple articulated robots in complex environments", IEEE T-RO 21(3), 2005): moving
-the joints along the straight line from q_a to q_b moves no point of the robot or the part
-farther than M(a, b) = Σ_k ρ_k |q_b,k − q_a,k|, where ρ_k bounds the distance of every
-geometry outboard of joint k from a point on its axis (``DrakeCell.motion_radii``). A pair's
-signed distance changes by at most c·M, c = 1 when one side is fixed (tool, obstacles,
-robot base) and 2 when both move. Hence, per geometry pair g (each queried alone):
+the joints along the straight line from q_a to q_b changes a pair's signed distance by at
+most c·M_g(a, b), M_g = Σ_k ρ_k |q_b,k − q_a,k| over the joints between its two sides (its
+span, :mod:`~offline_prog.collision.pairs`), c = 1, or 0 for a pair that never moves.
+Hence, per geometry pair g (each queried alone, M_g its own cumulative motion bound):
 
 * evaluated at sample i with distance d_g, g is certified (≥ clearance + margin) up to a
   cumulative motion of (d_g − clearance − margin) / c_g and next evaluated at the last
@@ -31,6 +30,7 @@ from heapq import heappop, heappush
 import numpy as np
 
 from offline_prog.arrays import at_index, true_runs
+from offline_prog.collision.pairs import Pairs
 from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     CollisionResult,
     CollisionStretch,
@@ -39,8 +39,6 @@ from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     write_collisions_json,
 )
 from offline_prog.scene.drake_cell import DrakeCell
-from offline_prog.scene.exact_distance import exact_distance, exact_shape
-from offline_prog.scene.filters import allow_fixed_layout
 
 # A pair certified above clearance + this is not evaluated (its minimum is then over
 # the evaluated points only).
@@ -51,92 +49,6 @@ N_WORST_PAIRS = 5
 MAX_EXACT_CHECKS = 2000  # FCL refinements of mesh pairs per check; beyond: Drake's, noted
 MIN_SUBSTEP_M = 1e-4  # bisection stops here even for clearance 0
 TOUCH_TOL_M = 1e-9  # a signed distance above −this is touching, not overlapping
-OWNER_ORDER = ("part", "tool", "robot", "obstacle")
-
-
-class CheckedPairs:
-    """The unfiltered geometry pairs g of a cell, grouped into shape pairs s, and their
-    signed distances at a joint vector (Drake) or on the original shapes (FCL)."""
-
-    def __init__(self, cell: DrakeCell, *, fixed_layout: bool = False):
-        self.cell, plant = cell, cell.plant
-        self.context = cell.diagram.CreateDefaultContext()
-        self.plant_context = plant.GetMyMutableContextFromRoot(self.context)
-        scene_graph = cell.diagram.scene_graph()
-        self.sg_context = scene_graph.GetMyMutableContextFromRoot(self.context)
-        if fixed_layout:  # in this context only: IK and plots keep Drake's filters
-            allow_fixed_layout(
-                scene_graph, plant, cell.robot, cell.labels, self.sg_context, cell.allowed_contact
-            )
-        # The robot's joints are the plant's only positions: the whole plant's are set.
-        assert plant.num_positions() == plant.num_positions(cell.robot), "robot only"
-        self._set_positions = plant.SetPositions
-        # The query object reads the context at each query (poses updated on demand):
-        # evaluated once, it answers for the positions last set.
-        self.query = scene_graph.get_query_output_port().Eval(self.sg_context)
-        fixed = {b.name() for b in plant.GetBodiesWeldedTo(plant.world_body())}
-        rank = {owner: i for i, owner in enumerate(OWNER_ORDER)}
-        self.ids, self.names, shape_of, c = [], [], [], []
-        for r in self.query.ComputeSignedDistancePairwiseClosestPoints():
-            labels = (cell.labels[r.id_A], cell.labels[r.id_B])
-            a, b = sorted(labels, key=lambda label: (rank[label.owner], label.name))
-            if (a.name, b.name) not in self.names:
-                self.names.append((a.name, b.name))
-            self.ids.append((r.id_A, r.id_B))
-            shape_of.append(self.names.index((a.name, b.name)))
-            # How fast the distance can change per unit of motion bound (0: both fixed).
-            c.append(
-                0.0
-                if a.body in fixed and b.body in fixed
-                else 1.0
-                if a.body in fixed or b.body in fixed
-                else 2.0
-            )
-        self.shape_of, self.c = np.array(shape_of, dtype=int), np.array(c)
-        robot = {label.name for label in cell.labels.values() if label.owner == "robot"}
-        # Robot link vs robot link: held to the self-clearance, per shape pair s.
-        self.is_self = np.array([a in robot and b in robot for a, b in self.names], dtype=bool)
-        # Fixed layout (robot base, tool, obstacles): never moves, held to contact only.
-        fixed_s = np.ones(len(self.names), dtype=bool)
-        fixed_s[self.shape_of[self.c > 0]] = False
-        self.is_fixed = fixed_s
-        owner = {label.name: label.owner for label in cell.labels.values()}
-        self.groups = [
-            "robot-self" if owner[a] == owner[b] else f"{owner[a]}-{owner[b]}"
-            for a, b in self.names
-        ]
-        mesh = {lb.name for lb in cell.labels.values() if lb.shape and lb.shape.kind == "mesh"}
-        self.has_mesh = np.array([a in mesh or b in mesh for a, b in self.names], dtype=bool)
-        self._exact, self.exact_checks, self.evaluations = {}, 0, 0
-
-    def set(self, q: np.ndarray) -> None:
-        """Set the joint positions q (6,) [rad] the next distances are measured at."""
-        self._set_positions(self.plant_context, q)
-
-    def distance(self, g: int) -> float:
-        """Drake's signed distance [m] of geometry pair g at the last set q."""
-        self.evaluations += 1
-        return self.query.ComputeSignedDistancePairClosestPoints(*self.ids[g]).distance
-
-    def _components(self, name: str):
-        """[(ExactShape, a GeometryId giving its pose X_IG)] of a shape name."""
-        if name not in self._exact:
-            ids = [g for g, label in self.cell.labels.items() if label.name == name]
-            shape = self.cell.labels[ids[0]].shape
-            self._exact[name] = (
-                [(exact_shape(shape.kind, shape.size_m, shape.mesh), ids[0])]
-                if shape is not None
-                else [(self.cell.exact_shape(g), g) for g in ids]
-            )
-        return self._exact[name]
-
-    def exact(self, q: np.ndarray, s: int) -> float:
-        """FCL's distance [m] of shape pair s on the original shapes at q."""
-        self.set(q)
-        self.exact_checks += 1
-        a, b = (self._components(name) for name in self.names[s])
-        pose = self.query.GetPoseInWorld
-        return min(exact_distance(sa, pose(ga), sb, pose(gb)) for sa, ga in a for sb, gb in b)
 
 
 def check_trajectory(
@@ -176,12 +88,13 @@ def check_trajectory(
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"{name}: expected a distance >= 0 m, got {value!r}")
     start = time.perf_counter()
-    pairs, rho = CheckedPairs(cell, fixed_layout=True), cell.motion_radii()
+    pairs, rho = Pairs(cell, fixed_layout=True), cell.motion_radii()
     clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
     clear_s = np.where(pairs.is_fixed, 0.0, clear_s)  # a base on its floor touches it
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]
-    step = np.abs(np.diff(q, axis=0)) @ rho  # (N - 1,) motion bound of each step [m]
-    cumulative = np.concatenate([[0.0], np.cumsum(step)])
+    # (N - 1, n_spans) motion bound of each step, per span of joints [m], and its sums.
+    step = np.abs(np.diff(q, axis=0)) @ pairs.span_radii(rho).T
+    cumulative = np.vstack([np.zeros((1, len(pairs.spans))), np.cumsum(step, axis=0)])
     # (geometry pair g, point x, Drake distance) of each evaluation, in order.
     found_g: list[int] = []
     found_x: list[float] = []
@@ -205,7 +118,8 @@ def check_trajectory(
     # In Python floats and a heap (numpy's per-call cost dominates arrays of a few
     # elements: usually a pair or two near an obstacle are due at a sample), the
     # sample loop's calls bound once: most of a long seam is one pair at every sample.
-    cumulative_list, step_list, rows = cumulative.tolist(), step.tolist(), list(q)
+    by_span = [(c.tolist(), s.tolist()) for c, s in zip(cumulative.T, step.T, strict=True)]
+    motion_g, rows = [by_span[k] for k in pairs.span_of], list(q)  # g's (cumulative, step)
     set_positions, context = pairs._set_positions, pairs.plant_context
     query, ids = pairs.query.ComputeSignedDistancePairClosestPoints, pairs.ids
     # (next sample to evaluate, g) of each pair not yet certified to the end; pairs due
@@ -220,6 +134,7 @@ def check_trajectory(
         seam with a tool near the part), without the heap in between."""
         nonlocal evaluated
         pair, c, clear = ids[g], c_list[g], clear_list[g]
+        cumulative_list, step_list = motion_g[g]
         while True:
             set_positions(context, rows[i])
             d = query(*pair).distance
@@ -255,6 +170,7 @@ def check_trajectory(
         split = []
         for g, d in zip(now, d_now, strict=True):
             c, clear = c_list[g], clear_list[g]
+            cumulative_list, step_list = motion_g[g]
             if c != 0.0:  # nothing moves (c = 0): measured once
                 # The last sample the distance budget reaches (searchsorted, right).
                 reach = bisect_right(cumulative_list, cumulative_list[i] + (d - clear - margin) / c)
@@ -264,7 +180,7 @@ def check_trajectory(
                 split.append((g, d))
             last_i[g] = i
         for g, d in split:
-            bisect(g, i - 1.0, last_d[g], x, d, step_list[i - 1])
+            bisect(g, i - 1.0, last_d[g], x, d, motion_g[g][1][i - 1])
         for g, d in zip(now, d_now, strict=True):
             last_d[g] = d
     pairs.evaluations += evaluated
@@ -396,4 +312,5 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         stats,
         self_clearance,
         cell.skipped_self_pairs,
+        cell.held_contacts,
     )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from offline_prog.collision.check import CheckedPairs
+from offline_prog.collision.pairs import Pairs
 from offline_prog.scene.drake_cell import DrakeCell
 
 PROFILE_POINTS = 400  # samples of the distance-over-time profile (report plot)
@@ -22,7 +22,7 @@ def distance_profile(
     Returns:
         (t_k (K,), {group: (K,) smallest Drake signed distance in that group [m]}).
     """
-    pairs = CheckedPairs(cell)
+    pairs = Pairs(cell)
     index = np.unique(np.linspace(0, len(q) - 1, min(n_points, len(q))).astype(int))
     profile = {group: np.full(len(index), np.inf) for group in sorted(set(pairs.groups))}
     for k, i in enumerate(index):

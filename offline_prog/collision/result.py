@@ -96,6 +96,19 @@ class CollisionResult:
     # Robot link pairs not checked, with class and reason (robots/<robot>/self_collision.yaml);
     # None: the robot has no matrix, every pair was checked.
     skipped_self_pairs: list | None = None
+    # (a, b, reason) of the pairs not checked because one holds the other (the gripper
+    # on the flange link, the part in the gripper): DrakeCell.held_contacts.
+    held_contacts: list | None = None
+
+
+def pair_names(pair: PairMinimum) -> str:
+    """ "a vs b", a shape of the gripper named so ("finger (gripper) vs stand"): the
+    gripper's shapes are named by the user, and it is the body nobody expects to hit."""
+    owners = pair.group.split("-")  # "part-obstacle", ..., "robot-self"
+    return " vs ".join(
+        f"{name} (gripper)" if owner == "gripper" and name != "gripper" else name
+        for name, owner in zip((pair.a, pair.b), owners, strict=True)
+    )
 
 
 def failure_message(first, stretch, closest, clearance) -> str:
@@ -103,12 +116,12 @@ def failure_message(first, stretch, closest, clearance) -> str:
     else the closest approach below the clearance; "" when clear."""
     if first is not None:
         return (
-            f"collision: {first.a} vs {first.b} at σ = {first.sigma_m:.4f} m, "
+            f"collision: {pair_names(first)} at σ = {first.sigma_m:.4f} m, "
             f"t = {first.t_s:.3f} s, depth {stretch.worst.depth_m * 1e3:.2f} mm"
         )
     if closest is not None and closest.distance_m < clearance:
         return (
-            f"clearance: {closest.a} vs {closest.b} at σ = {closest.sigma_m:.4f} m, "
+            f"clearance: {pair_names(closest)} at σ = {closest.sigma_m:.4f} m, "
             f"t = {closest.t_s:.3f} s: {max(closest.distance_m, 0.0) * 1e3:.2f} mm < "
             f"{clearance * 1e3:.2f} mm"
         )

@@ -32,7 +32,7 @@ def required():
 @dataclasses.dataclass
 class ShapeConfig:
     """A named collision/visual shape, posed in its owner's frame (I for obstacles,
-    T for the tool, P for the part). Sizes in mm (the keys say so)."""
+    T for the tool, P for the part, E for the gripper). Sizes in mm (the keys say so)."""
 
     name: str = required()
     shape: str = required()  # box | cylinder | sphere | capsule | mesh
@@ -108,6 +108,9 @@ class PartConfig:
     model: str | None = None  # STEP or STL/OBJ/PLY: seams (cad:), collision and visual
     geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in P
     mass_kg: float | None = None  # payload: the part's mass ...
+    # ... its inertia [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] about its centre of mass, axes of P
+    # (default: from its shapes, the mass spread evenly through them) ...
+    inertia_kgm2: list[float] | None = None
     center_of_mass_mm: list[float] | None = None  # ... and its centre of mass in P
     # The controller's frame that holds P on the flange: KUKA TOOL_DATA[m], FANUC UTOOL.
     controller_frame: int | None = None
@@ -115,11 +118,21 @@ class PartConfig:
 
 @dataclasses.dataclass
 class GripperConfig:
-    """The robot-held gripper that holds the part: its mass and centre of mass in the
-    flange frame E (payload statements of the programs)."""
+    """The gripper on the flange that holds the part, everything in the flange frame E:
+    its shapes and mesh (drawn and collision-checked with the robot) and its mass
+    properties (the payload, with the part's). Centre of mass and inertia default to
+    those of its shapes with the mass spread evenly through them."""
 
-    mass_kg: float = required()
-    center_of_mass_mm: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 0.0])
+    mass_kg: float | None = None
+    center_of_mass_mm: list[float] | None = None  # in E (default: the shapes', else E's origin)
+    # [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] about the centre of mass, axes of E (default: the shapes')
+    inertia_kgm2: list[float] | None = None
+    mesh: str | None = None  # STL/OBJ/PLY/GLB in E, relative to the cell file ("gripper")
+    mesh_units: str = "m"
+    geometry: list[ShapeConfig] = dataclasses.field(default_factory=list)  # in E
+
+
+GRIPPER_MESH_NAME = "gripper"  # the shape of gripper.mesh (as part.mesh is part.name)
 
 
 @dataclasses.dataclass

@@ -214,6 +214,9 @@ def data_file_keys(cell: Cell) -> dict[str, str]:
         keys["part.mesh"] = cell.part.mesh
     if cell.part.model:  # STEP or mesh: seams, collision and visual geometry
         keys["part.model"] = cell.part.model
+    gripper = cell.gripper
+    if gripper is not None and gripper.mesh:
+        keys["gripper.mesh"] = gripper.mesh
     paths = [("path", cell.path)] if cell.path else list(enumerate(cell.seams))
     for key, path in paths:
         key = key if isinstance(key, str) else f"seams.{key}"
@@ -226,6 +229,7 @@ def data_file_keys(cell: Cell) -> dict[str, str]:
         ("obstacles", cell.obstacles),
         ("part.geometry", cell.part.geometry),
         ("tool.geometry", cell.tool.geometry),
+        ("gripper.geometry", gripper.geometry if gripper is not None else []),
     ):
         for i, shape in enumerate(shapes):
             if shape.shape == "mesh" and shape.mesh:

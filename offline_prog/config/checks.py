@@ -12,15 +12,14 @@ import numpy as np
 
 from offline_prog.config.cad_keys import check_cad, check_part_model
 from offline_prog.config.calibration_keys import check_calibration, check_controller_frames
-from offline_prog.config.cell import Cell, PathConfig, transform
+from offline_prog.config.cell import GRIPPER_MESH_NAME, Cell, PathConfig, transform
 from offline_prog.config.job_checks import check_job
+from offline_prog.config.payload_keys import check_payload
 from offline_prog.config.process_keys import check_process
 from offline_prog.config.robot_search import find_robot, robots_in, search_path
 from offline_prog.config.unit_slips import far_translation
 from offline_prog.constants import (
-    MAX_CENTER_OF_MASS_MM,
     MAX_DATA_FILE_BYTES,
-    MAX_PAYLOAD_KG,
     MAX_SAMPLE_RATE_HZ,
     MAX_SPEED_M_S,
     PROCESS_INTENTS,
@@ -135,7 +134,7 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     for key in ("clearance", "self_clearance"):
         if not getattr(motion, key) >= 0:
             raise _error(file, f"motion.{key}", f"must be ≥ 0 m, got {getattr(motion, key)}")
-    _check_payload(file, cell)
+    check_payload(file, cell, _check_data_file)
     _check_shapes(file, cell)
     check_calibration(file, cell.calibration)
     check_controller_frames(file, cell, None)  # the robot's own ranges: stages.load_inputs
@@ -178,22 +177,6 @@ def _check_path(file: Path, key: str, path: PathConfig, cell: Cell) -> None:
             raise _error(file, f"{key}.{name}", f"must be > 0, got {getattr(path, name)}")
 
 
-def _check_payload(file: Path, cell: Cell) -> None:
-    """Masses within [0, MAX_PAYLOAD_KG], centres of mass 3 numbers within reach."""
-    loads = [("part", cell.part.mass_kg, cell.part.center_of_mass_mm)]
-    if cell.gripper is not None:
-        loads.append(("gripper", cell.gripper.mass_kg, cell.gripper.center_of_mass_mm))
-    for owner, mass, com in loads:
-        if mass is not None and not 0.0 <= mass <= MAX_PAYLOAD_KG:
-            raise _error(file, f"{owner}.mass_kg", f"must be within [0, {MAX_PAYLOAD_KG:g}] kg")
-        if com is not None and not (len(com) == 3 and np.linalg.norm(com) <= MAX_CENTER_OF_MASS_MM):
-            raise _error(
-                file,
-                f"{owner}.center_of_mass_mm",
-                f"expected [x, y, z] within {MAX_CENTER_OF_MASS_MM:g} mm, got {com}",
-            )
-
-
 def _check_data_file(file: Path, key: str, data_file: Path) -> None:
     """A path or mesh file exists and is at most MAX_DATA_FILE_BYTES."""
     if not data_file.is_file():
@@ -216,8 +199,13 @@ def _check_shapes(file: Path, cell: Cell) -> None:
         ("part.geometry", cell.part.geometry),
         ("tool.geometry", cell.tool.geometry),
         ("obstacles", cell.obstacles),
+        ("gripper.geometry", cell.gripper.geometry if cell.gripper else []),
     ]
     names = {cell.part.name} if cell.part.mesh or cell.part.model else set()
+    if cell.gripper is not None and cell.gripper.mesh:
+        if GRIPPER_MESH_NAME in names:
+            raise _error(file, "gripper.mesh", f"shape name {GRIPPER_MESH_NAME!r} used twice")
+        names.add(GRIPPER_MESH_NAME)
     for key, shapes in owners:
         for i, shape in enumerate(shapes):
             where = f"{key}[{i}]"

@@ -1,10 +1,10 @@
 """The load the robot carries: the gripper (fixed to the flange E) and the part (P).
 
-Cell keys: ``gripper: {mass_kg, center_of_mass_mm}`` (centre of mass in E) and
-``part: {mass_kg, center_of_mass_mm}`` (in P). A program states the load only when
-both masses are given; otherwise every program header and report.json say that the
-payload is not set, so that nobody runs the robot with a wrong load unknowingly.
-Inertia is not given: the programs write point masses (zero inertia).
+The record is the plan's (``scene.payload.payload_record``, stored in plan.npz): the
+gripper's mass and centre of mass in E, the part's in P, their inertias and the two as
+one load. A program states the load only when both masses are given; otherwise every
+program header and report.json say that the payload is not set, so that nobody runs
+the robot with a wrong load unknowingly. The programs write point masses (no inertia).
 """
 
 from __future__ import annotations
@@ -30,18 +30,6 @@ class Payload:
         p_EC = X_EP[:3, :3] @ self.p_PC + X_EP[:3, 3]
         weighted = self.gripper_mass_kg * self.p_EG + self.part_mass_kg * p_EC
         return mass, weighted / mass if mass > 0 else np.zeros(3)
-
-
-def payload_record(cell) -> dict:
-    """The payload keys the cell gives, as plan.npz stores them (SI units)."""
-    record = {}
-    if cell.gripper is not None:
-        record["gripper_mass_kg"] = cell.gripper.mass_kg
-        record["gripper_com_E_m"] = [v * 1e-3 for v in cell.gripper.center_of_mass_mm]
-    if cell.part.mass_kg is not None:
-        record["part_mass_kg"] = cell.part.mass_kg
-        record["part_com_P_m"] = [v * 1e-3 for v in (cell.part.center_of_mass_mm or [0, 0, 0])]
-    return record
 
 
 def payload(record: dict | None) -> Payload | None:

@@ -20,7 +20,8 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.collision.check import TOUCH_TOL_M, CheckedPairs
+from offline_prog.collision.check import TOUCH_TOL_M
+from offline_prog.collision.pairs import Pairs
 from offline_prog.scene.drake_cell import DrakeCell
 
 LOOK_SAMPLES = 16  # seam samples looked at (of the screen's), ends included
@@ -50,7 +51,7 @@ def collision_look(
     scene: DrakeCell, rows: np.ndarray, *, clearance: float, self_clearance: float
 ) -> CollisionLook:
     """The coarse look at the joint rows (M, 6) [rad] (see the module)."""
-    pairs = CheckedPairs(scene, fixed_layout=True)
+    pairs = Pairs(scene, fixed_layout=True)
     clear_s = np.where(pairs.is_self, self_clearance, clearance)
     layout, worst, deepest = "", "", 0.0
     for i, q_i in enumerate(rows):

@@ -76,7 +76,7 @@ def job_report(job: JobPlan) -> dict:
         **robot_source(job.robot),
         "tool": job.cell.tool.name,
         "part": job.cell.part.name,
-        "payload": payload_summary(job.cell),
+        "payload": payload_summary(job.cell, job.cell_file),
         "job": {
             "home_deg": np.rad2deg(job.robot.controller_joints(job.q_home)).tolist(),
             "home_from": "job.home" if job_config(job.cell).home else "robot.yaml home_deg",

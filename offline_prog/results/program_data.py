@@ -19,11 +19,11 @@ from offline_prog.config.cell import transform
 from offline_prog.constants import TimeLaw
 from offline_prog.export.densify import dense_grid
 from offline_prog.export.job_program import JobProgramData, JobSegment
-from offline_prog.export.payload import payload_record
 from offline_prog.export.program import ProgramData
 from offline_prog.job.records import JobPlan, Plan
 from offline_prog.robot.dense_joints import dense_joints
 from offline_prog.robot.record import robot_record
+from offline_prog.scene.payload import payload_record
 
 
 def time_law_name(motion) -> str:
@@ -53,7 +53,7 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "j23_factor": robot.j23_factor,
         "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
-        "payload": payload_record(cell),
+        "payload": payload_record(cell, cell_file),
         "robot_record": robot_record(robot),
     }
 

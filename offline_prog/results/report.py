@@ -8,14 +8,17 @@ stage timings.
 from __future__ import annotations
 
 import datetime
+from pathlib import Path
 
 import numpy as np
 
 from offline_prog import __version__
 from offline_prog.constants import TimeLaw
-from offline_prog.export.payload import payload, payload_note, payload_record
+from offline_prog.export.payload import payload, payload_note
 from offline_prog.job.records import Plan
 from offline_prog.robot.record import robot_source
+from offline_prog.scene.payload import payload_record
+from offline_prog.scene.shapes import gripper_shapes
 from offline_prog.timing.path_timing import without_joint_limits
 from offline_prog.timing.speed_hold import HOLD
 
@@ -184,6 +187,10 @@ def collision_summary(plan: Plan) -> dict:
             {"pair": [p.a, p.b], "class": p.kind, "reason": p.reason}
             for p in result.skipped_self_pairs
         ],
+        # The gripper on the flange link and the part in the gripper: held, not checked.
+        "held_contacts_not_checked": [
+            {"pair": [a, b], "reason": reason} for a, b, reason in result.held_contacts or []
+        ],
         "feasible": plan.feasible,
         "failure": plan.failure,
         "failure_kind": None if plan.failure_kind is None else plan.failure_kind.value,
@@ -191,12 +198,31 @@ def collision_summary(plan: Plan) -> dict:
     }
 
 
-def payload_summary(cell) -> dict:
-    """The payload the programs set, or ``set: false`` and a warning (export.payload)."""
-    record = payload_record(cell)
+def payload_summary(cell, cell_file) -> dict:
+    """The payload the programs set, or ``set: false`` and a warning (export.payload);
+    the record of scene.payload (masses, centres of mass, inertias, their sources)."""
+    record = payload_record(cell, cell_file)
     complete = payload(record) is not None
     warning = None if complete else payload_note(record, np.eye(4)).removeprefix("WARNING: ")
     return {"set": complete, "warning": warning, **record}
+
+
+def gripper_summary(cell, cell_file) -> list[dict] | None:
+    """The gripper's shapes in E for the report's views: name, kind, size_m (as
+    ``CellShape.size_m``; a mesh: its bounding box's) and X_OG (4, 4), the shape in E
+    [m]; None without a gripper."""
+    shapes = gripper_shapes(cell, Path(cell_file).parent)
+    if not shapes:
+        return None
+    out = []
+    for shape in shapes:
+        size, X_EG = list(shape.size_m), shape.X_OG.GetAsMatrix4()
+        if shape.kind == "mesh":  # its bounding box, centred on the box
+            low, high = shape.mesh.bounds
+            size = (high - low).tolist()
+            X_EG[:3, 3] += X_EG[:3, :3] @ ((low + high) / 2)
+        out.append({"name": shape.name, "kind": shape.kind, "size_m": size, "X_OG": X_EG.tolist()})
+    return out
 
 
 def cad_summary(points) -> dict | None:
@@ -253,7 +279,8 @@ def report(plan: Plan) -> dict:
         **robot_source(plan.robot),
         "tool": cell.tool.name,
         "part": cell.part.name,
-        "payload": payload_summary(cell),
+        "payload": payload_summary(cell, plan.cell_file),
+        "gripper": gripper_summary(cell, plan.cell_file),
         "path": {
             "source": source,
             "n_points": int(len(plan.points.p_PR)),

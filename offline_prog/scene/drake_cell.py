@@ -1,17 +1,19 @@
-"""The work cell as a Drake MultibodyPlant (robot, part in the gripper, fixed tool).
+"""The work cell as a Drake MultibodyPlant (robot, gripper and part, fixed tool).
 
 Built like Drake model directives: the robot URDF is welded to the world at
-X_IB, the part body is welded to the flange (tool0) at X_EP = X_PE⁻¹, and the
-tool body is welded to the world at X_IT. Part and tool meshes, when the cell
+X_IB, the gripper body (its frame is E) to the flange (tool0), the part body to the
+flange at X_EP = X_PE⁻¹, and the tool body to the world at X_IT. Part and tool meshes, when the cell
 gives them, are converted once to OBJ with trimesh (Drake's mesh format) and
 cached by content hash.
 
 The cell's shapes (:mod:`offline_prog.scene.shapes`) are registered on the part body (in P),
-the tool body (in T) and the world (obstacles, anchored, in I), each geometry named after
-its shape; ``DrakeCell.labels`` maps every collision GeometryId to (owner, shape name),
-robot geometries being named after their link. Collision filters: Drake filters adjacent
-links and bodies welded together; the part is also filtered against the bodies it is
-welded to (the gripper contact), and each ``allowed_contact`` pair is filtered out.
+the gripper body (in E), the tool body (in T) and the world (obstacles, anchored, in I),
+each geometry named after its shape; ``DrakeCell.labels`` maps every collision GeometryId
+to (owner, shape name), robot geometries being named after their link. Collision filters:
+Drake filters adjacent links and bodies welded together (the gripper on the flange link);
+the part is also filtered against the bodies it is welded to (the flange link and the
+gripper that holds it), and each ``allowed_contact`` pair is filtered out. The first
+kind are listed with their reasons in ``DrakeCell.held_contacts``.
 """
 
 from __future__ import annotations
@@ -30,19 +32,25 @@ from pydrake.planning import RobotDiagram, RobotDiagramBuilder
 from offline_prog.config.cell import Cell, transform
 from offline_prog.robot.model import ROBOTS_DIR, RobotModel
 from offline_prog.scene.exact_distance import ExactShape, bounding_radius, exact_shape_of_drake
-from offline_prog.scene.filters import filter_contacts, filter_self_pairs
+from offline_prog.scene.filters import filter_contacts, filter_self_pairs, held_contacts
 from offline_prog.scene.shapes import CellShape, ShapeError, cell_geometry, mesh_shape
 
 PART_COLOR = Rgba(0.85, 0.55, 0.15, 1.0)
 TOOL_COLOR = Rgba(0.3, 0.3, 0.35, 1.0)
 OBSTACLE_COLOR = Rgba(0.5, 0.55, 0.6, 0.6)
+GRIPPER_COLOR = Rgba(0.25, 0.35, 0.55, 1.0)
 # Where each owner's shapes sit in a cell file (for error messages).
-OWNER_KEYS = {"part": "part.geometry", "tool": "tool.geometry", "obstacle": "obstacles"}
+OWNER_KEYS = {
+    "part": "part.geometry",
+    "gripper": "gripper.geometry",
+    "tool": "tool.geometry",
+    "obstacle": "obstacles",
+}
 
 
 @dataclasses.dataclass(frozen=True)
 class GeometryLabel:
-    """What a collision geometry is: its owner (robot | part | tool | obstacle), the
+    """What a collision geometry is: its owner (robot | part | gripper | tool | obstacle), the
     shape's name (the link's name for robot geometry), its body and the CellShape."""
 
     owner: str
@@ -62,6 +70,8 @@ class DrakeCell:
         X_IB: robot base in I; X_IT: fixed tool in I; X_PE: flange in the part frame.
         labels: every collision GeometryId -> its GeometryLabel.
         allowed_contact: pairs of shape names whose contact is intended (filtered out).
+        held_contacts: (a, b, reason) of the shape pairs not checked because one holds
+            the other (the gripper on the flange link, the part in the gripper).
     """
 
     diagram: RobotDiagram
@@ -76,6 +86,7 @@ class DrakeCell:
     # Robot link pairs not checked for self-collision (robots/<robot>/self_collision.yaml:
     # every class but "check"), or None when the robot has no matrix (all pairs checked).
     skipped_self_pairs: list | None = None
+    held_contacts: list[tuple[str, str, str]] = dataclasses.field(default_factory=list)
     _motion_radii: np.ndarray | None = dataclasses.field(default=None, repr=False, compare=False)
     _exact: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
@@ -169,6 +180,7 @@ def build_drake_cell(
     part_shapes: Sequence[CellShape] = (),
     tool_shapes: Sequence[CellShape] = (),
     obstacles: Sequence[CellShape] = (),
+    gripper_shapes: Sequence[CellShape] = (),
     allowed_contact: Sequence[tuple[str, str]] = (),
     meshcat=None,
 ) -> DrakeCell:
@@ -183,6 +195,8 @@ def build_drake_cell(
             "part" and "tool"; scale: metres per file unit).
         part_shapes, tool_shapes: CellShapes posed in P and T.
         obstacles: CellShapes posed in I (anchored to the world).
+        gripper_shapes: CellShapes posed in E (a "gripper" body welded to the flange;
+            none: no gripper body).
         allowed_contact: pairs of shape (or robot link) names not to check.
         meshcat: a Meshcat to draw the cell in (adds a MeshcatVisualizer).
 
@@ -202,11 +216,17 @@ def build_drake_cell(
         tool_shapes.insert(0, mesh_shape("tool", tool_mesh, tool_mesh_scale, key="tool_mesh"))
     part = _add_welded_body(plant, "part", X_PE.inverse(), plant.GetFrameByName("tool0", model))
     tool = _add_welded_body(plant, "tool", X_IT, plant.world_frame())
+    gripper = None
+    if gripper_shapes:
+        gripper = _add_welded_body(
+            plant, "gripper", RigidTransform(), plant.GetFrameByName("tool0", model)
+        )
     links = {plant.get_body(b).name() for b in plant.GetBodyIndices(model)}
     names: set[str] = set()
     labels: dict[GeometryId, GeometryLabel] = {}
     for owner, body, shapes, color in (
         ("part", part, part_shapes, PART_COLOR),
+        ("gripper", gripper, gripper_shapes, GRIPPER_COLOR),
         ("tool", tool, tool_shapes, TOOL_COLOR),
         ("obstacle", plant.world_body(), obstacles, OBSTACLE_COLOR),
     ):
@@ -222,6 +242,7 @@ def build_drake_cell(
             labels[geometry_id] = GeometryLabel("robot", body.name(), body.name())
     filter_contacts(builder.scene_graph(), plant, labels, part, allowed_contact)
     skipped = filter_self_pairs(builder.scene_graph(), plant, model, robot)
+    held = held_contacts(builder.scene_graph(), labels, allowed_contact)
     visualizer = None
     if meshcat is not None:
         from pydrake.geometry import MeshcatVisualizer, MeshcatVisualizerParams
@@ -241,6 +262,7 @@ def build_drake_cell(
         list(allowed_contact),
         visualizer,
         skipped,
+        held,
     )
 
 
@@ -262,6 +284,7 @@ def build_cell_model(cell: Cell, cell_file: Path, robot: RobotModel, meshcat=Non
         part_shapes=geometry.part,
         tool_shapes=geometry.tool,
         obstacles=geometry.obstacles,
+        gripper_shapes=geometry.gripper,
         allowed_contact=geometry.allowed_contact,
         meshcat=meshcat,
     )

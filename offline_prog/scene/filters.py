@@ -8,6 +8,11 @@ tool vs obstacles; obstacles among themselves stay filtered: they stand on each 
 by design). Then the intended
 contacts (the part in its gripper, ``allowed_contact``) and the robot's own link pairs
 that its self-collision matrix does not mark ``check`` are filtered out.
+
+What holds what is never checked: the gripper against the flange link it is mounted on
+(Drake: bodies welded together), the part against the gripper holding it and the
+flange link (``filter_contacts``). :func:`held_contacts` lists those pairs with their
+reason; everything else of the gripper (tool, obstacles, the other links) is checked.
 """
 
 from __future__ import annotations
@@ -57,7 +62,8 @@ def allow_fixed_layout(scene_graph, plant, model, labels, context, allowed_conta
 
 
 def filter_contacts(scene_graph, plant, labels, part, allowed_contact) -> None:
-    """Part vs the bodies it is welded to (the gripper), and each allowed pair."""
+    """Part vs the bodies it is welded to (the flange link, the gripper), and each
+    allowed pair."""
     by_name = ids_by_name(labels)
     manager = scene_graph.collision_filter_manager()
     holders = [b for b in plant.GetBodiesWeldedTo(part) if b.index() != part.index()]
@@ -78,6 +84,31 @@ def filter_contacts(scene_graph, plant, labels, part, allowed_contact) -> None:
                 )
         a, b = (GeometrySet(by_name[name]) for name in pair)
         manager.Apply(CollisionFilterDeclaration().ExcludeBetween(a, b))
+
+
+# Why a pair of (owner, owner) is not checked when its shapes' bodies are welded together.
+HELD_REASONS = {
+    ("gripper", "robot"): "the gripper is mounted on the flange of {b}",
+    ("part", "gripper"): "the gripper holds the part",
+    ("part", "robot"): "the part is held at the flange of {b} (the gripper's contact)",
+}
+
+
+def held_contacts(scene_graph, labels, allowed_contact=()) -> list[tuple[str, str, str]]:
+    """(a, b, reason) of each shape pair of the part and the gripper not checked
+    because one holds the other (filtered in the model, and not an allowed_contact)."""
+    inspector = scene_graph.model_inspector()
+    allowed = {frozenset(pair) for pair in allowed_contact}
+    held: dict[tuple[str, str], str] = {}
+    for g, a in labels.items():
+        for h, b in labels.items():
+            reason = HELD_REASONS.get((a.owner, b.owner))
+            names = (a.name, b.name)
+            if reason is None or names in held or frozenset(names) in allowed:
+                continue
+            if inspector.CollisionFiltered(g, h):
+                held[names] = reason.format(b=b.name)
+    return [(a, b, reason) for (a, b), reason in held.items()]
 
 
 def filter_self_pairs(scene_graph, plant, model, robot: RobotModel):

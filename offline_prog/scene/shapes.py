@@ -2,12 +2,13 @@
 
 A :class:`~offline_prog.config.cell.ShapeConfig` (sizes in mm at the edge) becomes a
 :class:`CellShape` in SI units, posed in its owner's frame O (P for the part, T for the
-tool, I for obstacles) by X_OG, G being the shape's own frame (primitives centred on G,
-cylinders and capsules along G's z, like Drake and FCL). Drake uses a mesh's convex hull
-for collision, so a mesh is decomposed into convex pieces with CoACD (Wei et al., "Approximate
-Convex Decomposition for 3D Meshes with Collision-Aware Concavity and Tree Search", SIGGRAPH
-2022), cached on disk by content hash and scale; the original triangle mesh is kept for the
-exact distances of :func:`exact_distance` (python-fcl on a BVH of the triangles).
+tool, I for obstacles, E for the gripper) by X_OG, G being the shape's own frame
+(primitives centred on G, cylinders and capsules along G's z, like Drake and FCL). Drake
+uses a mesh's convex hull for collision, so a mesh is decomposed into convex pieces with
+CoACD (Wei et al., "Approximate Convex Decomposition for 3D Meshes with Collision-Aware
+Concavity and Tree Search", SIGGRAPH 2022), cached on disk by content hash and scale; the
+original triangle mesh is kept for the exact distances of :func:`exact_distance`
+(python-fcl on a BVH of the triangles).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 from pydrake.geometry import Box, Capsule, Convex, Cylinder, Mesh, Shape, Sphere
 from pydrake.math import RigidTransform
 
-from offline_prog.config.cell import Cell, transform
+from offline_prog.config.cell import GRIPPER_MESH_NAME, Cell, transform
 from offline_prog.config.safe_yaml import short_repr
 from offline_prog.config.unit_slips import large_mesh
 from offline_prog.errors import TravellingError
@@ -48,7 +49,7 @@ class CellShape:
     Attributes:
         name: unique name in the cell (used in reports and ``allowed_contact``).
         kind: box | cylinder | sphere | capsule | mesh.
-        X_OG: the shape frame G in its owner's frame O (P, T or I).
+        X_OG: the shape frame G in its owner's frame O (P, T, I or E).
         size_m: box (x, y, z), sphere (r,), cylinder and capsule (r, length) [m]; () for meshes.
         mesh: the original triangle mesh in G [m] (meshes only).
         pieces: OBJ files of the convex pieces in G [m] (meshes only).
@@ -178,16 +179,20 @@ def _read_mesh(file: Path, scale: float) -> tuple:
 
 @dataclasses.dataclass(frozen=True)
 class CellGeometry:
-    """The cell's shapes by owner, and the pairs of names whose contact is intended."""
+    """The cell's shapes by owner, and the pairs of names whose contact is intended.
+
+    The gripper's shapes are posed in the flange frame E (empty: no gripper modelled)."""
 
     part: list[CellShape]
     tool: list[CellShape]
     obstacles: list[CellShape]
     allowed_contact: list[tuple[str, str]]
+    gripper: list[CellShape] = dataclasses.field(default_factory=list)
 
 
 def cell_geometry(cell: Cell, cell_file: Path) -> CellGeometry:
-    """The shapes a cell file gives (part.mesh named part.name, then part/tool/obstacles).
+    """The shapes a cell file gives (part.mesh named part.name, gripper.mesh named
+    "gripper", then the geometry of part, tool, obstacles and gripper).
 
     Raises:
         ShapeError: a bad shape entry (one line, naming the key).
@@ -205,16 +210,28 @@ def cell_geometry(cell: Cell, cell_file: Path) -> CellGeometry:
         except ValueError as error:
             raise ShapeError("part.model", str(error)) from None
         part.append(mesh_shape(cell.part.name, mesh_file, scale, key="part.model"))
-    part += [
-        load_shape(c, base, key=f"part.geometry[{i}]") for i, c in enumerate(cell.part.geometry)
-    ]
-    tool = [
-        load_shape(c, base, key=f"tool.geometry[{i}]") for i, c in enumerate(cell.tool.geometry)
-    ]
-    obstacles = [load_shape(c, base, key=f"obstacles[{i}]") for i, c in enumerate(cell.obstacles)]
+    part += _shapes(cell.part.geometry, base, "part.geometry")
+    tool = _shapes(cell.tool.geometry, base, "tool.geometry")
+    obstacles = _shapes(cell.obstacles, base, "obstacles")
     allowed = []
     for i, pair in enumerate(cell.allowed_contact):
         if len(pair) != 2:
             raise ShapeError(f"allowed_contact[{i}]", f"expected [name, name], got {pair!r}")
         allowed.append((pair[0], pair[1]))
-    return CellGeometry(part, tool, obstacles, allowed)
+    return CellGeometry(part, tool, obstacles, allowed, gripper_shapes(cell, base))
+
+
+def _shapes(configs, base: Path, key: str) -> list[CellShape]:
+    return [load_shape(c, base, key=f"{key}[{i}]") for i, c in enumerate(configs)]
+
+
+def gripper_shapes(cell: Cell, base: Path) -> list[CellShape]:
+    """The gripper's shapes in E: its mesh (named "gripper") and its geometry."""
+    gripper = cell.gripper
+    if gripper is None:
+        return []
+    shapes = []
+    if gripper.mesh:
+        scale = _mesh_scale("gripper.mesh_units", gripper.mesh_units, GRIPPER_MESH_NAME)
+        shapes.append(mesh_shape(GRIPPER_MESH_NAME, base / gripper.mesh, scale, key="gripper.mesh"))
+    return shapes + _shapes(gripper.geometry, base, "gripper.geometry")

@@ -3,7 +3,8 @@ closest pair, and the robot at any time of the plan.
 
 The cell is drawn once by a MeshcatVisualizer (``/drake/visualizer/<model>/<body>``);
 after that the session poses the bodies itself: the robot's links from the plan's
-joints, the part at X_IP = X_IE · X_PE⁻¹ of the plan shown, the tool at the edited X_IT
+joints, the gripper at X_IE (its frame is the flange's), the part at
+X_IP = X_IE · X_PE⁻¹ of the plan shown, the tool at the edited X_IT
 (at once: it is what the engineer moved). The processing path hangs under the part's
 node in P, one line set per sample state; an outdated plan's path turns grey. The
 closest pair of the plan is a red (below the clearance) or amber segment between its
@@ -56,6 +57,8 @@ class SceneView:
         }
         self.part = f"{ROOT}/part/part"
         self.tool = f"{ROOT}/tool/tool"
+        # The gripper's body (welded to the flange at identity), when the cell has one.
+        self.gripper = f"{ROOT}/gripper/gripper" if plant.HasModelInstanceNamed("gripper") else None
         diagram_context = drake.diagram.CreateDefaultContext()
         drake.diagram.ForcedPublish(diagram_context)
         meshcat.SetCameraPose(*camera(drake.X_IB.translation(), X_IT.translation()))
@@ -146,6 +149,8 @@ class SceneView:
             self.meshcat.SetTransform(path, plant.EvalBodyPoseInWorld(self.context, body))
         X_IE = self.drake.frame_E.CalcPoseInWorld(self.context)
         self.meshcat.SetTransform(self.part, X_IE @ plan.flange.X_PE.inverse())
+        if self.gripper is not None:
+            self.meshcat.SetTransform(self.gripper, X_IE)
         if self._pair is not None:
             self._show_pair(q)
         return float(np.interp(t, traj.t, traj.s))

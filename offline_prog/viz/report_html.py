@@ -97,9 +97,10 @@ def render_report_html(plan_dir: Path, *, folder_name: str | None = None) -> str
         for plot in json.loads(plot_json)["plots"]
     )
     figures += (
-        f'<figure><div class="views">{views_svg(col, data)}</div><figcaption>Views: the '
-        "part with its processing path and process frames F (x = t red, y = n green, "
-        "z = b blue), and the flange path in the cell.</figcaption></figure>"
+        f'<figure><div class="views">{views_svg(col, data, report.get("gripper"))}</div>'
+        "<figcaption>Views: the part with its processing path and process frames F (x = t "
+        "red, y = n green, z = b blue), and the flange path in the cell; the gripper's "
+        "outline (blue-grey) on the part and at the flange at t = 0.</figcaption></figure>"
     )
     css, script = plot_assets()
     title = f"Plan report: {report.get('name') or folder_name}"

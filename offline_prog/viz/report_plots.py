@@ -20,10 +20,12 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from offline_prog.export.program import ProgramData
+from offline_prog.viz.outline import outline_in
 
 XYZ_COLORS = ("#0072bd", "#d95318", "#edb120")  # x|α, y|β, z|γ, as in the paper's fig. 5
 TRIAD_COLORS = ("#d62728", "#2ca02c", "#1f77b4")  # a frame's x, y, z axes
 LIMIT_COLOR = "#c62828"
+GRIPPER_COLOR = "#3b5b8c"
 GROUP_COLORS = [*XYZ_COLORS, "#7e2f8e", "#77ac30", "#4dbeee"]  # distance per pair group
 N_TRIADS = 24  # process frames drawn along the path
 MAX_SVG_POINTS = 800  # per polyline of a view (a drawing, not data)
@@ -242,9 +244,10 @@ def _triad_lines(X: np.ndarray, length: float, width: float) -> list:
     ]
 
 
-def views_svg(col: dict, data: ProgramData) -> str:
+def views_svg(col: dict, data: ProgramData, gripper: list[dict] | None = None) -> str:
     """Four SVG views: the part's path with process frames F in P (top, side), and
-    the flange path with the part's path at t = 0, base B and tool T in I (top, side)."""
+    the flange path with the part's path at t = 0, base B and tool T in I (top, side);
+    the gripper's outline (its shapes in E, report.json's ``gripper``) in both."""
     X_PF = data.X_PT  # the tool frame T in P: the process frame F on the seams
     p_PF = X_PF[:, :3, 3]
     length = float(np.sum(np.linalg.norm(np.diff(p_PF, axis=0), axis=1)))
@@ -266,6 +269,8 @@ def views_svg(col: dict, data: ProgramData) -> str:
     )
     cell += _triad_lines(np.stack([X_IB, X_IT]), size, 2.0)
     cell_labels = [(X_IB[:3, 3], "B (robot base)"), (X_IT[:3, 3], "T (tool)")]
+    for frame_pose, lines in ((np.linalg.inv(data.X_EP), part), (X_IE0, cell)):
+        lines += [(p, GRIPPER_COLOR, 1.0) for p in outline_in(frame_pose, gripper or [])]
     return "".join(
         [
             _svg_view(part, part_labels, (0, 1), "Part P: path and frames F, top"),

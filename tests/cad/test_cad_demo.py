@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+from gripper_clearance import GRIPPER_CLEARANCE_TOL_M, gripper_clearance
 
 from offline_prog.config.cell import load_cell
 from offline_prog.job.seams import seam_inputs
@@ -72,6 +73,9 @@ def test_the_demo_plans_exports_and_previews(tmp_path):
         assert seam["path"]["cad"]["length_m"] * 1e3 == pytest.approx(length, rel=1e-9)
         assert seam["path"]["cad"]["corners"] == []
     assert (out / "preview.html").stat().st_size > 100_000  # the scene, robot and part
+    # The gripper keeps the clearance on every row (python-fcl, tests/gripper_clearance.py).
+    distance, pair, row = gripper_clearance(CELL, out / "trajectory.csv")
+    assert distance >= load_cell(CELL).motion.clearance - GRIPPER_CLEARANCE_TOL_M, (pair, row)
     exported = subprocess.run(
         [
             sys.executable,

@@ -1,5 +1,6 @@
 """Payload statements: KRL $LOAD, RAPID tload + GripLoad, URScript set_payload; a
-prominent warning in every header and report.json when the cell gives none."""
+prominent warning in every header and report.json when the cell gives none (the demo
+cells give both masses)."""
 
 import dataclasses
 import json
@@ -14,6 +15,7 @@ from offline_prog.config.checks import check_cell
 from offline_prog.errors import InputError
 from offline_prog.export.formats import export
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.results.report import payload_summary
 from offline_prog.robot.model import ROBOTS_DIR
 
 RECORD = {  # gripper 4 kg 80 mm down the flange axis; part 2 kg at (10, 0, 5) mm in P
@@ -89,7 +91,9 @@ def test_urscript_payload(plans, tmp_path):
 
 
 def test_without_payload_every_header_and_the_report_warn(plans, planned_job, tmp_path):
-    kuka, abb, ur = plans
+    kuka, abb, ur = (  # no masses
+        dataclasses.replace(data, job=dataclasses.replace(data.job, payload={})) for data in plans
+    )
     texts = [
         program(kuka, "krl", tmp_path / "k"),
         program(abb, "rapid", tmp_path / "r"),
@@ -99,9 +103,13 @@ def test_without_payload_every_header_and_the_report_warn(plans, planned_job, tm
         assert "WARNING: PAYLOAD NOT SET" in text
         assert "$LOAD={" not in text and "GripLoad partLoad" not in text
         assert "set_payload(" not in text
+    without = payload_summary(load_cell(write_cell(tmp_path)), tmp_path / "cell.yaml")
+    assert without["set"] is False and "PAYLOAD NOT SET" in without["warning"]
+    # The demo cells give both masses: their programs and reports set the load.
     report = json.loads((planned_job("seal_plate_kr16")[1] / "report.json").read_text())
-    assert report["payload"]["set"] is False and "PAYLOAD NOT SET" in report["payload"]["warning"]
+    assert report["payload"]["set"] is True and report["payload"]["warning"] is None
     assert list(report).index("payload") < 10  # near the top: prominent
+    assert "WARNING: PAYLOAD NOT SET" not in program(plans[0], "krl", tmp_path / "d")
 
 
 @pytest.mark.parametrize(
@@ -119,8 +127,9 @@ def test_the_warning_names_the_cell_keys(record, missing):
     assert note.startswith(f"WARNING: PAYLOAD NOT SET (the cell gives no {missing}): ")
 
 
-def test_a_job_reports_and_prints_the_payload_warning(planned_job):
-    """report.json of a job has the payload entry, and ``plan`` prints its warning."""
+def test_a_job_reports_and_prints_the_payload_warning(planned_job, tmp_path):
+    """report.json of a job has the payload entry, and ``plan`` prints its warning once
+    when the cell gives no masses (none for the demo, which gives them)."""
     import io
 
     from rich.console import Console
@@ -129,9 +138,13 @@ def test_a_job_reports_and_prints_the_payload_warning(planned_job):
 
     _, folder = planned_job("seal_job_kr16")
     report = json.loads((folder / "report.json").read_text())
-    assert report["payload"]["set"] is False
-    assert "(the cell gives no gripper.mass_kg / part.mass_kg)" in report["payload"]["warning"]
+    assert report["payload"]["set"] is True and report["payload"]["total"]["mass_kg"] > 0
     assert list(report).index("payload") < 10  # near the top: prominent
+    out = io.StringIO()
+    print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
+    assert "payload" not in out.getvalue()
+    report["payload"] = payload_summary(load_cell(write_cell(tmp_path)), tmp_path / "cell.yaml")
+    assert "(the cell gives no gripper.mass_kg / part.mass_kg)" in report["payload"]["warning"]
     out = io.StringIO()
     print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
     assert out.getvalue().count(f"payload   {report['payload']['warning']}") == 1  # once

@@ -6,6 +6,7 @@ import csv
 
 import numpy as np
 import pytest
+from gripper_clearance import GRIPPER_CLEARANCE_TOL_M, gripper_clearance
 
 from offline_prog.config.cell import load_cell
 from offline_prog.robot.model import load_robot
@@ -238,3 +239,12 @@ def test_each_seam_runs_at_its_process_speed_record(job):
         seam = data.seams[data.seam_names.index(option.name)]
         assert seam.process_speed_m_s == speed.v_m_s
     assert {o.plan.process_speed.v_m_s for o in plan.chosen} == {0.1, 0.15}
+
+
+def test_the_gripper_is_clear_by_a_second_library(planned_job):
+    """The job's gripper keeps the clearance from the tool and the obstacles on every row
+    (python-fcl on shapes built from the cell file, tests/gripper_clearance.py)."""
+    _, folder = planned_job(JOB)
+    distance, pair, row = gripper_clearance(CELLS / f"{JOB}.yaml", folder / "trajectory.csv")
+    clearance = load_cell(CELLS / f"{JOB}.yaml").motion.clearance
+    assert distance >= clearance - GRIPPER_CLEARANCE_TOL_M, (distance, pair, row)

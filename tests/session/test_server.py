@@ -4,6 +4,7 @@ the controls move on stops at its next stage."""
 
 import time
 
+import numpy as np
 import pytest
 from pydrake.geometry import Meshcat
 
@@ -170,3 +171,23 @@ def test_a_path_cell_exports_its_one_seam_job(tmp_path):
     kinds = [s["segment"] for s in report["job"]["segments"]]
     assert kinds == ["link", "approach:seam", "process:seam", "retract:seam", "link"]
     assert report["trajectory"]["duration_s"] < report["job"]["cycle_time_s"]
+
+
+def test_the_gripper_is_drawn_at_the_flange(untouched):
+    """The session poses the gripper's node at the flange X_IE of the time shown (the
+    part at X_IE · X_PE⁻¹ beside it)."""
+    import umsgpack
+
+    view = untouched.view
+    plan = view.shown.plan
+    t = float(plan.trajectory.t[len(plan.trajectory.t) // 3])
+    view.pose(t)
+    q = [np.interp(t, plan.trajectory.t, plan.joints.q[:, j]) for j in range(6)]
+    X_IE = view.drake.X_IE(np.array(q)).GetAsMatrix4()
+    for path, expected in (
+        ("/drake/visualizer/gripper/gripper", X_IE),
+        ("/drake/visualizer/part/part", X_IE @ plan.flange.X_PE.inverse().GetAsMatrix4()),
+    ):
+        packed = umsgpack.unpackb(view.meshcat._GetPackedTransform(path))
+        shown = np.array(packed["matrix"]).reshape(4, 4).T  # column-major
+        np.testing.assert_allclose(shown, expected, atol=1e-9)

@@ -12,6 +12,7 @@ import time
 import numpy as np
 import pytest
 from PIL import Image
+from scipy.spatial.transform import Rotation
 
 from offline_prog.plan import plan_cell
 from offline_prog.viz.preview import show_plan
@@ -75,6 +76,39 @@ def test_preview_draws_the_vendor_meshes_in_their_colours(seal):
         attributes = geometry["data"]["attributes"]
         n_vertices = len(attributes["position"]["array"].data) // 12  # float32 x, y, z
         assert n_vertices > 300 and "color" in attributes, link
+
+
+def test_preview_draws_the_gripper_at_the_flange(seal):
+    """The gripper's shapes are drawn under its body's node, and the animation moves that
+    node with the flange: at every frame its pose is the link_6 frame's (it is welded to
+    the flange) and the part's is X_IE · X_PE⁻¹."""
+    import umsgpack
+
+    import offline_prog.viz.preview as preview
+
+    plan, _ = seal
+    scene, _ = preview.preview_scene(plan)
+    drawn, animation = [], None
+    for message in scene.messages:
+        if isinstance(message, bytes):
+            command = umsgpack.unpackb(message)
+            if command["type"] == "set_object" and command["path"].startswith("/drake/gripper/"):
+                node = command["path"].split("/")[4]  # gripper::<shape>.visual_<i>
+                drawn.append(node.split("::")[1].rsplit(".visual_", 1)[0])
+        elif '"set_animation"' in message:
+            animation = json.loads(message)
+    names = [shape.name for shape in plan.cell.gripper.geometry]
+    assert sorted(drawn) == sorted(names)
+    tracks = {a["path"]: a["clip"]["tracks"] for a in animation["animations"]}
+    gripper, part = tracks["/drake/gripper/gripper"], tracks["/drake/part/part"]
+    X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
+    for k in range(0, len(gripper[0]["keys"]), 37):
+        X_IE, X_IP = np.eye(4), np.eye(4)
+        X_IE[:3, 3] = gripper[0]["keys"][k]["value"]
+        X_IE[:3, :3] = Rotation.from_quat(gripper[1]["keys"][k]["value"]).as_matrix()
+        X_IP[:3, 3] = part[0]["keys"][k]["value"]
+        X_IP[:3, :3] = Rotation.from_quat(part[1]["keys"][k]["value"]).as_matrix()
+        np.testing.assert_allclose(X_IE @ X_EP, X_IP, atol=1e-9)
 
 
 @pytest.mark.slow

@@ -302,3 +302,27 @@ def test_speed_plot_shades_each_time_optimal_slowdown_with_its_joint(tmp_path):
     # The band's tint over white: rgba(255, 160, 0, 0.15) → (1.0, 0.944, 0.85).
     tint = (np.abs(region - [1.0, 0.944, 0.85]).max(axis=2) < 0.03).mean()
     assert tint > 0.01, tint
+
+
+def test_the_views_draw_the_gripper(planned_folder):
+    """report.json keeps the gripper's shapes in E; the page's four views draw each
+    shape's outline (on the part in P, at the flange in I), and the outline of a shape
+    lies on it."""
+    from offline_prog.viz.outline import outline_in, shape_outline
+    from offline_prog.viz.report_plots import GRIPPER_COLOR
+
+    plan, folder = planned_folder("seal_plate_kr16")
+    shapes = json.loads((folder / "report.json").read_text())["gripper"]
+    assert [s["name"] for s in shapes] == [s.name for s in plan.cell.gripper.geometry]
+    cup = next(s for s in shapes if s["name"] == "gripper_cup_1")
+    assert cup["kind"] == "cylinder" and cup["size_m"] == pytest.approx([0.02, 0.03])
+    np.testing.assert_allclose(np.array(cup["X_OG"])[:3, 3], [0.035, 0.04, 0.08])
+    page = (folder / REPORT_FILE).read_text()
+    lines = sum(len(shape_outline(s["kind"], s["size_m"])) for s in shapes)
+    assert page.count(f'stroke="{GRIPPER_COLOR}"') == 4 * lines  # top and side, P and I
+    # In P the cup's outline is on the plate's top face (z = 5 mm) and 20 mm around its axis.
+    X_PE = plan.flange.X_PE.GetAsMatrix4()
+    p_P = np.vstack(outline_in(X_PE, [cup]))
+    p_PC = X_PE[:3, :3] @ [0.035, 0.04, 0.08] + X_PE[:3, 3]
+    assert p_P[:, 2].min() == pytest.approx(0.005)
+    assert np.linalg.norm(p_P[:, :2] - p_PC[:2], axis=1).max() == pytest.approx(0.02)
