@@ -137,7 +137,7 @@ def test_bad_values_are_400_and_the_session_keeps_running_with_its_values(own):
     after = own.status()
     assert after["values"]["X_IT.x"] == 1010.0 and after["auto"] is False
     assert after["values"] == before["values"]
-    assert own.stop() == 130
+    assert own.stop() == 130, own.stderr()[-2000:]
     stderr = own.stderr()
     assert "Traceback" not in stderr and "RecursionError" not in stderr, stderr
 
