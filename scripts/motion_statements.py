@@ -49,9 +49,7 @@ def _krl(folder: Path):
         dat = src.with_suffix(".dat").read_text(encoding="utf-8")
         xyz = {
             name: np.array([float(x), float(y), float(z)]) * 1e-3
-            for name, x, y, z in re.findall(
-                r"DECL E6POS (\w+)=\{X (\S+),Y (\S+),Z ([^,]+),", dat
-            )
+            for name, x, y, z in re.findall(r"DECL E6POS (\w+)=\{X (\S+),Y (\S+),Z ([^,]+),", dat)
         }
         here = None
         for name in re.findall(r"^LIN (\w+)", src.read_text(encoding="utf-8"), re.M):
@@ -68,9 +66,7 @@ def _rapid(folder: Path):
         text = mod.read_text(encoding="utf-8")
         xyz = {
             name: np.array([float(x), float(y), float(z)]) * 1e-3
-            for name, x, y, z in re.findall(
-                r"robtarget (\w+) := \[\[(\S+?),(\S+?),(\S+?)\]", text
-            )
+            for name, x, y, z in re.findall(r"robtarget (\w+) := \[\[(\S+?),(\S+?),(\S+?)\]", text)
         }
         for proc in text.split("PROC ")[1:]:
             here = None
@@ -104,6 +100,7 @@ def _deviation(folder: Path) -> str:
     for file in folder.iterdir():
         if file.suffix in SUFFIX.values():
             text = file.read_text(encoding="utf-8")
+            text = re.sub(r" ;\n\s*\d+:\s*! ", " ", text)  # FANUC remarks: one line
             found |= set(re.findall(r"deviation[^\n;]*?(<=\s*[\d.]+ ?mm)", text))
     return ", ".join(sorted(found)) or "-"
 
@@ -112,8 +109,10 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("folders", nargs="+", type=Path)
     args = parser.parse_args(argv)
-    print(f"{'folder':40s} {'format':8s} {'linear':>7s} {'<0.5mm':>7s} {'<0.1mm':>7s} "
-          f"{'<=5mm/s':>8s}  stated deviation")
+    print(
+        f"{'folder':40s} {'format':8s} {'linear':>7s} {'<0.5mm':>7s} {'<0.1mm':>7s} "
+        f"{'<=5mm/s':>8s}  stated deviation"
+    )
     for folder in args.folders:
         for fmt, suffix in SUFFIX.items():
             if not any(folder.glob(f"*{suffix}")):

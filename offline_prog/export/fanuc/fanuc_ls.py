@@ -58,6 +58,7 @@ from offline_prog.export.fanuc.fanuc import (
     wpr_deg,
 )
 from offline_prog.export.fanuc.fanuc_io import Samples, place_events
+from offline_prog.export.merge import PathCheck
 from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
@@ -66,7 +67,7 @@ from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
 DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
 JOINT_SPEED_PCT = 20  # J moves of the links
-MAX_SPEED_MMS = 2000  # FANUC L moves take at most 2000 mm/sec
+MIN_SPEED_MMS, MAX_SPEED_MMS = 1, 2000  # FANUC L moves take 1 to 2000 mm/sec
 UF, UT = 1, 1
 
 
@@ -215,9 +216,28 @@ class _Chain:
     def __init__(self, post: FanucPost, run: SeamRun):
         job, io, seam = post.job, post.job.process_io, run.seam
         samples, points, (n_a, n_p) = _samples(job.job, run)
+        check = PathCheck(samples.X_BP, job.job.X_BT, *run.process.selection_tol)
+
+        def merge(points: list[int], pinned: set[int], flow_fits) -> list[int]:
+            # A merged motion holds the path tolerance and the plan's flow steps (the
+            # bead's accuracy), except that a motion the plan runs slower than FANUC's
+            # slowest L speed merges into its neighbour: the program cannot time it.
+            def fits(a: int, k: int, b: int) -> bool:
+                at = np.array([a, k, b])
+                speeds = segment_speeds_mms(samples.t, samples.X_BP, at, clip=False)
+                return speeds.min() < MIN_SPEED_MMS or flow_fits(a, b)
+
+            return check.merge(points, pinned | {n_a, n_p}, fits)  # the FINE points stay
+
         try:
             motions = place_events(
-                samples, points, list(run.events), seam=seam, io=io, flow_at=_flow_at(job)
+                samples,
+                points,
+                list(run.events),
+                seam=seam,
+                io=io,
+                flow_at=_flow_at(job),
+                merge=merge,
             )
         except ValueError as error:  # the cell's switch positions: one line, exit 2
             raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
@@ -231,7 +251,8 @@ class _Chain:
                 strict=True,
             )
         )
-        self.lines: list = []
+        # The seam program's first lines: its deviation from the plan, re-checked.
+        self.lines: list = _deviation_remarks(check, motions, (n_a, n_p), run.process.residual)
         current = None if io is None else io.idle
         for m in motions:
             if m.flow is not None and f"{m.flow:.3f}" != f"{current:.3f}":
@@ -248,6 +269,24 @@ class _Chain:
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
         if current is not None and f"{current:.3f}" != f"{io.idle:.3f}":
             self.lines.append(post.ao_statement(io.idle))
+
+
+def _deviation_remarks(check: PathCheck, motions, seam_ends, residual) -> list[str]:
+    """The seam program's statement of its deviation from the plan: the seam's motions
+    re-checked against the planned samples, plus the densified plan's residual."""
+    n_a, n_p = seam_ends
+    on_seam = [m for m in motions if n_a <= m.start and m.end <= n_p]
+    i, j = np.array([m.start for m in on_seam], int), np.array([m.end for m in on_seam], int)
+    d, a = check.deviations(i, j)
+    p = check.X_BP[:, :3, 3]
+    shortest = np.linalg.norm(p[j] - p[i], axis=1).min(initial=np.inf)
+    return remarks(
+        [
+            f"Seam: {len(on_seam)} L motions, shortest {shortest * 1e3:.3f} mm; deviation <= "
+            f"{(d.max(initial=0.0) + residual[0]) * 1e3:.4f} mm, "
+            f"{np.rad2deg(a.max(initial=0.0) + residual[1]):.4f} deg from the plan"
+        ]
+    )
 
 
 def _samples(rows, run: SeamRun):
@@ -287,13 +326,16 @@ def _flow_at(job):
     return lambda times: io.flow(np.interp(np.asarray(times) + io.lag_s, t, v))
 
 
-def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.ndarray:
+def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray, *, clip: bool = True):
     """(n-1,) planned mean speed of the TCP U (origin of X_BU (N, 4, 4) [m]; times t
-    (N,) [s]) on each segment between rows idx [mm/sec], whole numbers in [1, 2000]."""
+    (N,) [s]) on each segment between rows idx [mm/sec]: whole numbers in
+    [MIN_SPEED_MMS, MAX_SPEED_MMS] as an L statement takes them, or (clip False) as planned."""
     p = X_BU[idx, :3, 3]
     dt = np.maximum(np.diff(t[idx]), 1e-9)
     speeds = np.linalg.norm(np.diff(p, axis=0), axis=1) / dt * 1e3
-    return np.clip(np.round(speeds), 1, MAX_SPEED_MMS).astype(int)
+    if not clip:
+        return speeds
+    return np.clip(np.round(speeds), MIN_SPEED_MMS, MAX_SPEED_MMS).astype(int)
 
 
 def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:
