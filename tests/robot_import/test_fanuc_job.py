@@ -430,3 +430,22 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
             if np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) < MIN_MOTION_M:
                 needed = "DB" in statement or "FINE" in statement
                 assert needed or any(line.startswith("AO[") for line in around), statement
+
+
+def test_fanuc_ao_in_counts_is_the_volts_times_the_cells_counts_per_volt(stripe, tmp_path):
+    """Issue 42: with ``flow.ao_unit: counts`` every motion holds AO[n] = its value in
+    volts × counts_per_volt, a whole number, and the header says so."""
+    data, _, robot = stripe
+    per_volt = 3276.7  # a ±10 V, 16-bit module's counts
+    io = dataclasses.replace(data.process_io, ao_unit="counts", counts_per_volt=per_volt)
+    write_fanuc_job(data, tmp_path / "volts")
+    write_fanuc_job(dataclasses.replace(data, process_io=io), tmp_path / "counts")
+    (volts,) = _walk(data, tmp_path / "volts", robot)
+    (counts,) = _walk(data, tmp_path / "counts", robot)
+    assert len(volts["moves"]) == len(counts["moves"])
+    for (a, b, v), (_, _, c) in zip(volts["moves"], counts["moves"], strict=True):
+        assert c == round(c) and abs(c / per_volt - v) <= 0.0005 + 1 / per_volt, (a, b)
+    assert any(abs(c) > 1000 for _, _, c in counts["moves"])
+    mn = read_ls(tmp_path / "counts" / "OFFLINE_PROG.ls")["mn"]
+    head = " ".join(s.removeprefix("! ") for s in mn if s.startswith("!"))
+    assert "in counts: 3276.7 counts per V" in head, head

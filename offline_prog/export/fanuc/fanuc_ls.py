@@ -146,6 +146,12 @@ class FanucPost(ControllerPost):
                 f"[m/s], in [{io.min:g}, {io.max:g}] while DO is on, {io.idle:g} otherwise; AO "
                 f"statements take effect as the next motion starts, {io.lag_s:g} s ahead."
             )
+            lines.append(
+                f"AO[{io.analog_output}] values in counts: {io.counts_per_volt:g} counts per V "
+                "(tool.process_io.flow.ao_unit)."
+                if io.ao_unit == "counts"
+                else f"AO[{io.analog_output}] values in volts (tool.process_io.flow.ao_unit)."
+            )
         return lines + payload_conventions(rows)
 
     def header(self, lines: list[str]) -> None:
@@ -193,8 +199,12 @@ class FanucPost(ControllerPost):
         return files
 
     def ao_statement(self, value_v: float) -> str:
-        """``AO[n]=value`` of the flow output [V]."""
-        return f"  AO[{self.job.process_io.analog_output}]={value_v:.3f}"
+        """``AO[n]=value`` of the flow output at value_v [V], in the cell's
+        ``flow.ao_unit``: volts, or whole counts (counts_per_volt per V)."""
+        io = self.job.process_io
+        if io.ao_unit == "counts":
+            return f"  AO[{io.analog_output}]={round(value_v * io.counts_per_volt):d}"
+        return f"  AO[{io.analog_output}]={value_v:.3f}"
 
     def _parts(self, name: str, lines: list) -> list[_Program]:
         """The seam's statements in programs of at most line_limit lines (``name``, or
@@ -255,7 +265,7 @@ class _Chain:
         self.lines: list = _deviation_remarks(check, motions, (n_a, n_p), run.process.residual)
         current = None if io is None else io.idle
         for m in motions:
-            if m.flow is not None and f"{m.flow:.3f}" != f"{current:.3f}":
+            if m.flow is not None and post.ao_statement(m.flow) != post.ao_statement(current):
                 if m.flow_event is None:
                     self.lines.append(post.ao_statement(m.flow))
                 else:  # the flow's event, at the value the plan's flow has on the motion
@@ -267,7 +277,7 @@ class _Chain:
             switch = "" if m.event is None else post.set_output(Switch(0, m.before_end_m, m.event))
             entry = (samples.X_BP[m.end], configs[m.end])
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
-        if current is not None and f"{current:.3f}" != f"{io.idle:.3f}":
+        if current is not None and post.ao_statement(current) != post.ao_statement(io.idle):
             self.lines.append(post.ao_statement(io.idle))
 
 
