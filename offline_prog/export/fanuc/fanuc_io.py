@@ -16,6 +16,11 @@ chain of ``L`` points (approach, seam, retract) is split at planned samples unti
   its value on a motion (where the tool speeds up or slows down, a planned sample starts
   a new motion), and the motion's value is the middle of that range.
 
+Then the writer may merge motions shorter than 0.5 mm (``export.merge``, the ``merge``
+argument): never away from a digital event's motion end or a flow edge, and only where
+the merged motion keeps the flow as flat as above (the writer's own rule decides where
+that may give: FANUC's slowest ``L`` speed).
+
 Every inserted point is a planned sample (trajectory.csv's rows on the approach and
 retract, the seam's densified samples on the seam), so the program still moves through
 the plan. Positions are the seam's path positions σ [m] (negative on the approach,
