@@ -87,6 +87,8 @@ class ProcessIo:
     min: float = 0.0
     max: float = 10.0
     lag_s: float = 0.0
+    ao_unit: str = "volts"  # FANUC's AO value: volts, or counts (counts_per_volt per V)
+    counts_per_volt: float = 1.0
 
     @property
     def idle(self) -> float:

@@ -73,6 +73,10 @@ class AnalogFlow:
     min: float = 0.0
     max: float = 10.0
     lag_s: float = 0.0
+    # FANUC: the unit of AO[n]'s value as the I/O module takes it: volts, or counts
+    # (the value in volts times counts_per_volt, a whole number).
+    ao_unit: str = "volts"
+    counts_per_volt: float | None = None
 
 
 @dataclasses.dataclass

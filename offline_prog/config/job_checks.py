@@ -98,12 +98,30 @@ def check_job(file: Path, cell: Cell) -> None:
                 "tool.process_io.flow.per_mps",
                 f"must be > 0 V per m/s (the flow rises with the speed), got {io.flow.per_mps:g}",
             )
+        if io.flow is not None:
+            _check_ao_unit(file, io.flow)
         if io.flow is not None and not 0 <= io.flow.lag_s <= MAX_FLOW_LAG_S:
             raise _error(
                 file,
                 "tool.process_io.flow.lag_s",
                 f"must be within [0, {MAX_FLOW_LAG_S:g}] s, got {io.flow.lag_s:g}",
             )
+
+
+AO_UNITS = ("volts", "counts")  # tool.process_io.flow.ao_unit
+
+
+def _check_ao_unit(file: Path, flow) -> None:
+    """``flow.ao_unit`` one of AO_UNITS; ``counts_per_volt`` > 0 with counts, absent
+    with volts (a number that would change nothing is refused, not ignored)."""
+    key = "tool.process_io.flow"
+    if flow.ao_unit not in AO_UNITS:
+        raise _error(file, f"{key}.ao_unit", f"{flow.ao_unit!r} (use volts or counts)")
+    per_volt = flow.counts_per_volt
+    if flow.ao_unit == "counts" and not (per_volt is not None and per_volt > 0):
+        raise _error(file, f"{key}.counts_per_volt", "must be > 0 counts per V with counts")
+    if flow.ao_unit == "volts" and per_volt is not None:
+        raise _error(file, f"{key}.counts_per_volt", "only with ao_unit: counts")
 
 
 # The process outputs each controller family can have (its own numbering):

@@ -80,6 +80,23 @@ def _nozzle_batch(X_BP, X_BT, X_PT, i: np.ndarray, j: np.ndarray):
     return segment_max(gap.min(axis=1), i, j), segment_max(angle, i, j)
 
 
+def lin_deviations(X_BP, X_BT, X_PT, i: np.ndarray, j: np.ndarray):
+    """For each LIN segment (i, j) (S,) between pose samples, the largest deviation of
+    the plan's samples between them: both from the straight line of the tool frames
+    X_PT (N, 4, 4) across the part and from the tool's curve on the part while the
+    controller interpolates X_BP (N, 4, 4) with the tool fixed at X_BT (4, 4) (flange
+    style: P in B with T in B; external_tcp with the X_TP convention: X_BP = X_PT⁻¹,
+    X_BT = identity).
+
+    Returns:
+        ((S,) distances [m], (S,) angles [rad]).
+    """
+    p, R = X_PT[:, :3, 3], X_PT[:, :3, :3]
+    d_line, a_line = segment_deviations(p, R, i, j)
+    d_tool, a_tool = _nozzle_deviations(X_BP, X_BT, X_PT, i, j)
+    return np.maximum(d_line, d_tool), np.maximum(a_line, a_tool)
+
+
 @dataclasses.dataclass(frozen=True)
 class PointRule:
     """How a writer's controller interpolates (``style``, and for external_tcp the
@@ -132,9 +149,7 @@ def process_points(data: ProgramData, rule: PointRule, chord_tol_m: float, angle
     i, j = chosen.indices[:-1], chosen.indices[1:]
     ends, worst = [chosen.indices[:1]], np.zeros(2)
     while len(i):
-        d_line, a_line = segment_deviations(p, R, i, j)
-        d_tool, a_tool = _nozzle_deviations(X_BP, X_BT, data.X_PT, i, j)
-        d, a = np.maximum(d_line, d_tool), np.maximum(a_line, a_tool)
+        d, a = lin_deviations(X_BP, X_BT, data.X_PT, i, j)
         split = (j - i > 1) & ((d > chord_tol_m) | (a > angle_tol_rad))
         ends.append(j[~split])
         worst = np.maximum(worst, [d[~split].max(initial=0.0), a[~split].max(initial=0.0)])

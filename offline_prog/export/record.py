@@ -73,7 +73,11 @@ class LinearMove:
 class Process:
     """Seam ``seam`` (run ``number``): its (densified) samples ``data``, and ``indices``
     (K,) of the samples that are the writer's points (the first is the seam's start);
-    the points' largest deviation from the continuous plan [m, rad]."""
+    the points' largest deviation from the continuous plan [m, rad]; ``residual`` the
+    continuous plan's largest deviation [m, rad] from what the samples show
+    (``Densified.bound``: a deviation measured at the samples plus it bounds the true one)
+    and ``selection_tol`` the tolerances [m, rad] the points were chosen with (the
+    writer's less the residual: a motion merged later holds them too)."""
 
     seam: str
     number: int
@@ -82,6 +86,8 @@ class Process:
     max_chord_m: float
     max_angle_rad: float
     switches: tuple[Switch, ...] = ()
+    residual: tuple[float, float] = (0.0, 0.0)
+    selection_tol: tuple[float, float] = (0.0, 0.0)
 
     def switches_before(self, m: int) -> tuple[Switch, ...]:
         """The switches on the LIN to point m, in path order."""
@@ -181,7 +187,10 @@ def _process(seam: ProgramData, name: str, number: int, points: PointRule | None
     tolerances = dense.selection_tolerances(points.chord_tol_m, points.angle_tol_rad)
     idx, chord, angle = process_points(dense.data, points, *tolerances)
     chord, angle = dense.bound(chord, angle)
-    return Process(name, number, dense.data, idx, chord, angle)
+    residual = dense.bound(0.0, 0.0)
+    return Process(
+        name, number, dense.data, idx, chord, angle, residual=residual, selection_tol=tolerances
+    )
 
 
 def _position(event: IoEvent, flow_where_set: bool) -> float:

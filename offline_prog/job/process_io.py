@@ -68,6 +68,8 @@ def process_io_settings(
             "min": flow.min,
             "max": flow.max,
             "lag_s": flow.lag_s,
+            "ao_unit": flow.ao_unit,
+            "counts_per_volt": flow.counts_per_volt or 1.0,
         } | fields
     return ProcessIo(
         digital_output=None if io is None or io.on is None else io.on.digital_output,

@@ -223,3 +223,20 @@ def test_every_controller_language_numbers_its_outputs():
     from offline_prog.robot.model import LANGUAGES
 
     assert set(OUTPUT_RANGES) == set(LANGUAGES)
+
+
+@pytest.mark.parametrize(
+    ("unit", "key"),
+    [
+        ("ao_unit: amperes", "tool.process_io.flow.ao_unit"),
+        ("ao_unit: counts", "tool.process_io.flow.counts_per_volt"),
+        ("ao_unit: counts, counts_per_volt: 0", "tool.process_io.flow.counts_per_volt"),
+        ("counts_per_volt: 3276.7", "tool.process_io.flow.counts_per_volt"),  # with volts
+    ],
+)
+def test_the_ao_unit_is_checked(capsys, tmp_path, unit, key):
+    """Issue 42: FANUC's AO unit is volts or counts with counts per volt, else one line."""
+    text = (CELLS / "seal_job_kr16.yaml").read_text()
+    text = text.replace("per_mps: 40.0", f"per_mps: 40.0, {unit}", 1)
+    code, err = run(capsys, tmp_path, with_cell_dir(text))
+    assert code == 2 and len(err) == 1 and f": {key}: " in err[0], err

@@ -17,6 +17,8 @@ import pytest
 from fanuc_reader import joints_from_config, pose, read_ls
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation, Slerp
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
 
 from offline_prog.config.cell import load_cell
@@ -380,3 +382,70 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     assert report["model"] == "bead"
     assert share == pytest.approx(report["share_within_band"], abs=0.01)
     assert np.mean(inside_plan[check] == inside_replay[check]) > 0.99
+
+
+def _seam_motions(folder, name="OFFLINE_PROG"):
+    """Per seam program: its L motions in order as (statement, X_BP (4, 4), the lines
+    before and after it), read back from the LS text."""
+    seams = []
+    for file in sorted(folder.glob(f"{name}_S*.ls")):
+        ls = read_ls(file)
+        motions = []
+        for k, statement in enumerate(ls["mn"]):
+            if m := re.match(r"L P\[(\d+)\]", statement):
+                around = (ls["mn"][k - 1], ls["mn"][k + 1] if k + 1 < len(ls["mn"]) else "")
+                motions.append((statement, pose(ls["pos"][int(m[1])]["xyzwpr"]), around))
+        seams.append((ls["mn"], motions))
+    return seams
+
+
+def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tmp_path):
+    """Issue 42: the seam programs read back, the tool's curve on the part while the
+    controller moves P linearly (slerp) between their points reconstructed, and the
+    plan's continuous path (its dense grid) compared with it: within the chord
+    tolerance. A motion shorter than 0.5 mm is left only where the plan needs its
+    point: a flow step (an AO statement at either end), a switch (DB) or a FINE end;
+    none is written slower than the plan runs it."""
+    from offline_prog.export.density import DEFAULT_CHORD_TOL_M
+    from offline_prog.export.merge import MIN_MOTION_M
+
+    data, _, _, _ = fanuc_job
+    write_fanuc_job(data, tmp_path)
+    p_BT = data.job.X_BT[:3, 3]
+    for k, (mn, motions) in enumerate(_seam_motions(tmp_path)):
+        stated = re.search(r"deviation <= ([\d.]+)", " ".join(s.lstrip("! ") for s in mn))
+        assert stated and float(stated[1]) * 1e-3 <= DEFAULT_CHORD_TOL_M
+        X_BP = np.array([X for _, X, _ in motions])
+        curve = []
+        for a, b in zip(X_BP, X_BP[1:], strict=False):
+            length = np.linalg.norm(b[:3, 3] - a[:3, 3])
+            lam = np.linspace(0.0, 1.0, max(2, int(length / 1e-5) + 2))
+            R = Slerp([0, 1], Rotation.from_matrix([a[:3, :3], b[:3, :3]]))(lam).as_matrix()
+            p = a[:3, 3] + lam[:, None] * (b[:3, 3] - a[:3, 3])
+            curve.append(np.einsum("gji,gj->gi", R, p_BT - p))  # the tool's point on P
+        planned = data.seams[k].X_PT_dense[:, :3, 3]
+        gap, _ = cKDTree(np.concatenate(curve)).query(planned)
+        assert gap.max() <= DEFAULT_CHORD_TOL_M + 1e-5, gap.max()  # + the curve's spacing
+        for (statement, X, around), (_, X_prev, _) in zip(motions[1:], motions, strict=False):
+            if np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) < MIN_MOTION_M:
+                needed = "DB" in statement or "FINE" in statement
+                assert needed or any(line.startswith("AO[") for line in around), statement
+
+
+def test_fanuc_ao_in_counts_is_the_volts_times_the_cells_counts_per_volt(stripe, tmp_path):
+    """Issue 42: with ``flow.ao_unit: counts`` every motion holds AO[n] = its value in
+    volts × counts_per_volt, a whole number, and the header says so."""
+    data, _, robot = stripe
+    per_volt = 3276.7  # a ±10 V, 16-bit module's counts
+    io = dataclasses.replace(data.process_io, ao_unit="counts", counts_per_volt=per_volt)
+    write_fanuc_job(data, tmp_path / "volts")
+    write_fanuc_job(dataclasses.replace(data, process_io=io), tmp_path / "counts")
+    (volts,) = _walk(data, tmp_path / "volts", robot)
+    (counts,) = _walk(data, tmp_path / "counts", robot)
+    assert len(volts["moves"]) == len(counts["moves"])
+    for (a, b, v), (_, _, c) in zip(volts["moves"], counts["moves"], strict=True):
+        assert c == round(c) and abs(c / per_volt - v) <= 0.0005 + 1 / per_volt, (a, b)
+    assert any(abs(c) > 1000 for _, _, c in counts["moves"])
+    mn = read_ls(tmp_path / "counts" / "OFFLINE_PROG.ls")["mn"]
+    head = " ".join(s.removeprefix("! ") for s in mn if s.startswith("!"))
+    assert "in counts: 3276.7 counts per V" in head, head

@@ -16,6 +16,11 @@ chain of ``L`` points (approach, seam, retract) is split at planned samples unti
   its value on a motion (where the tool speeds up or slows down, a planned sample starts
   a new motion), and the motion's value is the middle of that range.
 
+Then the writer may merge motions shorter than 0.5 mm (``export.merge``, the ``merge``
+argument): never away from a digital event's motion end or a flow edge, and only where
+the merged motion keeps the flow as flat as above (the writer's own rule decides where
+that may give: FANUC's slowest ``L`` speed).
+
 Every inserted point is a planned sample (trajectory.csv's rows on the approach and
 retract, the seam's densified samples on the seam), so the program still moves through
 the plan. Positions are the seam's path positions σ [m] (negative on the approach,
@@ -76,6 +81,7 @@ def place_events(
     seam: str,
     io: ProcessIo | None,
     flow_at: Callable[[np.ndarray], np.ndarray] | None = None,
+    merge: Callable[[list[int], set[int], Callable[[int, int], bool]], list[int]] | None = None,
 ) -> list[Motion]:
     """The seam's ``L`` motions with its events on them, split at planned samples.
 
@@ -87,6 +93,10 @@ def place_events(
         seam: its name, for errors.
         io: the process I/O (None: no flow values).
         flow_at: the live flow's values [V] at job times (n,) [s] (the plan's).
+        merge: merges short motions (``export.merge``): the points after the splits,
+            the points it must keep (the digital events' motion ends, the flow's
+            edges) and whether the plan's flow allows a motion from sample a to b (as
+            flat as the splits make it) ↦ the points left (None: no merging).
 
     Returns:
         The motions in run order (at most one digital event each).
@@ -116,6 +126,15 @@ def place_events(
         points = sorted({*points, int(inside[0])})
     if io is not None and io.analog_output is not None:
         points = _flow_splits(samples, points, edges, flow_at)
+    if merge is not None:  # the switches' points and the flow's edges stay where they are
+        ends = {points[_motion_of(sigma, points, e.path_m)] for e in digital}
+        pinned = ends | {i for i, _ in split}
+
+        def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow still flat
+            live = io is not None and io.analog_output is not None and _live(samples, a, edges)
+            return not live or _flat(flow_at(samples.t[a : b + 1]))
+
+        points = merge(points, pinned, flow_fits)
     on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
     assert len(on_motion) == len(digital), "one digital event per motion"
     motions = []
@@ -156,14 +175,18 @@ def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[in
             values = flow_at(samples.t[a : b + 1])
             start = 0
             for k in range(1, len(values)):
-                span = values[start : k + 1]
                 moved = samples.path_m[a + k - 1] - samples.path_m[out[-1]] > SAME_POINT_M
-                step = min(FLOW_STEP_V, FLOW_STEP_SHARE * span.max())
-                if span.max() - span.min() > step and k - 1 > start and moved:
+                if not _flat(values[start : k + 1]) and k - 1 > start and moved:
                     start = k - 1  # no L motion of zero length: at rest the flow waits
                     out.append(a + start)
         out.append(b)
     return out
+
+
+def _flat(values: np.ndarray) -> bool:
+    """Whether flow values (n,) [V] on one motion vary by at most FLOW_STEP_V and by at
+    most FLOW_STEP_SHARE of their largest."""
+    return values.max() - values.min() <= min(FLOW_STEP_V, FLOW_STEP_SHARE * values.max())
 
 
 def _split(sigma: np.ndarray, points: list[int], position: float) -> int:

@@ -58,6 +58,7 @@ from offline_prog.export.fanuc.fanuc import (
     wpr_deg,
 )
 from offline_prog.export.fanuc.fanuc_io import Samples, place_events
+from offline_prog.export.merge import PathCheck
 from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
@@ -66,7 +67,7 @@ from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
 DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
 JOINT_SPEED_PCT = 20  # J moves of the links
-MAX_SPEED_MMS = 2000  # FANUC L moves take at most 2000 mm/sec
+MIN_SPEED_MMS, MAX_SPEED_MMS = 1, 2000  # FANUC L moves take 1 to 2000 mm/sec
 UF, UT = 1, 1
 
 
@@ -145,6 +146,12 @@ class FanucPost(ControllerPost):
                 f"[m/s], in [{io.min:g}, {io.max:g}] while DO is on, {io.idle:g} otherwise; AO "
                 f"statements take effect as the next motion starts, {io.lag_s:g} s ahead."
             )
+            lines.append(
+                f"AO[{io.analog_output}] values in counts: {io.counts_per_volt:g} counts per V "
+                "(tool.process_io.flow.ao_unit)."
+                if io.ao_unit == "counts"
+                else f"AO[{io.analog_output}] values in volts (tool.process_io.flow.ao_unit)."
+            )
         return lines + payload_conventions(rows)
 
     def header(self, lines: list[str]) -> None:
@@ -192,8 +199,12 @@ class FanucPost(ControllerPost):
         return files
 
     def ao_statement(self, value_v: float) -> str:
-        """``AO[n]=value`` of the flow output [V]."""
-        return f"  AO[{self.job.process_io.analog_output}]={value_v:.3f}"
+        """``AO[n]=value`` of the flow output at value_v [V], in the cell's
+        ``flow.ao_unit``: volts, or whole counts (counts_per_volt per V)."""
+        io = self.job.process_io
+        if io.ao_unit == "counts":
+            return f"  AO[{io.analog_output}]={round(value_v * io.counts_per_volt):d}"
+        return f"  AO[{io.analog_output}]={value_v:.3f}"
 
     def _parts(self, name: str, lines: list) -> list[_Program]:
         """The seam's statements in programs of at most line_limit lines (``name``, or
@@ -215,9 +226,28 @@ class _Chain:
     def __init__(self, post: FanucPost, run: SeamRun):
         job, io, seam = post.job, post.job.process_io, run.seam
         samples, points, (n_a, n_p) = _samples(job.job, run)
+        check = PathCheck(samples.X_BP, job.job.X_BT, *run.process.selection_tol)
+
+        def merge(points: list[int], pinned: set[int], flow_fits) -> list[int]:
+            # A merged motion holds the path tolerance and the plan's flow steps (the
+            # bead's accuracy), except that a motion the plan runs slower than FANUC's
+            # slowest L speed merges into its neighbour: the program cannot time it.
+            def fits(a: int, k: int, b: int) -> bool:
+                at = np.array([a, k, b])
+                speeds = segment_speeds_mms(samples.t, samples.X_BP, at, clip=False)
+                return speeds.min() < MIN_SPEED_MMS or flow_fits(a, b)
+
+            return check.merge(points, pinned | {n_a, n_p}, fits)  # the FINE points stay
+
         try:
             motions = place_events(
-                samples, points, list(run.events), seam=seam, io=io, flow_at=_flow_at(job)
+                samples,
+                points,
+                list(run.events),
+                seam=seam,
+                io=io,
+                flow_at=_flow_at(job),
+                merge=merge,
             )
         except ValueError as error:  # the cell's switch positions: one line, exit 2
             raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
@@ -231,10 +261,11 @@ class _Chain:
                 strict=True,
             )
         )
-        self.lines: list = []
+        # The seam program's first lines: its deviation from the plan, re-checked.
+        self.lines: list = _deviation_remarks(check, motions, (n_a, n_p), run.process.residual)
         current = None if io is None else io.idle
         for m in motions:
-            if m.flow is not None and f"{m.flow:.3f}" != f"{current:.3f}":
+            if m.flow is not None and post.ao_statement(m.flow) != post.ao_statement(current):
                 if m.flow_event is None:
                     self.lines.append(post.ao_statement(m.flow))
                 else:  # the flow's event, at the value the plan's flow has on the motion
@@ -246,8 +277,26 @@ class _Chain:
             switch = "" if m.event is None else post.set_output(Switch(0, m.before_end_m, m.event))
             entry = (samples.X_BP[m.end], configs[m.end])
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
-        if current is not None and f"{current:.3f}" != f"{io.idle:.3f}":
+        if current is not None and post.ao_statement(current) != post.ao_statement(io.idle):
             self.lines.append(post.ao_statement(io.idle))
+
+
+def _deviation_remarks(check: PathCheck, motions, seam_ends, residual) -> list[str]:
+    """The seam program's statement of its deviation from the plan: the seam's motions
+    re-checked against the planned samples, plus the densified plan's residual."""
+    n_a, n_p = seam_ends
+    on_seam = [m for m in motions if n_a <= m.start and m.end <= n_p]
+    i, j = np.array([m.start for m in on_seam], int), np.array([m.end for m in on_seam], int)
+    d, a = check.deviations(i, j)
+    p = check.X_BP[:, :3, 3]
+    shortest = np.linalg.norm(p[j] - p[i], axis=1).min(initial=np.inf)
+    return remarks(
+        [
+            f"Seam: {len(on_seam)} L motions, shortest {shortest * 1e3:.3f} mm; deviation <= "
+            f"{(d.max(initial=0.0) + residual[0]) * 1e3:.4f} mm, "
+            f"{np.rad2deg(a.max(initial=0.0) + residual[1]):.4f} deg from the plan"
+        ]
+    )
 
 
 def _samples(rows, run: SeamRun):
@@ -287,13 +336,16 @@ def _flow_at(job):
     return lambda times: io.flow(np.interp(np.asarray(times) + io.lag_s, t, v))
 
 
-def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.ndarray:
+def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray, *, clip: bool = True):
     """(n-1,) planned mean speed of the TCP U (origin of X_BU (N, 4, 4) [m]; times t
-    (N,) [s]) on each segment between rows idx [mm/sec], whole numbers in [1, 2000]."""
+    (N,) [s]) on each segment between rows idx [mm/sec]: whole numbers in
+    [MIN_SPEED_MMS, MAX_SPEED_MMS] as an L statement takes them, or (clip False) as planned."""
     p = X_BU[idx, :3, 3]
     dt = np.maximum(np.diff(t[idx]), 1e-9)
     speeds = np.linalg.norm(np.diff(p, axis=0), axis=1) / dt * 1e3
-    return np.clip(np.round(speeds), 1, MAX_SPEED_MMS).astype(int)
+    if not clip:
+        return speeds
+    return np.clip(np.round(speeds), MIN_SPEED_MMS, MAX_SPEED_MMS).astype(int)
 
 
 def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:

@@ -1,0 +1,120 @@
+"""Merging motion statements too short for a robot programmer along the planned path.
+
+A writer that splits a seam's linear moves for its I/O (FANUC: a motion starts where
+the flow's value steps, ``export.fanuc.fanuc_io``) can end up with motions of a few µm
+where the tool speeds up from rest: ``L P[17] 1mm/sec`` over 0.001 mm. No programmer
+writes those, and a controller runs them at its minimum speed. :func:`merge_short`
+drops the end points of motions shorter than ``MIN_MOTION_M`` (the programmed TCP's
+travel) where the plan allows it: the point is not pinned (the seam's start and end,
+a point a switch is attached to or the flow's edge starts at) and the merged motion
+still holds the path tolerance against the planned samples it now passes (the
+caller's ``fits``, e.g. ``export.points.lin_deviations``). Every point kept is a
+planned sample, so the program still moves through the plan.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from collections.abc import Callable, Collection
+
+import numpy as np
+
+from offline_prog.export.points import lin_deviations
+
+MIN_MOTION_M = 0.5e-3  # the shortest motion statement a writer leaves where it may merge
+
+
+def merge_short(
+    points: list[int],
+    p_tcp: np.ndarray,
+    *,
+    pinned: Collection[int],
+    fits: Callable[[int, int, int], bool],
+    min_length_m: float = MIN_MOTION_M,
+) -> list[int]:
+    """The points with the ends of short motions merged away where the plan allows.
+
+    A motion a → b shorter than ``min_length_m`` loses b (it joins the next motion) if
+    b is not pinned and a → (b's successor) fits; otherwise it loses a (joining the
+    previous motion) under the same rule; otherwise it stays (the plan allows no
+    merge there).
+
+    Args:
+        points: sorted sample indices of the motions' ends (the first is where the
+            robot already is; first and last are kept).
+        p_tcp: (N, 3) the programmed TCP's position at each sample [m], one frame.
+        pinned: sample indices that stay points.
+        fits: whether point k may go from between points i and j (the motion from
+            sample i to sample j holds the path tolerance), called as fits(i, k, j).
+        min_length_m: the shortest motion wanted [m].
+
+    Returns:
+        The remaining points, sorted (a subset of ``points``).
+    """
+    out = list(points)
+    keep = set(pinned) | {out[0], out[-1]}
+    k = 1
+    while k < len(out):
+        a, b = out[k - 1], out[k]
+        if np.linalg.norm(p_tcp[b] - p_tcp[a]) >= min_length_m:
+            k += 1
+            continue
+        for drop in (k, k - 1):
+            if out[drop] not in keep and fits(out[drop - 1], out[drop], out[drop + 1]):
+                del out[drop]
+                k = max(1, drop)  # look at the merged motion again
+                break
+        else:
+            k += 1
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class PathCheck:
+    """LIN motions between planned samples against the plan, for merging and for the
+    deviation a program states.
+
+    Attributes:
+        X_BP: (N, 4, 4) the pose the controller interpolates at each sample (the part P
+            in the base B, flange style).
+        X_BT: (4, 4) the fixed tool T in B.
+        chord_tol_m, angle_tol_rad: the tolerances a merged motion must hold, measured
+            at the samples [m, rad].
+    """
+
+    X_BP: np.ndarray
+    X_BT: np.ndarray
+    chord_tol_m: float
+    angle_tol_rad: float
+
+    @functools.cached_property
+    def X_PT(self) -> np.ndarray:
+        """(N, 4, 4) the tool frame T in P at each sample."""
+        return np.linalg.inv(self.X_BP) @ self.X_BT
+
+    def deviations(self, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(S,) distances [m] and (S,) angles [rad] of the motions (i, j) (S,) from the
+        samples they pass (``points.lin_deviations``)."""
+        i, j = np.asarray(i, dtype=int), np.asarray(j, dtype=int)
+        return lin_deviations(self.X_BP, self.X_BT, self.X_PT, i, j)
+
+    def fits(self, i: int, j: int) -> bool:
+        """Whether the motion from sample i to sample j holds the tolerances."""
+        d, a = self.deviations(np.array([i]), np.array([j]))
+        return bool(d[0] <= self.chord_tol_m and a[0] <= self.angle_tol_rad)
+
+    def merge(
+        self,
+        points: list[int],
+        pinned: Collection[int],
+        also: Callable[[int, int, int], bool] = lambda i, k, j: True,
+    ) -> list[int]:
+        """merge_short with this check and ``also`` (the writer's own condition on
+        dropping point k from between i and j: its process output's), the TCP the
+        origin of X_BP."""
+
+        def fits(i: int, k: int, j: int) -> bool:
+            return also(i, k, j) and self.fits(i, j)
+
+        return merge_short(points, self.X_BP[:, :3, 3], pinned=pinned, fits=fits)
