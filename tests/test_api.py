@@ -70,7 +70,10 @@ def test_import_offline_prog_loads_no_pipeline():
 def test_bad_input_raises_the_exit_2_error(tmp_path):
     """A bad key is the InputError the command prints as one line with exit code 2."""
     cell = tmp_path / "cell.yaml"
-    cell.write_text((CELLS / "seal_plate_kr16.yaml").read_text().replace("robot:", "robt:", 1))
+    cell.write_text(
+        (CELLS / "seal_plate_kr16.yaml").read_text(encoding="utf-8").replace("robot:", "robt:", 1),
+        encoding="utf-8",
+    )
     with pytest.raises(InputError) as error:
         op.plan(cell)
     assert str(error.value).startswith(f"{cell}: ")

@@ -30,10 +30,13 @@ def _text(page: Path) -> str:
 
 
 def command_lines(page: Path) -> list[str]:
-    """Each command of the page's bash/sh blocks, one per line, indentation removed."""
+    """Each command of the page's bash/sh blocks, one per line, indentation removed; in
+    the README also its inline ``offline-prog ...`` spans (its quick start)."""
     lines = []
     for indent, _, block in COMMAND_BLOCK.findall(_text(page)):
         lines += [line[len(indent) :].strip() for line in block.splitlines() if line.strip()]
+    if page == README:
+        lines += re.findall(r"`(offline-prog [^`\s]+ [^`]+)`", _text(page))
     return lines
 
 
