@@ -145,12 +145,12 @@ OUT = ("reach", "joint_limit", "stand", "collision")  # placement's screened-out
 def _run_place(args, console: Console, errors: Console) -> str:
     """``place``: the search with a progress bar on stderr, then a short summary.
     Returns "" or, when no candidate was feasible, the one line saying so."""
+    from offline_prog import api
     from offline_prog.cli_progress import PlaceProgress
-    from offline_prog.placement.run import place_cell
 
     out = args.out or Path("out") / f"{args.cell.stem}_place"
     with PlaceProgress(errors, console) as progress:
-        data = place_cell(
+        data = api.place(
             args.cell,
             out,
             budget=args.budget,
