@@ -162,3 +162,30 @@ def test_the_site_builds_strict_and_a_broken_link_fails_it(tmp_path):
     broken = _run_mkdocs(copy / "mkdocs.yml", tmp_path / "broken")
     assert broken.returncode != 0
     assert "no-such-page.md" in broken.stderr
+
+
+# Pages whose command blocks the slow suite runs as written (getting-started's in the
+# quick start test above). Placement's block is a search of minutes; the same command
+# runs in tests/placement/test_place_cli.py.
+RUN_AS_WRITTEN = ["calibration.md", "process-models.md"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", RUN_AS_WRITTEN)
+def test_the_pages_commands_run_as_written(tmp_path, name):
+    (tmp_path / "cells").symlink_to(REPO / "cells")
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    lines = command_lines(DOCS / name)
+    assert lines
+    for line in lines:
+        line = line.replace("offline-prog ", f"{shlex.quote(sys.executable)} -m offline_prog ")
+        done = subprocess.run(
+            ["bash", "-o", "pipefail", "-c", line],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=900,
+        )
+        assert done.returncode == 0, (line, done.stdout[-1000:], done.stderr[-1000:])
+        assert done.stdout.strip(), line
