@@ -71,7 +71,7 @@ def test_count() -> str:
         text=True,
         check=False,
     )
-    last = [line for line in done.stdout.splitlines() if " collected" in line or "tests" in line]
+    last = [line for line in done.stdout.splitlines() if " collected" in line]
     return last[-1].strip() if last else "unknown"
 
 
