@@ -9,8 +9,11 @@ Frames: I inertial (Drake's world), B robot base, E flange, P part, F process
 frame on the path, T fixed tool (TCP).
 """
 
+import importlib
 import logging
 import os
+import sys
+import types
 
 # One BLAS thread unless the user says otherwise (before numpy loads, if it has not):
 # the least-squares fits and 6×6 solves here are small, and OpenBLAS's spinning threads
@@ -21,3 +24,37 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 __version__ = "0.1.0"
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+# The Python API (offline_prog.api), imported on first use: `import offline_prog` stays
+# cheap (no pydrake) for the command's flag parsing and for `__version__`.
+__all__ = ["Plan", "load_cell", "place", "plan"]
+
+
+def _api_name(name: str) -> property:
+    """``offline_prog.<name>``: the API's, loaded on first use. A data descriptor on the
+    package's class: importing the submodule ``offline_prog.plan`` (the pipeline), which
+    Python records as the package attribute ``plan``, does not hide the function (the
+    submodule stays in ``sys.modules``, where ``from offline_prog.plan import ...``
+    finds it)."""
+
+    def get(package: types.ModuleType):
+        # By name: the modules that read __version__ do not depend on the API.
+        return getattr(importlib.import_module("offline_prog.api"), name)
+
+    def set_submodule(package: types.ModuleType, value) -> None:
+        if not isinstance(value, types.ModuleType):
+            raise AttributeError(f"offline_prog.{name} is the API's; it cannot be set")
+
+    return property(get, set_submodule, doc=f"offline_prog.api.{name}")
+
+
+class _Package(types.ModuleType):
+    """The package module, with the API's names (see :func:`_api_name`)."""
+
+    Plan = _api_name("Plan")
+    load_cell = _api_name("load_cell")
+    place = _api_name("place")
+    plan = _api_name("plan")
+
+
+sys.modules[__name__].__class__ = _Package

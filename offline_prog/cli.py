@@ -145,12 +145,12 @@ OUT = ("reach", "joint_limit", "stand", "collision")  # placement's screened-out
 def _run_place(args, console: Console, errors: Console) -> str:
     """``place``: the search with a progress bar on stderr, then a short summary.
     Returns "" or, when no candidate was feasible, the one line saying so."""
+    from offline_prog import api
     from offline_prog.cli_progress import PlaceProgress
-    from offline_prog.placement.run import place_cell
 
     out = args.out or Path("out") / f"{args.cell.stem}_place"
     with PlaceProgress(errors, console) as progress:
-        data = place_cell(
+        data = api.place(
             args.cell,
             out,
             budget=args.budget,
@@ -245,8 +245,7 @@ def main(argv: list[str] | None = None, *, own_process: bool = False) -> int:
         return code
 
     try:
-        from offline_prog.plan import plan_job
-        from offline_prog.results.job_folder import write_job_outputs
+        from offline_prog import api
         from offline_prog.results.plan_folder import check_out_dir
         from offline_prog.results.summary import print_job_summary
 
@@ -302,14 +301,14 @@ def main(argv: list[str] | None = None, *, own_process: bool = False) -> int:
         # Every cell is a job (path: one seam). Progress on stderr only while stdout is
         # a terminal: logs and pipes stay clean.
         with PlanProgress(errors, enabled=console.is_terminal) as progress:
-            plan = plan_job(args.cell, progress=progress)
+            plan = api.plan(args.cell, progress=progress)
             progress("writing outputs")
             if args.command == "plan":
-                files, report = write_job_outputs(plan, out)
+                files = plan.write(out)
         if args.command == "plan":
-            print_job_summary(console, report, files, time.perf_counter() - started)
+            print_job_summary(console, plan.report, files, time.perf_counter() - started)
         if args.preview:
-            _serve_preview(plan, args, console)
+            _serve_preview(plan.job, args, console)
         if not plan.feasible:  # outputs written so the user can see why; no programs
             where = f" (see {files['collisions']})" if args.command == "plan" else ""
             return fail(f"error: {args.cell}: {plan.failure}{where}", EXIT_PLAN_FAILED)

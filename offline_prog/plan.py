@@ -31,6 +31,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from offline_prog.collision.profile import distance_profile
+from offline_prog.config.cell import Cell
 from offline_prog.config.edits import CellValues
 from offline_prog.errors import PlanFailedError
 from offline_prog.forked import quiet
@@ -150,17 +151,22 @@ def plan_job(
     *,
     robots_dir: Path = ROBOTS_DIR,
     progress: Callable[[str], None] = lambda stage: None,
+    cell: Cell | None = None,
 ) -> JobPlan:
     """A whole job (issue 13): every seam by the one-seam pipeline, approach and
     retract, seam order, collision-free links from home and back, process I/O, and the
     collision check of the whole job.
+
+    Args:
+        cell: the file's cell, already read (the API's edited cell); ``cell_file``
+            still resolves its relative paths and names it.
 
     Raises:
         InputError: bad input (one line; exit 2).
         PlanFailedError: a seam the robot cannot do, or a link not found (exit 1).
     """
     stage = StageTimer(progress)
-    inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir)
+    inputs = stage("load", "reading the cell", load_inputs, Path(cell_file), robots_dir, cell)
     return plan_loaded_job(inputs, stage, parallel=True)
 
 

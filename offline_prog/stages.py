@@ -86,9 +86,14 @@ class FlangePaths:
     cusps: list[Cusp]
 
 
-def load_inputs(file: Path, robots_dir: Path) -> Inputs:
-    """Read and check the cell file; load the path points and the robot."""
-    cell = load_cell(file)
+def load_inputs(file: Path, robots_dir: Path, cell: Cell | None = None) -> Inputs:
+    """Read and check the cell file; load the path points and the robot.
+
+    Args:
+        cell: the file's cell, already read (the API's edited cell): checked, not read
+            again; ``file`` still resolves its relative paths and names it in errors.
+    """
+    cell = load_cell(file) if cell is None else cell
     check_cell(file, cell, robots_dir)
     points = load_points(file, cell) if cell.path is not None else None
     try:

@@ -137,6 +137,7 @@ SMOKE = [
     ("calibration_accuracy.py", ["--draws", "1"], "tip_mm"),
     ("cad_accuracy.py", ["--parts", "plate", "--stl-chord-mm", "0.1"], "plate top loop"),
     ("process_bound.py", [], "report.json quality.timing_bound"),
+    ("figures.py", ["--cells", "seal_plate_kr16", "--runs", "1", "--out", "figures.md"], "wrote"),
 ]
 
 

@@ -118,15 +118,21 @@ def _run(writers: tuple[Writer, ...], done: FinishedJob, folder: Path) -> dict[s
     return files
 
 
-def write_job_outputs(job: JobPlan, out_dir: Path) -> tuple[dict[str, Path], dict]:
+def write_job_outputs(
+    job: JobPlan, out_dir: Path, *, finished: FinishedJob | None = None
+) -> tuple[dict[str, Path], dict]:
     """Write the job's plan folder; returns the files by name and the report.
+
+    Args:
+        finished: the job's report and program data made already (the API's plan).
 
     Raises:
         InputError: out_dir is a file, or a folder with files we did not write.
     """
     out_dir = Path(out_dir)
     check_out_dir(out_dir)
-    done = FinishedJob(job, out_dir.name)
+    done = finished or FinishedJob(job, out_dir.name)
+    done.folder_name = out_dir.name
     with staged_folder(out_dir) as folder:
         # An error or Ctrl-C in the block stops the second core before the staged
         # folder goes.
