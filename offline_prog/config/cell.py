@@ -54,10 +54,13 @@ class RobotConfig:
 @dataclasses.dataclass
 class DigitalSwitch:
     """Switch a digital output at a distance along the path: ``lead_mm`` before the
-    seam's start (on) or before its end (off); negative: after."""
+    seam's start (on) or before its end (off); negative: after. ``delay_s``: the valve's
+    response time [s]: the output is set that much earlier, so the valve opens (closes)
+    at the lead's position."""
 
     digital_output: int = required()
     lead_mm: float = 0.0
+    delay_s: float = 0.0
 
 
 @dataclasses.dataclass
@@ -170,6 +173,9 @@ class PathConfig:
     fit_tolerance_mm: float = 0.1
     normal_tolerance_deg: float = 2.0  # max angle, given (CSV) to fitted normal
     n_control_points: int | None = None
+    # A closed seam's bead runs past its start by this much before the gun closes [mm]
+    # (the path runs on over its first overlap_mm); refused on an open seam.
+    overlap_mm: float = 0.0
 
 
 @dataclasses.dataclass
