@@ -49,8 +49,9 @@ class IoEvent:
         state: digital on / off; analog live / back to idle.
         value: digital 1.0 / 0.0; analog: the value from this event on [V].
         path_m: where along the seam's path from its start the change takes effect [m]
-            (digital: where the valve opens or closes; flow: where the dispensed flow
-            starts, the gate, or where it is cut, the valve's closing).
+            (digital: where the valve opens or closes; flow: where the tool is
+            ``lag_s`` after it is set: the gate going live, past the valve's closing
+            for the cut-off, where a controller that leads by the lag itself sets it).
         t_s: job time at which the controller sets the output [s] (digital: the valve's
             delay before the tool passes ``path_m``; flow going live: ``lag_s`` before;
             flow cut-off: when the tool passes ``path_m``).

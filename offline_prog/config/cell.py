@@ -29,6 +29,10 @@ def required():
     return dataclasses.field(default=None, metadata=REQUIRED)
 
 
+FIT_TOLERANCE_MM = 0.1  # path.fit_tolerance_mm's default for measured points
+CAD_FIT_TOLERANCE_MM = 0.01  # ... and for a cad: seam (an exact source)
+
+
 @dataclasses.dataclass
 class ShapeConfig:
     """A named collision/visual shape, posed in its owner's frame (I for obstacles,
@@ -170,7 +174,9 @@ class PathConfig:
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5
-    fit_tolerance_mm: float = 0.1
+    # Max point-to-curve distance. Not given: 0.01 mm for a cad: seam (its source is
+    # exact), 0.1 mm otherwise (load_cell decides).
+    fit_tolerance_mm: float | None = None
     normal_tolerance_deg: float = 2.0  # max angle, given (CSV) to fitted normal
     n_control_points: int | None = None
     # A closed seam's bead runs past its start by this much before the gun closes [mm]
@@ -326,6 +332,9 @@ def load_cell(file: str | os.PathLike) -> Cell:
     for seam in ([cell.path] if cell.path is not None else []) + cell.seams:
         if seam.closed is None:  # not given: a loop comes back to its start
             seam.closed = seam.cad is not None and seam.cad.loop is not None
+        if seam.fit_tolerance_mm is None:  # not given: a CAD seam is exact
+            exact = seam.cad is not None
+            seam.fit_tolerance_mm = CAD_FIT_TOLERANCE_MM if exact else FIT_TOLERANCE_MM
     return cell
 
 

@@ -156,6 +156,9 @@ def io_columns(
             # Live lag_s before the valve opens, until it closes (the cut-off not led).
             flow_times = (times[0] - lag, times[1])
             live |= (t >= flow_times[0]) & (t < flow_times[1])
+            # Where each takes effect, lag_s after it is set (a controller that leads by
+            # the lag itself places it there): the gate, and past the valve's closing.
+            flow_at = (gate[0], float(np.interp(times[1] + lag, t_seam, path)))
             v_on = float(np.interp(times[0], t, tcp_speed))
             values = (float(settings.flow(v_on)), settings.idle)
             events += [
@@ -171,7 +174,7 @@ def io_columns(
                     t_seam,
                 )
                 for state, value, position, time in zip(
-                    (True, False), values, gate, flow_times, strict=True
+                    (True, False), values, flow_at, flow_times, strict=True
                 )
             ]
     digital = on.astype(np.int8) if switching else None

@@ -181,7 +181,13 @@ def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
     assert live_t[0] == pytest.approx(process.t_start - lag, abs=dt)
     assert live_t[-1] == pytest.approx(process.t_stop, abs=dt)
     assert columns.analog.max() == pytest.approx(0.5 + 40.0 * 0.1)
-    assert [(e.state, e.path_m) for e in columns.events] == [(True, 0.0), (False, 0.1)]
+    # The cut-off takes effect (a controller leading by the lag places it) lag_s past
+    # the seam's end, so it is set as the seam ends.
+    assert [(e.state, e.path_m) for e in columns.events] == [
+        (True, 0.0),
+        (False, pytest.approx(0.1 + 0.1 * lag)),
+    ]
+    assert columns.events[1].set_path_m == pytest.approx(0.1)
 
 
 def test_a_lag_that_leads_before_the_approach_is_refused():

@@ -226,9 +226,15 @@ def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     ]
     flow = [(float(v), p, lag) for what, v, p, lag in events if what == "ao1"]
     assert [v for v, _, _ in flow] == [pytest.approx(PER_MPS / 1000), 0.0]
+    # ScaleLag leads both: the cut-off is placed where the tool is lag_s after the
+    # valve closes (the seam's end, where it comes to rest), so the controller sets it
+    # as the valve closes (the flow stays live until then).
+    cut = next(e for e in data.events if e.signal is Signal.ANALOG and not e.state)
+    close = next(e for e in data.events if e.signal is Signal.DIGITAL and not e.state)
+    assert cut.t_s == pytest.approx(close.t_s) and cut.path_m > off
     assert [p for _, p, _ in flow] == [
         pytest.approx(on, abs=IO_TOL_M),
-        pytest.approx(off, abs=IO_TOL_M),
+        pytest.approx(cut.path_m, abs=IO_TOL_M),
     ]
     assert all(lag == LAG_S for _, _, lag in flow)  # ScaleLag is the cell's lag_s
     assert "\\Start" not in text  # nothing switches at a motion's start
@@ -260,7 +266,8 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     for (_, p, _), asked_m in zip(digital, (on, off), strict=True):
         assert asked_m - 1e-6 <= p <= asked_m + SPEED_M_S * period + IO_TOL_M
     # The flow: idle before it goes live lag_s (lag_s / period commands) ahead of the
-    # gun, the live value at once (not a ramp from idle), idle again lag_s early.
+    # gun, the live value at once (not a ramp from idle), idle again as the gun closes
+    # (the cut-off is not led: a flow cut lag_s early thins the seam's end).
     volts = [(float(v) * 10.0, p, i) for v, p, i in analog]
     live_flow = OFFSET_V + PER_MPS * SPEED_M_S
     first = next(k for k, (v, _, _) in enumerate(volts) if v > OFFSET_V + 0.01)
@@ -276,7 +283,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
 
     lead = LAG_S / period
     assert commands_between(volts[first][2], digital[0][2]) == pytest.approx(lead, abs=1.01)
-    assert commands_between(volts[back][2], digital[1][2]) == pytest.approx(lead, abs=1.01)
+    assert commands_between(volts[back][2], digital[1][2]) == pytest.approx(0, abs=1.01)
     # The speed at the switch, from the program's own joints: the flow follows it.
     i = volts[first][2]
     v = (positions[servoj[servoj.index(i) + 1]] - positions[i]) / period
@@ -286,7 +293,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
 # --- the plan's own columns -----------------------------------------------------------
 
 
-def test_trajectory_csv_flow_leads_the_output_by_the_lag(stripe):
+def test_trajectory_csv_flow_leads_the_output_by_the_lag_and_is_cut_with_it(stripe):
     _, folder, _ = stripe
     with open(folder / "trajectory.csv") as f:
         rows = list(csv.DictReader(f))
@@ -298,7 +305,7 @@ def test_trajectory_csv_flow_leads_the_output_by_the_lag(stripe):
     t_live, t_idle = t[np.argmax(live)], t[len(live) - np.argmax(live[::-1])]
     dt = np.diff(t).max()
     assert t_live == pytest.approx(t_on - LAG_S, abs=dt)
-    assert t_idle == pytest.approx(t_off - LAG_S, abs=dt)
+    assert t_idle == pytest.approx(t_off, abs=dt)  # the cut-off is not led
     assert np.all(ao[~live] == OFFSET_V)  # idle: the flow at zero speed
 
 
