@@ -101,7 +101,8 @@ def main() -> None:
     print(f"cell: {CELL.name} + on/off delay {ON_DELAY_S}/{OFF_DELAY_S} s, overlap {OVERLAP_MM} mm")
     for name, (share, worst, at) in f["shares"].items():
         print(
-            f"  {name:38s} within ±5 %: {share * 100:6.2f} %  worst {worst * 100:+7.2f} % at {at:.1f} mm"
+            f"  {name:38s} within ±5 %: {share * 100:6.2f} %  "
+            f"worst {worst * 100:+7.2f} % at {at:.1f} mm"
         )
     print(
         f"  overlap past the start: {f['overlap_mm']:.3f} mm (asked {OVERLAP_MM}); gap: {f['gap']}"

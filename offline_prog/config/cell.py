@@ -174,8 +174,9 @@ class PathConfig:
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5
-    # Max point-to-curve distance. Not given: 0.01 mm for a cad: seam (its source is
-    # exact), 0.1 mm otherwise (load_cell decides).
+    # Max point-to-curve distance. Not given: 0.1 mm (load_cell decides); for a cad:
+    # seam 0.01 mm (its source is exact) unless it has sharp corners, which the fit
+    # rounds (path.inputs.load_points decides, knowing the corners).
     fit_tolerance_mm: float | None = None
     normal_tolerance_deg: float = 2.0  # max angle, given (CSV) to fitted normal
     n_control_points: int | None = None
@@ -332,9 +333,8 @@ def load_cell(file: str | os.PathLike) -> Cell:
     for seam in ([cell.path] if cell.path is not None else []) + cell.seams:
         if seam.closed is None:  # not given: a loop comes back to its start
             seam.closed = seam.cad is not None and seam.cad.loop is not None
-        if seam.fit_tolerance_mm is None:  # not given: a CAD seam is exact
-            exact = seam.cad is not None
-            seam.fit_tolerance_mm = CAD_FIT_TOLERANCE_MM if exact else FIT_TOLERANCE_MM
+        if seam.fit_tolerance_mm is None and seam.cad is None:  # a cad: seam's: its points'
+            seam.fit_tolerance_mm = FIT_TOLERANCE_MM
     return cell
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from offline_prog.config.cell import Cell
+from offline_prog.config.cell import CAD_FIT_TOLERANCE_MM, FIT_TOLERANCE_MM, Cell
 from offline_prog.errors import InputError
 from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
@@ -96,7 +96,11 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     if path.cad is not None:  # Open CASCADE (seconds to import) only for these
         from offline_prog.path.cad_source import cad_points
 
-        return cad_points(file, cell)
+        points = cad_points(file, cell)
+        if path.fit_tolerance_mm is None:  # not given: exact, unless corners round it
+            corners = points.exact is not None and points.exact.corners
+            path.fit_tolerance_mm = FIT_TOLERANCE_MM if corners else CAD_FIT_TOLERANCE_MM
+        return points
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
     close_tolerance_m = path.fit_tolerance_mm * 1e-3
     try:
