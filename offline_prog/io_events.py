@@ -13,9 +13,14 @@ on the path (KRL ``TRIGGER WHEN PATH``, RAPID ``TriggIO`` / ``TriggSpeed``).
 The flow output is live only while the digital output is on (without on/off: while the
 seam runs), and at its idle value otherwise: the flow at zero speed, ``offset`` clipped
 to [min, max], which is what every controller's speed-proportional output gives when
-its factor is zero. The dispenser's lag ``lag_s`` shifts the flow's command earlier:
-the analog event at a gate position happens ``lag_s`` before the tool passes it, so
-the dispensed flow starts and stops where the digital output switches.
+its factor is zero. The dispenser's lag ``lag_s`` shifts the flow's changes earlier:
+the flow goes live ``lag_s`` before the valve opens, so the dispensed flow is up to
+speed where the gun opens; the cut-off is not led: the flow stays live until the valve
+closes (a flow cut ``lag_s`` early thins the seam's last stretch).
+
+The valve answers its output after its response time (``on.delay_s``, ``off.delay_s``):
+a digital event is set that much before the tool reaches the position where the valve
+opens or closes (``path_m``), at ``set_path_m``.
 """
 
 from __future__ import annotations
@@ -44,12 +49,14 @@ class IoEvent:
         state: digital on / off; analog live / back to idle.
         value: digital 1.0 / 0.0; analog: the value from this event on [V].
         path_m: where along the seam's path from its start the change takes effect [m]
-            (for the flow: where the dispensed flow starts or stops, the gate).
-        t_s: job time at which the controller sets the output [s] (for the flow,
-            ``lag_s`` before the tool passes ``path_m``).
-        set_path_m: where the tool is at ``t_s`` [m] (``path_m`` for the digital
-            output; for the flow, where a controller without its own lag
-            compensation sets it).
+            (digital: where the valve opens or closes; flow: where the tool is
+            ``lag_s`` after it is set: the gate going live, past the valve's closing
+            for the cut-off, where a controller that leads by the lag itself sets it).
+        t_s: job time at which the controller sets the output [s] (digital: the valve's
+            delay before the tool passes ``path_m``; flow going live: ``lag_s`` before;
+            flow cut-off: when the tool passes ``path_m``).
+        set_path_m: where the tool is at ``t_s`` [m]: where a controller sets the
+            output (without its own lag compensation for the flow).
     """
 
     seam: str
@@ -73,7 +80,8 @@ class IoEvent:
 @dataclasses.dataclass(frozen=True)
 class ProcessIo:
     """``tool.process_io`` in SI units: the digital output switched ``on_lead_m`` before
-    each seam's start and ``off_lead_m`` before its end (None: no switching), and the
+    each seam's start and ``off_lead_m`` before its end (None: no switching), set
+    ``on_delay_s`` / ``off_delay_s`` earlier (the valve's response), and the
     analog flow output value = offset + per_mps · v_TCP [V] in [min, max] while the
     process output is on (None: no flow); ``lag_s`` the dispenser's lag [s]. The
     leads are the cell's words for the header; the positions are the events'."""
@@ -81,6 +89,8 @@ class ProcessIo:
     digital_output: int | None = None
     on_lead_m: float = 0.0
     off_lead_m: float = 0.0
+    on_delay_s: float = 0.0
+    off_delay_s: float = 0.0
     analog_output: int | None = None
     per_mps: float = 0.0
     offset: float = 0.0

@@ -150,6 +150,8 @@ def fit_path(inputs: Inputs) -> FittedPath:
     except ValueError as error:
         raise InputError(file, "path", str(error)) from None
     path = ArcLengthPath(fitted)
+    if spec.closed and spec.overlap_mm > 0:  # the seam runs on over its first overlap_mm
+        path.length += spec.overlap_mm * 1e-3
     _check_turns(file, path)
     normal = normal_field(file, inputs.cell, inputs.points, path)
     normal_fit = check_normal_fit(file, inputs.cell, inputs.points, path, normal)

@@ -29,6 +29,10 @@ def required():
     return dataclasses.field(default=None, metadata=REQUIRED)
 
 
+FIT_TOLERANCE_MM = 0.1  # path.fit_tolerance_mm's default for measured points
+CAD_FIT_TOLERANCE_MM = 0.01  # ... and for a cad: seam (an exact source)
+
+
 @dataclasses.dataclass
 class ShapeConfig:
     """A named collision/visual shape, posed in its owner's frame (I for obstacles,
@@ -54,10 +58,13 @@ class RobotConfig:
 @dataclasses.dataclass
 class DigitalSwitch:
     """Switch a digital output at a distance along the path: ``lead_mm`` before the
-    seam's start (on) or before its end (off); negative: after."""
+    seam's start (on) or before its end (off); negative: after. ``delay_s``: the valve's
+    response time [s]: the output is set that much earlier, so the valve opens (closes)
+    at the lead's position."""
 
     digital_output: int = required()
     lead_mm: float = 0.0
+    delay_s: float = 0.0
 
 
 @dataclasses.dataclass
@@ -171,9 +178,15 @@ class PathConfig:
     normal: list[float] | None = None  # constant surface normal in P (into the surface)
     normal_from_mesh: bool = False  # normals from part.mesh
     degree: int = 5
-    fit_tolerance_mm: float = 0.1
+    # Max point-to-curve distance. Not given: 0.1 mm (load_cell decides); for a cad:
+    # seam 0.01 mm (its source is exact) unless it has sharp corners, which the fit
+    # rounds (path.inputs.load_points decides, knowing the corners).
+    fit_tolerance_mm: float | None = None
     normal_tolerance_deg: float = 2.0  # max angle, given (CSV) to fitted normal
     n_control_points: int | None = None
+    # A closed seam's bead runs past its start by this much before the gun closes [mm]
+    # (the path runs on over its first overlap_mm); refused on an open seam.
+    overlap_mm: float = 0.0
 
 
 @dataclasses.dataclass
@@ -324,6 +337,8 @@ def load_cell(file: str | os.PathLike) -> Cell:
     for seam in ([cell.path] if cell.path is not None else []) + cell.seams:
         if seam.closed is None:  # not given: a loop comes back to its start
             seam.closed = seam.cad is not None and seam.cad.loop is not None
+        if seam.fit_tolerance_mm is None and seam.cad is None:  # a cad: seam's: its points'
+            seam.fit_tolerance_mm = FIT_TOLERANCE_MM
     return cell
 
 

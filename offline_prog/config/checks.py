@@ -173,7 +173,7 @@ def _check_path(file: Path, key: str, path: PathConfig, cell: Cell) -> None:
     if path.degree < 5:
         raise _error(file, f"{key}.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
     for name in ("fit_tolerance_mm", "normal_tolerance_deg"):
-        if not getattr(path, name) > 0:
+        if getattr(path, name) is not None and not getattr(path, name) > 0:  # None: cad:'s
             raise _error(file, f"{key}.{name}", f"must be > 0, got {getattr(path, name)}")
 
 

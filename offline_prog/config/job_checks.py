@@ -17,6 +17,7 @@ APPROACH_KINDS = ("normal", "tangent", "none")
 MAX_APPROACH_MM = 1000.0  # approach, retract and I/O lead distances
 MAX_LINK_TIME_S = 600.0  # planning time per link
 MAX_FLOW_LAG_S = 1.0  # a dispenser's lag: beyond this the path triggers cannot lead it
+MAX_VALVE_DELAY_S = 1.0  # a valve's response time (on.delay_s, off.delay_s)
 MAX_SEAM_NAME_CHARS = 20  # KRL names are at most 24 characters; we add a prefix
 SEAM_NAME = name_pattern(MAX_SEAM_NAME_CHARS)
 
@@ -60,6 +61,7 @@ def check_job(file: Path, cell: Cell) -> None:
                     f"{key}.{end}.distance_mm",
                     f"must be within [0, {MAX_APPROACH_MM:g}] mm, got {move.distance_mm:g}",
                 )
+    _check_overlaps(file, cell)
     job = cell.job or JobConfig()
     if job.order not in ("given", "auto"):
         raise _error(file, "job.order", f"{job.order!r} (use given or auto)")
@@ -76,6 +78,13 @@ def check_job(file: Path, cell: Cell) -> None:
                     file,
                     f"tool.process_io.{name}.lead_mm",
                     f"must be within ±{MAX_APPROACH_MM:g} mm",
+                )
+            if switch is not None and not 0 <= switch.delay_s <= MAX_VALVE_DELAY_S:
+                raise _error(
+                    file,
+                    f"tool.process_io.{name}.delay_s",
+                    f"must be within [0, {MAX_VALVE_DELAY_S:g}] s (the valve's response "
+                    f"time), got {switch.delay_s:g}",
                 )
         _check_leads(file, cell, io)
         if (io.on is None) != (io.off is None):
@@ -136,6 +145,29 @@ OUTPUT_RANGES = {
     "rapid": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
     "fanuc": {"digital_output": (1, 9999), "analog_output": (1, 9999)},
 }
+
+
+def _check_overlaps(file: Path, cell: Cell) -> None:
+    """``overlap_mm`` only on a closed seam, within [0, MAX_APPROACH_MM]."""
+    specs = [(f"seams[{k}]", seam) for k, seam in enumerate(cell.seams)]
+    if cell.path is not None:
+        specs.append(("path", cell.path))
+    for key, spec in specs:
+        if spec.overlap_mm == 0.0:
+            continue
+        if not 0 < spec.overlap_mm <= MAX_APPROACH_MM:
+            raise _error(
+                file,
+                f"{key}.overlap_mm",
+                f"must be within [0, {MAX_APPROACH_MM:g}] mm, got {spec.overlap_mm:g}",
+            )
+        if not spec.closed:
+            raise _error(
+                file,
+                f"{key}.overlap_mm",
+                "an open seam has no start to overlap (only a closed seam's bead runs past "
+                "its start)",
+            )
 
 
 def _check_leads(file: Path, cell: Cell, io) -> None:

@@ -194,8 +194,12 @@ def _process(seam: ProgramData, name: str, number: int, points: PointRule | None
 
 
 def _position(event: IoEvent, flow_where_set: bool) -> float:
-    """Where along the path a program switches the event [m]."""
-    return event.set_path_m if flow_where_set else event.path_m
+    """Where along the path a program switches the event [m]: a digital output where
+    it is set (its valve's response time ahead), the flow where it is set or where it
+    takes effect (a controller that leads by the lag itself)."""
+    if event.signal is Signal.DIGITAL or flow_where_set:
+        return event.set_path_m
+    return event.path_m
 
 
 def _with_switches(run: SeamRun, length: float, flow_where_set: bool) -> SeamRun:

@@ -1,12 +1,14 @@
 """Process I/O along a job, decided once: where each seam's process output (glue gun,
 torch) switches, when the flow output goes live, and both as per-row columns.
 
-The digital output goes on ``on.lead_mm`` before each seam's start and off
-``off.lead_mm`` before its end (positions along the tool's path on the part,
-``JobSamples.path_m``: negative on the approach, beyond L on the retract). The flow
-output follows the TCP speed (value = offset + per_mps · v_TCP, clipped to [min, max])
-only while the digital output is on, and rests at its idle value (``ProcessIo.idle``)
-otherwise; its command leads by the dispenser's lag ``flow.lag_s``. The events
+The valve opens ``on.lead_mm`` before each seam's start and closes ``off.lead_mm``
+before its end (positions along the tool's path on the part, ``JobSamples.path_m``:
+negative on the approach, beyond L on the retract; a closed seam's L includes its
+``overlap_mm``); the digital output is set the valve's response time (``on.delay_s``,
+``off.delay_s``) before. The flow output follows the TCP speed (value = offset +
+per_mps · v_TCP, clipped to [min, max]) while the valve is open, and rests at its idle
+value (``ProcessIo.idle``) otherwise; it goes live ``flow.lag_s`` before the valve opens
+and its command leads the speed by that lag, but it is cut when the valve closes. The events
 (:class:`~offline_prog.io_events.IoEvent`) are what every program writer translates.
 """
 
@@ -29,12 +31,15 @@ POSITION_TOL_M = 1e-6  # a switch this close to the approach's start or retract'
 class IoColumns:
     """Per row: ``digital`` (N,) 0/1 of the process output (None without on/off),
     ``analog`` (N,) the flow output's command [V] (None without flow); ``events`` in
-    time order; ``settings`` the cell's process I/O in SI units (None: no I/O)."""
+    time order; ``settings`` the cell's process I/O in SI units (None: no I/O);
+    ``valve`` (N,) where the valve is open (the output's response time after it is set;
+    None without on/off)."""
 
     digital: np.ndarray | None
     analog: np.ndarray | None
     events: list[IoEvent]
     settings: ProcessIo | None = None
+    valve: np.ndarray | None = None  # (N,) bool: the valve open (the output's delay on)
 
     @property
     def switches(self) -> list[IoEvent]:
@@ -75,6 +80,8 @@ def process_io_settings(
         digital_output=None if io is None or io.on is None else io.on.digital_output,
         on_lead_m=0.0 if io is None or io.on is None else io.on.lead_mm * 1e-3,
         off_lead_m=0.0 if io is None or io.off is None else io.off.lead_mm * 1e-3,
+        on_delay_s=0.0 if io is None or io.on is None else io.on.delay_s,
+        off_delay_s=0.0 if io is None or io.off is None else io.off.delay_s,
         **fields,
     )
 
@@ -105,24 +112,29 @@ def io_columns(
     if settings is None:
         return IoColumns(None, None, [])
     t = samples.t
-    on = np.zeros(len(t), dtype=bool)
+    on = np.zeros(len(t), dtype=bool)  # the output as the controller sets it
+    valve = np.zeros(len(t), dtype=bool)  # the valve open, its response time later
     live = np.zeros(len(t), dtype=bool)  # the flow's command is live
     flowing = settings.analog_output is not None
+    switching = settings.digital_output is not None
     lag = settings.lag_s if flowing else 0.0
     events: list[IoEvent] = []
     for seam, (rows, t_end) in _seam_rows(samples).items():
         path, t_seam = _with_retract_end(samples.path_m[rows], t[rows], t_end)
         length = lengths_m[seam]
-        if settings.digital_output is None:  # no switching: the flow runs on the seam
+        if not switching:  # no switching: the flow runs on the seam
             gate = (0.0, length)
         else:
             gate = (-settings.on_lead_m, length - settings.off_lead_m)
             _check_gate(seam, gate, path, length)
-        times = [_time_at(position, path, t_seam) for position in gate]
-        if settings.digital_output is not None:
-            on |= (t >= times[0]) & (t < times[1])
+        times = [_time_at(position, path, t_seam) for position in gate]  # valve opens, closes
+        if switching:
+            set_times = [times[0] - settings.on_delay_s, times[1] - settings.off_delay_s]
+            _check_delays(seam, set_times, t_seam[0])
+            on |= (t >= set_times[0]) & (t < set_times[1])
+            valve |= (t >= times[0]) & (t < times[1])
             events += [
-                IoEvent(
+                _event(
                     seam,
                     Signal.DIGITAL,
                     settings.digital_output,
@@ -130,9 +142,10 @@ def io_columns(
                     float(state),
                     position,
                     time,
-                    position,
+                    path,
+                    t_seam,
                 )
-                for state, position, time in zip((True, False), gate, times, strict=True)
+                for state, position, time in zip((True, False), gate, set_times, strict=True)
             ]
         if flowing:
             if times[0] - lag < t_seam[0] - 1e-9:  # a program sets it on the approach
@@ -142,32 +155,62 @@ def io_columns(
                     f"starts ({times[0] - t_seam[0]:.3f} s earlier): a longer approach or "
                     "on.lead_mm leaves the flow room to lead",
                 )
-            live |= (t >= times[0] - lag) & (t < times[1] - lag)
+            # Live lag_s before the valve opens, until it closes (the cut-off not led).
+            flow_times = (times[0] - lag, times[1])
+            live |= (t >= flow_times[0]) & (t < flow_times[1])
+            # Where each takes effect, lag_s after it is set (a controller that leads by
+            # the lag itself places it there): the gate, and past the valve's closing.
+            flow_at = (gate[0], float(np.interp(times[1] + lag, t_seam, path)))
             v_on = float(np.interp(times[0], t, tcp_speed))
             values = (float(settings.flow(v_on)), settings.idle)
             events += [
-                IoEvent(
+                _event(
                     seam,
                     Signal.ANALOG,
                     settings.analog_output,
                     state,
                     value,
                     position,
-                    time - lag,
-                    float(np.interp(time - lag, t_seam, path)),
+                    time,
+                    path,
+                    t_seam,
                 )
                 for state, value, position, time in zip(
-                    (True, False), values, gate, times, strict=True
+                    (True, False), values, flow_at, flow_times, strict=True
                 )
             ]
-    digital = on.astype(np.int8) if settings.digital_output is not None else None
+    digital = on.astype(np.int8) if switching else None
     analog = None
     if flowing:
         # The command at t is the flow the tool needs lag_s later.
         value = settings.flow(np.interp(t + lag, t, tcp_speed))
         analog = np.where(live, value, settings.idle)
     events.sort(key=lambda e: (e.t_s, e.signal is not Signal.DIGITAL))
-    return IoColumns(digital, analog, events, settings)
+    return IoColumns(digital, analog, events, settings, valve if switching else None)
+
+
+def _event(seam, signal, output, state, value, position, time, path, t_seam) -> IoEvent:
+    """The event taking effect at ``position`` [m], set at ``time`` [s] where the tool
+    is then on the seam's path."""
+    where = float(np.interp(time, t_seam, path))
+    return IoEvent(seam, signal, output, state, value, float(position), float(time), where)
+
+
+def _check_delays(seam: str, set_times: list[float], t_start: float) -> None:
+    """The valve's response times leave the output set after the approach starts and
+    on before off."""
+    if set_times[0] < t_start - 1e-9:
+        raise IoPlacementError(
+            "tool.process_io.on.delay_s",
+            f"seam {seam}: the output would be set {t_start - set_times[0]:.3f} s before its "
+            "approach starts: a longer approach or a smaller on.lead_mm leaves the valve room",
+        )
+    if not set_times[0] < set_times[1]:
+        raise IoPlacementError(
+            "tool.process_io.off.delay_s",
+            f"seam {seam}: the output would be set off before it is set on (off.delay_s "
+            "longer than the seam's run)",
+        )
 
 
 def _lag_key(model: ProcessModel | None) -> str:

@@ -297,7 +297,7 @@ def job_quality(inputs: Inputs, linked: LinkedJob, io: IoColumns) -> ProcessQual
         path_m=samples.path_m,
         segments=samples.segments,
         command=io.analog,
-        digital=io.digital,
+        digital=io.digital if io.valve is None else io.valve,
         settings=io.settings,
         events=io.events,
     )

@@ -63,9 +63,29 @@ def distances_to_reference(exact: ExactSeam, points_P: np.ndarray) -> np.ndarray
     return best
 
 
-def path_to_reference(exact: ExactSeam, path) -> tuple[float, float]:
-    """Max and RMS distance [m] of the fitted arc-length path from the exact seam, on
-    a COMPARE_SPACING_M grid over its whole length."""
+def path_to_reference(exact: ExactSeam, path) -> tuple[float, float, float]:
+    """Max and RMS distance [m] of the fitted arc-length path from the exact seam, and
+    the largest angle [rad] between the path's tangent and the exact seam's (at the
+    nearest reference vertex), on a COMPARE_SPACING_M grid over its whole length."""
     s = np.linspace(0.0, path.length, max(2, int(path.length / COMPARE_SPACING_M) + 1))
-    d = distances_to_reference(exact, path(s, 0)[0])
-    return float(d.max()), float(np.sqrt(np.mean(d**2)))
+    r, t = path(s, 1)
+    d = distances_to_reference(exact, r)
+    return float(d.max()), float(np.sqrt(np.mean(d**2))), float(_tangent_error(exact, r, t).max())
+
+
+def _tangent_error(exact: ExactSeam, points_P: np.ndarray, t_P: np.ndarray) -> np.ndarray:
+    """(N,) angle [rad] between unit tangents t_P (N, 3) and the exact seam's at the
+    reference vertex nearest each of points_P (N, 3) [m]: the central difference of its
+    neighbours (a closed seam wraps; an open one's ends take the one-sided chord)."""
+    ref = exact.reference_P
+    count = len(ref)
+    _, i = cKDTree(ref).query(points_P)
+    if exact.closed:
+        before, after = ref[(i - 1) % count], ref[(i + 1) % count]
+    else:
+        before, after = ref[np.maximum(i - 1, 0)], ref[np.minimum(i + 1, count - 1)]
+    # The reference's tangent at vertex i: the central difference (second order).
+    tangent = after - before
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    cos = np.abs(np.einsum("ij,ij->i", tangent, t_P))
+    return np.arccos(np.clip(cos, -1.0, 1.0))

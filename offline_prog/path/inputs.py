@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from offline_prog.config.cell import Cell
+from offline_prog.config.cell import CAD_FIT_TOLERANCE_MM, FIT_TOLERANCE_MM, Cell
 from offline_prog.errors import InputError
 from offline_prog.path import sources as path_sources
 from offline_prog.path.arc_length import ArcLengthPath
@@ -33,7 +33,9 @@ class NormalFit:
     "mesh" (part.mesh: not measured, None) or "cad" (the model's faces at the fit's
     points: measured). worst_row: 1-based CSV data row of the largest angle (row 1 is
     the first point after the header), or None. edge_max_error_mm, edge_rms_error_mm:
-    for a cad: seam, the fitted path's distance from the model's exact seam [mm].
+    for a cad: seam, the fitted path's distance from the model's exact seam [mm];
+    edge_tangent_max_error_deg: the largest angle between the fitted path's tangent and
+    the exact seam's [deg].
     """
 
     source: str
@@ -42,6 +44,7 @@ class NormalFit:
     worst_row: int | None = None
     edge_max_error_mm: float | None = None
     edge_rms_error_mm: float | None = None
+    edge_tangent_max_error_deg: float | None = None
 
 
 def _error(file, key, reason) -> InputError:
@@ -93,7 +96,11 @@ def load_points(file: Path, cell: Cell) -> path_sources.PathPoints:
     if path.cad is not None:  # Open CASCADE (seconds to import) only for these
         from offline_prog.path.cad_source import cad_points
 
-        return cad_points(file, cell)
+        points = cad_points(file, cell)
+        if path.fit_tolerance_mm is None:  # not given: exact, unless corners round it
+            corners = points.exact is not None and points.exact.corners
+            path.fit_tolerance_mm = FIT_TOLERANCE_MM if corners else CAD_FIT_TOLERANCE_MM
+        return points
     key, source = ("path.points", path.points) if path.points else ("path.dxf", path.dxf)
     close_tolerance_m = path.fit_tolerance_mm * 1e-3
     try:
@@ -192,7 +199,7 @@ def _check_cad_fit(file: Path, cell: Cell, points, path: ArcLengthPath, angles) 
     from offline_prog.path.exact_seam import path_to_reference
 
     worst = int(np.argmax(angles))
-    edge_max, edge_rms = path_to_reference(points.exact, path)
+    edge_max, edge_rms, tangent = path_to_reference(points.exact, path)
     fit = NormalFit(
         "cad",
         float(angles[worst]),
@@ -200,6 +207,7 @@ def _check_cad_fit(file: Path, cell: Cell, points, path: ArcLengthPath, angles) 
         None,
         edge_max * 1e3,
         edge_rms * 1e3,
+        float(np.rad2deg(tangent)),
     )
     tolerance = cell.path.normal_tolerance_deg
     if fit.max_error_deg > tolerance:

@@ -214,11 +214,12 @@ def _values(model: ProcessModel, t, v, command, on, settings) -> tuple[np.ndarra
 
 def _uncompensated_command(t, v, settings: ProcessIo, events: list[IoEvent]) -> np.ndarray:
     """(N,) the flow without the lead: flow(v(t)) while the output is live, each live
-    window shifted by lag_s to where the flow starts and stops (the gate)."""
+    window starting lag_s later, at the gate (the cut-off, at the valve's closing, is
+    not led either way)."""
     live = np.zeros(len(t), bool)
     flow = [e for e in events if e.signal is Signal.ANALOG]
     for on, off in zip(flow[::2], flow[1::2], strict=True):
-        live |= (t >= on.t_s + settings.lag_s) & (t < off.t_s + settings.lag_s)
+        live |= (t >= on.t_s + settings.lag_s) & (t < off.t_s)
     return np.where(live, settings.flow(v), settings.idle)
 
 

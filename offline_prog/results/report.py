@@ -255,6 +255,7 @@ def normal_fit_summary(plan: Plan) -> dict:
         # cad: seams: the fitted path's distance from the model's exact seam [mm]
         "edge_max_error_mm": None if fit is None else fit.edge_max_error_mm,
         "edge_rms_error_mm": None if fit is None else fit.edge_rms_error_mm,
+        "edge_tangent_max_error_deg": None if fit is None else fit.edge_tangent_max_error_deg,
     }
 
 

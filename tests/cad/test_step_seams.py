@@ -173,3 +173,18 @@ def test_offset_moves_the_seam_along_the_normal(parts):
     np.testing.assert_allclose(p[:, 1:], [[2.0, 0.0]] * len(p), atol=PATH_TOL_MM)
     for fit in (lifted, inside):
         assert fit.normal_fit.edge_max_error_mm < PATH_TOL_MM
+
+
+def test_a_cad_seam_is_fitted_exactly_by_default_and_its_tangent_error_reported(parts):
+    """Issue 37: a cad: seam's source is exact, so its fit tolerance defaults to
+    0.01 mm (not 0.1 mm); the tangent of the fitted path against the exact edge's is
+    measured, and it is smaller at the exact default than at 0.1 mm."""
+    loop = {"loop": {"face_near_mm": [150, 100, 10]}}
+    exact, coarse = fitted_seams(
+        parts, "plate.step", [{"cad": loop}, {"cad": loop, "fit_tolerance_mm": 0.1}]
+    )
+    assert exact.normal_fit.edge_max_error_mm <= 0.0101
+    assert coarse.normal_fit.edge_max_error_mm > 0.02
+    tangent_exact = exact.normal_fit.edge_tangent_max_error_deg
+    tangent_coarse = coarse.normal_fit.edge_tangent_max_error_deg
+    assert tangent_exact < 1.5 and tangent_coarse > 1.5 * tangent_exact

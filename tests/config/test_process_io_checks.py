@@ -168,7 +168,8 @@ def test_switch_positions_are_the_cells_or_refused(
 
 
 def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
-    """No on/off: the flow is live while the seam runs; its command leads by lag_s."""
+    """No on/off: the flow is live while the seam runs; it goes live lag_s early, but
+    is cut where the seam ends (a cut led by the lag would thin the seam's end)."""
     samples, speed = one_seam(0.1, 0.03, 0.03)
     lag = 0.02
     io = ProcessIoConfig(flow=AnalogFlow(analog_output=1, per_mps=40.0, offset=0.5, lag_s=lag))
@@ -178,9 +179,15 @@ def test_flow_without_switching_runs_on_the_seam_and_leads_by_the_lag():
     process = next(s for s in samples.segments if s.kind == "process")
     dt = np.diff(samples.t).max()
     assert live_t[0] == pytest.approx(process.t_start - lag, abs=dt)
-    assert live_t[-1] == pytest.approx(process.t_stop - lag, abs=dt)
+    assert live_t[-1] == pytest.approx(process.t_stop, abs=dt)
     assert columns.analog.max() == pytest.approx(0.5 + 40.0 * 0.1)
-    assert [(e.state, e.path_m) for e in columns.events] == [(True, 0.0), (False, 0.1)]
+    # The cut-off takes effect (a controller leading by the lag places it) lag_s past
+    # the seam's end, so it is set as the seam ends.
+    assert [(e.state, e.path_m) for e in columns.events] == [
+        (True, 0.0),
+        (False, pytest.approx(0.1 + 0.1 * lag)),
+    ]
+    assert columns.events[1].set_path_m == pytest.approx(0.1)
 
 
 def test_a_lag_that_leads_before_the_approach_is_refused():
@@ -240,3 +247,64 @@ def test_the_ao_unit_is_checked(capsys, tmp_path, unit, key):
     text = text.replace("per_mps: 40.0", f"per_mps: 40.0, {unit}", 1)
     code, err = run(capsys, tmp_path, with_cell_dir(text))
     assert code == 2 and len(err) == 1 and f": {key}: " in err[0], err
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key"),
+    [
+        ("lead_mm: 5}", "lead_mm: 5, delay_s: -0.02}", "tool.process_io.on.delay_s"),
+        ("lead_mm: 2}", "lead_mm: 2, delay_s: -0.01}", "tool.process_io.off.delay_s"),
+        ("    closed: true\n", "    closed: true\n    overlap_mm: -3\n", "seams[0].overlap_mm"),
+        ("    closed: true\n", "    closed: false\n    overlap_mm: 5\n", "seams[0].overlap_mm"),
+    ],
+)
+def test_bad_valve_delays_and_overlaps_are_refused(capsys, tmp_path, old, new, key):
+    """A negative response time, a negative overlap, an overlap on an open seam: one
+    line naming the key, exit 2, nothing written."""
+    text = (CELLS / "seal_job_kr16.yaml").read_text()
+    assert old in text
+    code, err = run(capsys, tmp_path, with_cell_dir(text.replace(old, new, 1)))
+    assert code == 2 and len(err) == 1 and f": {key}: " in err[0], err
+    assert not (tmp_path / "out").exists()
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(
+    on_delay=st.floats(0.0, 0.2),
+    off_delay=st.floats(0.0, 0.2),
+    lag=st.floats(0.0, 0.15),
+)
+def test_the_valve_opens_and_closes_at_the_leads_and_the_flow_is_cut_as_it_closes(
+    on_delay, off_delay, lag
+):
+    """The output is set ``delay_s`` before the tool reaches the lead's position, so the
+    valve (open ``delay_s`` after it is set) opens and closes there; the flow goes live
+    ``lag_s`` before the valve opens and stays live until it closes."""
+    samples, speed = one_seam(0.1, 0.04, 0.04)  # 0.1 m/s, a 40 mm approach: 0.4 s
+    io = io_config(5.0, 2.0, lag_s=lag)
+    io.on.delay_s, io.off.delay_s = on_delay, off_delay
+    columns = io_columns(samples, io, {"s": 0.1}, speed)
+    t, path = samples.t, samples.path_m
+    rows = np.isfinite(path)
+    t_open, t_close = np.interp([-0.005, 0.098], path[rows], t[rows])
+    on, off = columns.switches
+    assert (on.path_m, off.path_m) == (pytest.approx(-0.005), pytest.approx(0.098))
+    assert on.t_s == pytest.approx(t_open - on_delay, abs=1e-9)
+    assert off.t_s == pytest.approx(t_close - off_delay, abs=1e-9)
+    assert on.set_path_m == pytest.approx(-0.005 - 0.1 * on_delay, abs=1e-6)
+    dt = np.diff(t).max()
+    open_t = t[columns.valve]
+    assert open_t[0] == pytest.approx(t_open, abs=dt) and open_t[-1] == pytest.approx(
+        t_close, abs=dt
+    )
+    live_t = t[columns.analog > 0.5 + 1e-9]
+    assert live_t[0] == pytest.approx(t_open - lag, abs=dt)
+    assert live_t[-1] == pytest.approx(t_close, abs=dt)  # the cut-off is not led
+
+
+def test_an_on_delay_before_the_approach_is_refused():
+    samples, speed = one_seam(0.1, 0.03, 0.03)  # the on switch 25 mm into 30 mm: 0.25 s
+    io = io_config(5.0, 2.0)
+    io.on.delay_s = 0.3
+    with pytest.raises(IoPlacementError, match=r"on.delay_s: seam s: the output would be set"):
+        io_columns(samples, io, {"s": 0.1}, speed)

@@ -163,13 +163,12 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
     # Both fall on the stripe's own LIN(s): the seam module holds both TRIGGERs.
     module = next(f for f in files if f.name == "offline_prog_1.src").read_text()
     assert len(re.findall(r"^TRIGGER .* DO \$OUT\[1\]", module, re.M)) == 2
-    # The flow: its factor is live between them, switched lag_s earlier: at v · lag_s
-    # before the on switch (the stripe runs at its speed there), and at most that much
-    # before the off switch (the tool slows down to the stripe's end).
+    # The flow: its factor goes live lag_s earlier: at v · lag_s before the on switch
+    # (the stripe runs at its speed there), and is cut at the off switch (not led).
     flow = [(value, position, delay) for what, value, position, delay in events if "_FK" in what]
     assert [float(v) for v, _, _ in flow] == [pytest.approx(PER_MPS / 10), 0.0]
     assert flow[0][1] == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
-    assert off - SPEED_M_S * LAG_S - IO_TOL_M <= flow[1][1] < off
+    assert flow[1][1] == pytest.approx(off, abs=IO_TOL_M)  # cut as the valve closes
     assert all(delay == 0 for _, _, delay in flow)  # no negative DELAY to be clamped
     # One ANOUT ON before any motion, idle until a trigger: no constant factor.
     anout = [line for line in run if line.startswith("ANOUT ON")]
@@ -226,9 +225,15 @@ def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     ]
     flow = [(float(v), p, lag) for what, v, p, lag in events if what == "ao1"]
     assert [v for v, _, _ in flow] == [pytest.approx(PER_MPS / 1000), 0.0]
+    # ScaleLag leads both: the cut-off is placed where the tool is lag_s after the
+    # valve closes (the seam's end, where it comes to rest), so the controller sets it
+    # as the valve closes (the flow stays live until then).
+    cut = next(e for e in data.events if e.signal is Signal.ANALOG and not e.state)
+    close = next(e for e in data.events if e.signal is Signal.DIGITAL and not e.state)
+    assert cut.t_s == pytest.approx(close.t_s) and cut.path_m > off
     assert [p for _, p, _ in flow] == [
         pytest.approx(on, abs=IO_TOL_M),
-        pytest.approx(off, abs=IO_TOL_M),
+        pytest.approx(cut.path_m, abs=IO_TOL_M),
     ]
     assert all(lag == LAG_S for _, _, lag in flow)  # ScaleLag is the cell's lag_s
     assert "\\Start" not in text  # nothing switches at a motion's start
@@ -260,7 +265,8 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     for (_, p, _), asked_m in zip(digital, (on, off), strict=True):
         assert asked_m - 1e-6 <= p <= asked_m + SPEED_M_S * period + IO_TOL_M
     # The flow: idle before it goes live lag_s (lag_s / period commands) ahead of the
-    # gun, the live value at once (not a ramp from idle), idle again lag_s early.
+    # gun, the live value at once (not a ramp from idle), idle again as the gun closes
+    # (the cut-off is not led: a flow cut lag_s early thins the seam's end).
     volts = [(float(v) * 10.0, p, i) for v, p, i in analog]
     live_flow = OFFSET_V + PER_MPS * SPEED_M_S
     first = next(k for k, (v, _, _) in enumerate(volts) if v > OFFSET_V + 0.01)
@@ -276,7 +282,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
 
     lead = LAG_S / period
     assert commands_between(volts[first][2], digital[0][2]) == pytest.approx(lead, abs=1.01)
-    assert commands_between(volts[back][2], digital[1][2]) == pytest.approx(lead, abs=1.01)
+    assert commands_between(volts[back][2], digital[1][2]) == pytest.approx(0, abs=1.01)
     # The speed at the switch, from the program's own joints: the flow follows it.
     i = volts[first][2]
     v = (positions[servoj[servoj.index(i) + 1]] - positions[i]) / period
@@ -286,7 +292,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
 # --- the plan's own columns -----------------------------------------------------------
 
 
-def test_trajectory_csv_flow_leads_the_output_by_the_lag(stripe):
+def test_trajectory_csv_flow_leads_the_output_by_the_lag_and_is_cut_with_it(stripe):
     _, folder, _ = stripe
     with open(folder / "trajectory.csv") as f:
         rows = list(csv.DictReader(f))
@@ -298,7 +304,7 @@ def test_trajectory_csv_flow_leads_the_output_by_the_lag(stripe):
     t_live, t_idle = t[np.argmax(live)], t[len(live) - np.argmax(live[::-1])]
     dt = np.diff(t).max()
     assert t_live == pytest.approx(t_on - LAG_S, abs=dt)
-    assert t_idle == pytest.approx(t_off - LAG_S, abs=dt)
+    assert t_idle == pytest.approx(t_off, abs=dt)  # the cut-off is not led
     assert np.all(ao[~live] == OFFSET_V)  # idle: the flow at zero speed
 
 
@@ -379,3 +385,38 @@ def test_programs_switch_where_the_events_say(stripe, positions_mm):
     got = [(value == "1", p) for what, value, p, _ in rapid_events(data, text) if what == "do1"]
     assert [s for s, _ in got] == [s for s, _ in expected]
     assert [p for _, p in got] == [pytest.approx(p, abs=IO_TOL_M) for _, p in expected]
+
+
+def test_valve_delays_move_every_programs_switch_ahead_by_the_response(tmp_path):
+    """``delay_s`` on both switches: KRL's TRIGGERs and RAPID's TriggIOs set the gun
+    where the plan sets it (its events' ``set_path_m``), ahead of the cell's positions,
+    so the valve opens and closes there; the flow's cut-off is at the valve's closing."""
+    on_delay, off_delay = 0.05, 0.02
+    cell = stripe_cell(tmp_path)
+    text = cell.read_text()
+    text = text.replace(f"lead_mm: {ON_LEAD_MM}}}", f"lead_mm: {ON_LEAD_MM}, delay_s: {on_delay}}}")
+    text = text.replace(
+        f"lead_mm: {OFF_LEAD_MM}}}", f"lead_mm: {OFF_LEAD_MM}, delay_s: {off_delay}}}"
+    )
+    cell.write_text(text)
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, tmp_path / "plan")
+    data = JobProgramData.load(tmp_path / "plan")
+    on, off = asked()
+    switches = [e for e in data.events if e.signal is Signal.DIGITAL]
+    assert [e.path_m for e in switches] == [pytest.approx(on), pytest.approx(off)]
+    # At the stripe's speed on the way in: v · delay ahead; the end is slowing down.
+    assert switches[0].set_path_m == pytest.approx(on - SPEED_M_S * on_delay, abs=1e-4)
+    assert off - SPEED_M_S * off_delay - 1e-4 < switches[1].set_path_m < off - 1e-4
+    planned = [e.set_path_m for e in switches]
+    write(data, "krl", tmp_path / "krl")
+    _, events = krl_events(data, tmp_path / "krl")
+    krl = [position for what, _, position, _ in events if what == "$OUT[1]"]
+    assert krl == [pytest.approx(p, abs=IO_TOL_M) for p in planned]
+    cut = [position for what, v, position, _ in events if "_FK" in what and float(v) == 0.0]
+    assert cut == [pytest.approx(off, abs=IO_TOL_M)]
+    rapid = rapid_events(data, write(data, "rapid", tmp_path / "rapid")[0].read_text())
+    assert [p for what, _, p, _ in rapid if what == "do1"] == [
+        pytest.approx(p, abs=IO_TOL_M) for p in planned
+    ]

@@ -63,9 +63,9 @@ def quality(process, t, v, *, lead: bool = True):
     if io is not None:
         lag = io.lag_s if lead else 0.0
         command = io.flow(np.interp(t + lag, t, v))
-        events = [
-            IoEvent("a", Signal.ANALOG, 1, state, 0.0, at, time - io.lag_s, at)
-            for state, at, time in ((True, 0.0, t[0]), (False, path[-1], t[-1] + DT))
+        events = [  # live lag_s before the seam, cut as it ends (not led)
+            IoEvent("a", Signal.ANALOG, 1, state, 0.0, at, time, at)
+            for state, at, time in ((True, 0.0, t[0] - io.lag_s), (False, path[-1], t[-1] + DT))
         ]
     result = process_quality(
         model,

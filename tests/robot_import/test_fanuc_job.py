@@ -229,11 +229,12 @@ def test_fanuc_keeps_both_switches_on_a_straight_seam(stripe, tmp_path):
     assert seam["db"][1][2] == pytest.approx(off, abs=IO_TOL_M)
     statements = [s for f in tmp_path.glob("*.ls") for s in read_ls(f)["mn"]]
     assert sum("DO[" in s for s in statements if not s.startswith("!")) == 2  # not the flow
-    # The flow goes live lag_s ahead of the on switch (at the stripe's speed).
+    # The flow goes live lag_s ahead of the on switch (at the stripe's speed), and is
+    # cut as the gun closes (not led).
     first = next(a for a, _, v in seam["moves"] if v > OFFSET_V + 0.01)
     assert first == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
     last = max(b for _, b, v in seam["moves"] if v > OFFSET_V + 0.01)
-    assert off - SPEED_M_S * LAG_S - IO_TOL_M <= last < off
+    assert last == pytest.approx(off, abs=IO_TOL_M)  # live until the valve closes
 
 
 def test_fanuc_flow_replays_the_plans_ao_column(stripe, tmp_path):

@@ -110,24 +110,24 @@ def place_events(
     analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
     split = [(_split(sigma, points, e.set_path_m), e) for e in analog]  # (L point, event)
     edges = [(sigma[i], e.state) for i, e in split]
-    digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.path_m)
+    digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.set_path_m)
     while (pair := _crowded(sigma, points, digital)) is not None:
         first, second = pair
         inside = np.flatnonzero(
-            (sigma >= first.path_m - SAME_POINT_M) & (sigma < second.path_m - SAME_POINT_M)
+            (sigma >= first.set_path_m - SAME_POINT_M) & (sigma < second.set_path_m - SAME_POINT_M)
         )
         inside = [i for i in inside if all(abs(sigma[i] - sigma[p]) > SAME_POINT_M for p in points)]
         if not inside:
             raise ValueError(
-                f"seam {seam}: the output switches at {first.path_m * 1e3:.3f} mm and at "
-                f"{second.path_m * 1e3:.3f} mm along its path with no planned sample "
+                f"seam {seam}: the output switches at {first.set_path_m * 1e3:.3f} mm and at "
+                f"{second.set_path_m * 1e3:.3f} mm along its path with no planned sample "
                 "between them: a FANUC motion takes one DB option"
             )
         points = sorted({*points, int(inside[0])})
     if io is not None and io.analog_output is not None:
         points = _flow_splits(samples, points, edges, flow_at)
     if merge is not None:  # the switches' points and the flow's edges stay where they are
-        ends = {points[_motion_of(sigma, points, e.path_m)] for e in digital}
+        ends = {points[_motion_of(sigma, points, e.set_path_m)] for e in digital}
         pinned = ends | {i for i, _ in split}
 
         def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow still flat
@@ -135,13 +135,15 @@ def place_events(
             return not live or _flat(flow_at(samples.t[a : b + 1]))
 
         points = merge(points, pinned, flow_fits)
-    on_motion = {_motion_of(sigma, points, e.path_m): e for e in digital}
+    on_motion = {_motion_of(sigma, points, e.set_path_m): e for e in digital}
     assert len(on_motion) == len(digital), "one digital event per motion"
     motions = []
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
         event = on_motion.get(i)
-        before = 0.0 if event is None else float(min(sigma[b] - event.path_m, sigma[b] - sigma[a]))
+        before = (
+            0.0 if event is None else float(min(sigma[b] - event.set_path_m, sigma[b] - sigma[a]))
+        )
         flow = _flow(samples, a, b, edges, io, flow_at)
         motions.append(Motion(a, b, event, max(before, 0.0), flow, dict(split).get(a)))
     return motions
@@ -213,6 +215,8 @@ def _motion_of(sigma: np.ndarray, points: list[int], position: float) -> int:
 def _crowded(sigma, points, digital) -> tuple[IoEvent, IoEvent] | None:
     """The first two digital events on one motion, in path order (None: none)."""
     for first, second in zip(digital, digital[1:], strict=False):
-        if _motion_of(sigma, points, first.path_m) == _motion_of(sigma, points, second.path_m):
+        if _motion_of(sigma, points, first.set_path_m) == _motion_of(
+            sigma, points, second.set_path_m
+        ):
             return first, second
     return None
