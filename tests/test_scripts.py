@@ -137,6 +137,7 @@ SMOKE = [
     ("calibration_accuracy.py", ["--draws", "1"], "tip_mm"),
     ("cad_accuracy.py", ["--parts", "plate", "--stl-chord-mm", "0.1"], "plate top loop"),
     ("process_bound.py", [], "report.json quality.timing_bound"),
+    ("off_seam_speeds.py", ["--cells", "weld_seam_irb2400"], "cycle / default"),
 ]
 
 
