@@ -138,6 +138,7 @@ SMOKE = [
     ("cad_accuracy.py", ["--parts", "plate", "--stl-chord-mm", "0.1"], "plate top loop"),
     ("process_bound.py", [], "report.json quality.timing_bound"),
     ("figures.py", ["--cells", "seal_plate_kr16", "--runs", "1", "--out", "figures.md"], "wrote"),
+    ("off_seam_speeds.py", ["--cells", "weld_seam_irb2400"], "cycle / default"),
 ]
 
 

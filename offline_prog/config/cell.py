@@ -240,6 +240,10 @@ class MotionConfig:
     cusp_smoothing_mm: float | None = None  # re-fit the flange path within this deviation
     clearance: float = 0.005  # m: robot and part vs obstacles, the tool and each other
     self_clearance: float = 0.005  # m: robot link vs robot link (pairs of class "check")
+    # m/s of the tool along the part on approach and retract (None: the seam's process
+    # speed; config.process_speed.approach_speed decides)
+    approach_speed: float | None = None
+    link_speed_percent: float = 100.0  # % of the joints' speed limits on links (PTP)
 
 
 @dataclasses.dataclass

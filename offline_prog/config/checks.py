@@ -95,6 +95,7 @@ def check_cell(file: Path, cell: Cell, robots_dir: Path) -> None:
     ):
         if not value > 0:
             raise _error(file, key, f"must be > 0, got {value}")
+    check_off_seam_speeds(file, motion)
     if motion.speed > MAX_SPEED_M_S:
         raise _error(
             file,
@@ -234,3 +235,22 @@ def _check_shapes(file: Path, cell: Cell) -> None:
                     f"{name!r} is not a shape of the "
                     f"cell (have: {', '.join(sorted(names)) or 'none'})",
                 )
+
+
+def check_off_seam_speeds(file: Path, motion) -> None:
+    """``motion.approach_speed`` within (0, MAX_SPEED_M_S] m/s (the controllers' path
+    speed limit: KUKA $VEL.CP, FANUC 2000 mm/sec) and ``motion.link_speed_percent``
+    within (0, 100] %."""
+    speed = motion.approach_speed
+    if speed is not None and not (np.isfinite(speed) and 0.0 < speed <= MAX_SPEED_M_S):
+        raise _error(
+            file,
+            "motion.approach_speed",
+            f"must be within (0, {MAX_SPEED_M_S:g}] m/s (the robot's path speed limit), "
+            f"got {speed:g}",
+        )
+    percent = motion.link_speed_percent
+    if not (np.isfinite(percent) and 0.0 < percent <= 100.0):
+        raise _error(
+            file, "motion.link_speed_percent", f"must be within (0, 100] %, got {percent:g}"
+        )

@@ -6,7 +6,9 @@ choice and nothing else does: the time law's cap and the process model's caps
 (``stages.motion_setup``), the speed band check (``job.speed_band``), the labels of an
 untimed option, the approach and retract, the report and the program writers read the
 :class:`ProcessSpeed` a seam's ``Inputs`` and ``Plan`` carry, and the session's active
-seam (``config.edits.CellValues.speed``) reads the same choice.
+seam (``config.edits.CellValues.speed``) reads the same choice. The approach and
+retract run at :func:`approach_speed` (``motion.approach_speed``, else the process
+speed).
 """
 
 from __future__ import annotations
@@ -50,3 +52,11 @@ def process_speed(cell: Cell, k: int) -> ProcessSpeed:
     """Seam k's process speed in ``cell`` (a ``path:`` cell has the one seam 0)."""
     seam_speeds = [seam.speed for seam in cell.seams] if cell.seams else [None]
     return chosen_speed(cell.motion.speed, seam_speeds, k)
+
+
+def approach_speed(cell: Cell, process: ProcessSpeed) -> ProcessSpeed:
+    """The speed a seam's approach and retract run at: ``motion.approach_speed``, else
+    the seam's process speed ``process`` (the default)."""
+    if cell.motion.approach_speed is None:
+        return process
+    return ProcessSpeed(float(cell.motion.approach_speed), "motion.approach_speed")

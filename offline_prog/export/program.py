@@ -112,6 +112,17 @@ class ProgramData:
     # The plan's robot (robot.record.robot_record); None: a plan made before plans
     # carried it, whose robot is looked up by name.
     robot_record: dict | None = None
+    # A seam's approach and retract speed [m/s] (config.process_speed.approach_speed;
+    # None: the job's rows, or a plan before motion.approach_speed: the process speed).
+    approach_speed_m_s: float | None = None
+    link_speed_percent: float = 100.0  # motion.link_speed_percent: the links' PTP override
+
+    @property
+    def off_seam_speed_m_s(self) -> float:
+        """The speed the seam's approach and retract run at [m/s]."""
+        if self.approach_speed_m_s is None:
+            return self.process_speed_m_s
+        return self.approach_speed_m_s
 
     def load_robot(self):
         """The plan's RobotModel, built from the robot record the plan carries (no

@@ -175,7 +175,7 @@ def _linear_move(job: JobProgramData, segment: JobSegment, number: int, k: int) 
     end = min(segment.stop, len(rows.t) - 1)  # the row where the segment ends
     X_PT = rows.X_PT
     length = float(np.linalg.norm(X_PT[end, :3, 3] - X_PT[segment.start, :3, 3]))
-    speed = float(job.seams[k].process_speed_m_s)
+    speed = float(job.seams[k].off_seam_speed_m_s)
     return LinearMove(segment.kind, segment.seam, number, X_PT[end], rows.q[end], length, speed)
 
 

@@ -10,7 +10,8 @@ with u = n (y of F, into the surface) for ``normal`` and u = ±t (x of F; − be
 start, + after the end) for ``tangent``. The flange follows from the paper's chain
 X_IE = X_IT · X_PT⁻¹ · X_PE: with R_IE constant, p_IE(δ) = p_IE(0) + δ·R_IP·u, R_IP =
 R_IE·R_PE⁻¹ (the part moves by δu in I while the tool stays put). The move is timed by
-the same sin² law as the seam (speed = the seam's speed) and solved by analytic IK on the
+the same sin² law as the seam (speed: ``config.process_speed.approach_speed``,
+``motion.approach_speed`` else the seam's process speed) and solved by analytic IK on the
 seam's branch, continuous with the seam's end configuration.
 """
 
@@ -21,6 +22,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.config.cell import ApproachConfig
+from offline_prog.config.process_speed import approach_speed
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.path_ik import base_poses, branch_results
 from offline_prog.robot.model import RobotModel
@@ -184,7 +186,7 @@ def seam_ends(
                 R_PE=R_PE,
                 q_seam=q_ends[i],
                 branch=branch,
-                speed=inputs.speed.v_m_s,
+                speed=approach_speed(inputs.cell, inputs.speed).v_m_s,
                 a_max=motion.max_acceleration,
                 j_max=motion.max_jerk,
                 rate_hz=motion.sample_rate_hz,

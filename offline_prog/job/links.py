@@ -88,8 +88,10 @@ def plan_link(
     rate_hz: float,
     name: str,
     checker: MotionChecker | None = None,
+    speed_share: float = 1.0,
 ) -> LinkMotion:
-    """The link move q_start → q_goal (6,) [rad], sampled at rate_hz [Hz]."""
+    """The link move q_start → q_goal (6,) [rad], sampled at rate_hz [Hz], at
+    ``speed_share`` of the joints' speed limits (``motion.link_speed_percent`` / 100)."""
     started = time.perf_counter()
     checker = checker or MotionChecker(scene, clearance=clearance, self_clearance=self_clearance)
     q_start, q_goal = (np.asarray(q, dtype=float) for q in (q_start, q_goal))
@@ -111,7 +113,7 @@ def plan_link(
         if waypoints is None:
             return failed(f"no collision-free path found within {time_budget_s:g} s (OMPL)")
         method = "planned"
-    t, q, qd = timed_polyline(robot, waypoints, rate_hz)
+    t, q, qd = timed_polyline(robot, waypoints, rate_hz, speed_share=speed_share)
     nearest = min(
         checker.min_distance(q_k) for q_k in q[:: max(1, len(q) // MIN_CLEARANCE_SAMPLES)]
     )
@@ -194,9 +196,13 @@ def _urdf_bounds(robot: RobotModel) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
-def timed_polyline(robot: RobotModel, waypoints: np.ndarray, rate_hz: float):
+def timed_polyline(
+    robot: RobotModel, waypoints: np.ndarray, rate_hz: float, *, speed_share: float = 1.0
+):
     """(t, q, qd): the waypoints (K, 6) joined by straight segments, each rest to rest,
-    sampled at rate_hz (see the module docstring: ruckig on s with the tightest limits)."""
+    sampled at rate_hz (see the module docstring: ruckig on s with the tightest limits),
+    the joints' speed limits scaled by ``speed_share`` ∈ (0, 1] (a PTP speed override
+    scales the axes' speed, as KUKA's ``BAS(#VEL_PTP, %)``)."""
     from ruckig import InputParameter, Result, Ruckig, Trajectory
 
     q_c = robot.controller_joints(waypoints)
@@ -209,7 +215,8 @@ def timed_polyline(robot: RobotModel, waypoints: np.ndarray, rate_hz: float):
         moving = delta > 1e-12
         otg, inp, profile = Ruckig(1), InputParameter(1), Trajectory(1)
         inp.current_position, inp.target_position = [0.0], [1.0]
-        inp.max_velocity = [float(np.min(robot.qd_max[moving] / delta[moving]))]
+        qd_max = speed_share * robot.qd_max[moving]
+        inp.max_velocity = [float(np.min(qd_max / delta[moving]))]
         inp.max_acceleration = [float(np.min(robot.qdd_max[moving] / delta[moving]))]
         inp.max_jerk = [float(np.min(jerk[moving] / delta[moving]))]
         result = otg.calculate(inp, profile)

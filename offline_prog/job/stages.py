@@ -198,10 +198,14 @@ def job_pieces(
             rate_hz=motion.sample_rate_hz,
             name=name,
             checker=checker,
+            speed_share=motion.link_speed_percent / 100.0,
         )
         if not link.ok:  # the direct move stands in: the check shows where it collides
             t, q, qd = timed_polyline(
-                inputs.robot, np.array([q_now, target]), motion.sample_rate_hz
+                inputs.robot,
+                np.array([q_now, target]),
+                motion.sample_rate_hz,
+                speed_share=motion.link_speed_percent / 100.0,
             )
             link = dataclasses.replace(link, t=t, q=q, qd=qd, waypoints=np.array([q_now, target]))
         links.append(link)

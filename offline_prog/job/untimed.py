@@ -170,7 +170,7 @@ def choose_order(
     return order_job(
         [(o.seam, o.label, o.q_in, o.q_out) for o in flat],
         q_home,
-        qd_max=robot.qd_max,
+        qd_max=robot.qd_max * inputs.cell.motion.link_speed_percent / 100.0,  # the links'
         qdd_max=robot.qdd_max,
         n_seams=len(options),
         mode=job_config(inputs.cell).order,

@@ -7,10 +7,13 @@ flow command leading by the dispenser's lag, for the tape the heater's power). W
 dispensed is gated by the process output: the bead's flow and the heater's power reach
 the part only while the digital output is on (where there is one), the torch's arc too.
 
-Only the process stretches count (the rows of each seam's ``process`` segment). On them
-a row is *dispensing* when the output is on and (bead, tape) its lagged flow or power is
-positive; elsewhere the quality column is NaN. The share within the band is weighted by
-path length (trapezoid weights from ``path_m``), over the dispensing length. A row
+The part gets material wherever the output is open: on a seam's ``process`` rows and
+on its approach and retract (a switch led by ``on.lead_mm`` before the seam's start, or
+off after its end). On these rows a row is *dispensing* when the output is on and
+(bead, tape) its lagged flow or power is positive; elsewhere (links, the output off) the
+quality column is NaN. The share within the band is weighted by the tool's path length
+(trapezoid weights from ``path_m``, continuous from the approach through the seam to the
+retract), over the dispensing length; ``process_length_m`` is the seam's alone. A row
 where the tool stands (v below ``constants.STANDSTILL_SPEED_M_S``) while dispensing is out of
 the band (the bead piles up, the weld overheats) and NaN in the column, unless the
 output follows the speed to rest (the heater: no power, nothing dispensed).
@@ -21,14 +24,15 @@ excess over the band) in this order:
 1. ``standstill``: v_i below the model's least defined speed;
 2. ``output saturated``: the output the target needs at v_i, offset + gain · v_i, lies
    outside the output's [min, max] (for the tape: the heater's full power);
-3. ``start ramp``: the seam starts from rest and i lies on its first rise: before the
+3. ``approach`` / ``retract``: i lies on the move onto or off the seam, gun open;
+4. ``start ramp``: the seam starts from rest and i lies on its first rise: before the
    speed first reaches RAMP_SHARE of the seam's top speed or first falls; ``end ramp``:
    the seam ends at rest and i lies on its last fall (after the speed last was at the
    top or last rose);
-4. ``lag`` (a bead with a lag): the speed changes where the lead cannot cancel the
+5. ``lag`` (a bead with a lag): the speed changes where the lead cannot cancel the
    dispenser's first-order lag (a slowdown, a corner);
-5. ``slowdown``: v_i below RAMP_SHARE of the seam's top speed (heat input, tape);
-6. ``process speed``: at the seam's top speed and still outside: the set speed itself
+6. ``slowdown``: v_i below RAMP_SHARE of the seam's top speed (heat input, tape);
+7. ``process speed``: at the seam's top speed and still outside: the set speed itself
    gives a quality off the band.
 
 For the bead the share is also computed with compensation off: the same flow without
@@ -163,12 +167,7 @@ def process_quality(
         events: the plan's I/O events (the flow's live windows, for compensation off).
     """
     t, v = np.asarray(t, float), np.asarray(v_tcp, float)
-    seam_of = np.full(len(t), -1)
-    names: list[str] = []
-    for segment in segments:
-        if segment.kind == "process":
-            seam_of[segment.start : segment.stop] = len(names)
-            names.append(segment.seam)
+    seam_of, process_of, names = _seam_rows(segments, len(t))
     gate = np.ones(len(t), bool) if digital is None else np.asarray(digital) > 0
     values, dispensing = _values(model, t, v, command, gate & (seam_of >= 0), settings)
     weights = _row_weights(np.nan_to_num(np.asarray(path_m, float)), seam_of)
@@ -181,19 +180,50 @@ def process_quality(
         off_inside = off_dispensing & (off_values >= low) & (off_values <= high)
         uncompensated = (off_inside, off_dispensing)
         off_shown = np.where(off_dispensing & np.isfinite(off_values), off_values, np.nan)
-    causes = _cause_rows(model, v, seam_of, len(names), settings)
+    causes = _cause_rows(model, v, process_of, len(names), settings)
+    causes = _with_moves(causes, segments, len(t))
     stretches = _stretches(
         values, dispensing & ~inside, model.band, seam_of, names, t, path_m, causes
     )
     shown = np.where(dispensing & np.isfinite(values), values, np.nan)
 
-    def summary(rows: np.ndarray, seam: str | None = None) -> QualitySummary:
+    def summary(rows: np.ndarray, process: np.ndarray, seam: str | None = None):
         s = _summary(values, rows, dispensing, inside, uncompensated, weights)
         listed = [x for x in stretches if seam is None or x.seam == seam]
-        return dataclasses.replace(s, stretches=listed)
+        return dataclasses.replace(
+            s, stretches=listed, process_length_m=float(weights[process].sum())
+        )
 
-    seams = {name: summary(seam_of == k, name) for k, name in enumerate(names)}
-    return ProcessQuality(model, shown, summary(seam_of >= 0), seams, off_shown)
+    seams = {name: summary(seam_of == k, process_of == k, name) for k, name in enumerate(names)}
+    return ProcessQuality(model, shown, summary(seam_of >= 0, process_of >= 0), seams, off_shown)
+
+
+def _seam_rows(segments, n: int) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(seam_of, process_of, names): per row the index of its seam among ``names`` (run
+    order) on its approach, process and retract rows (seam_of) and on its process rows
+    alone (process_of), −1 elsewhere (links)."""
+    seam_of, process_of = np.full(n, -1), np.full(n, -1)
+    names: list[str] = []
+    for segment in segments:
+        if segment.kind == "process":
+            process_of[segment.start : segment.stop] = len(names)
+            names.append(segment.seam)
+    for segment in segments:
+        if segment.kind in ("approach", "process", "retract"):
+            seam_of[segment.start : segment.stop] = names.index(segment.seam)
+    return seam_of, process_of, names
+
+
+def _with_moves(causes: dict, segments, n: int) -> dict[str, np.ndarray]:
+    """The causes with ``approach`` and ``retract`` (their rows) after the output's
+    (see the module)."""
+    moves = {kind: np.zeros(n, bool) for kind in ("approach", "retract")}
+    for segment in segments:
+        if segment.kind in moves:
+            moves[segment.kind][segment.start : segment.stop] = True
+    first = {key: causes[key] for key in ("standstill", "output saturated")}
+    rest = {key: mask for key, mask in causes.items() if key not in first}
+    return first | moves | rest
 
 
 def _values(model: ProcessModel, t, v, command, on, settings) -> tuple[np.ndarray, np.ndarray]:

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.config.cell import transform
+from offline_prog.config.process_speed import approach_speed
 from offline_prog.constants import TimeLaw
 from offline_prog.export.densify import dense_grid
 from offline_prog.export.job_program import JobProgramData, JobSegment
@@ -55,6 +56,7 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "language": robot.language,
         "payload": payload_record(cell, cell_file),
         "robot_record": robot_record(robot),
+        "link_speed_percent": cell.motion.link_speed_percent,
     }
 
 
@@ -67,7 +69,14 @@ def _header(plan: Plan | JobPlan, cell_file: Path, robot, summary: dict) -> dict
     speed = getattr(plan, "process_speed", None)
     return {
         **program_names(cell, cell_file, robot, summary),
-        **({} if speed is None else {"process_speed_m_s": speed.v_m_s}),
+        **(
+            {}
+            if speed is None
+            else {
+                "process_speed_m_s": speed.v_m_s,
+                "approach_speed_m_s": approach_speed(cell, speed).v_m_s,
+            }
+        ),
         "time_law": time_law_name(cell.motion),
         "feasible": plan.feasible,
         "failure": plan.failure,

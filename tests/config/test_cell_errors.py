@@ -150,6 +150,15 @@ CASES = [  # (replace, with, key in message, reason fragment)
         "[1000, 0, 150] mm is [1, 0, 0.15]",
     ),
     ("path:\n", "path:\n  analytic: {kind: spiral}\n", "path", "exactly one of"),
+    ("speed: 0.1", "speed: 0.1\n  approach_speed: -0.05", "motion.approach_speed", "(0, 2]"),
+    ("speed: 0.1", "speed: 0.1\n  approach_speed: 50", "motion.approach_speed", "path speed"),
+    ("speed: 0.1", "speed: 0.1\n  link_speed_percent: 0", "motion.link_speed_percent", "(0, 100]"),
+    (
+        "speed: 0.1",
+        "speed: 0.1\n  link_speed_percent: 150",
+        "motion.link_speed_percent",
+        "got 150",
+    ),
 ]
 
 

@@ -64,3 +64,31 @@ def test_speeds_beyond_the_controller_are_refused(plans, tmp_path):
     with pytest.raises(ValueError, match=r"m/s, not mm/s"):
         export(abb, "rapid", tmp_path / "rapid")
     assert not any(p.is_file() for p in tmp_path.rglob("*") if p.suffix in (".src", ".mod"))
+
+
+def off_seam(data: JobProgramData, *, approach_m_s: float, link_percent: float):
+    """The job as planned with motion.approach_speed and motion.link_speed_percent."""
+    seams = tuple(dataclasses.replace(s, approach_speed_m_s=approach_m_s) for s in data.seams)
+    job = dataclasses.replace(data.job, link_speed_percent=link_percent)
+    return dataclasses.replace(data, job=job, seams=seams)
+
+
+def test_the_approach_speed_and_the_link_override_are_written(plans, planned_job, tmp_path):
+    """Approach and retract LIN / MoveL at motion.approach_speed; KRL's PTP override
+    and URScript's movej speed at motion.link_speed_percent (issue 37)."""
+    kuka, abb = (off_seam(d, approach_m_s=0.05, link_percent=40.0) for d in plans)
+    krl = "".join(f.read_text() for f in export(kuka, "krl", tmp_path / "krl"))
+    assert "BAS(#VEL_PTP,40)" in krl
+    assert "$VEL.CP=0.0500" in krl
+    rapid = "".join(f.read_text() for f in export(abb, "rapid", tmp_path / "rapid"))
+    (approach,) = re.findall(r"MoveL pA1, (\w+),", rapid)
+    assert re.search(rf"speeddata {approach} := \[50,", rapid)
+    ur_full = JobProgramData.load(planned_job("tape_cylinder_ur10e")[1])
+    ur = off_seam(ur_full, approach_m_s=0.05, link_percent=40.0)
+
+    def movej_speeds(data, folder):
+        text = "".join(f.read_text() for f in export(data, "urscript", tmp_path / folder))
+        return [float(x) for x in re.findall(r"movej\(.*v=([\d.]+)\)", text)]
+
+    v, v_full = movej_speeds(ur, "ur"), movej_speeds(ur_full, "ur_full")
+    assert v and v[0] == pytest.approx(0.4 * v_full[0], abs=1e-3)

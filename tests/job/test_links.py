@@ -8,7 +8,7 @@ import pytest
 
 from offline_prog.collision.check import check_trajectory
 from offline_prog.collision.motion import MotionChecker
-from offline_prog.job.links import plan_link
+from offline_prog.job.links import plan_link, timed_polyline
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import build_scene, load_inputs
 
@@ -184,3 +184,18 @@ def test_goal_inside_an_obstacle_is_a_failure_naming_the_link(tmp_path, ends):
     assert not link.ok
     assert "link home -> blocked" in link.failure.reason
     assert "goal configuration" in link.failure.reason
+
+
+def test_a_link_at_half_speed_keeps_half_the_joint_speed_and_takes_longer(ends):
+    """motion.link_speed_percent scales the joints' speed limits of a link (a PTP
+    override): at 50 % no joint exceeds half its limit, and the link takes longer."""
+    inputs = load_inputs(CELLS / "seal_plate_kr16.yaml", ROBOTS_DIR)
+    robot = inputs.robot
+    q_a, q_b, _ = ends
+    full = timed_polyline(robot, np.array([q_a, q_b]), 250.0)
+    half = timed_polyline(robot, np.array([q_a, q_b]), 250.0, speed_share=0.5)
+    peak = np.abs(robot.controller_joints(half[2])).max(axis=0)
+    assert np.all(peak <= 0.5 * robot.qd_max * (1 + 1e-9))
+    # Axis 1 (the one that turns) reaches more than half its limit at full speed.
+    assert np.abs(robot.controller_joints(full[2])[:, 0]).max() > 0.6 * robot.qd_max[0]
+    assert half[0][-1] > full[0][-1] * 1.1  # 60° of axis 1: mostly ramps

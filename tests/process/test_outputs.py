@@ -1,5 +1,6 @@
 """The process quality in the plan folder: trajectory.csv's column (named after the
-model, in its unit, empty off the process), report.json's ``quality`` and report.html's
+model, in its unit, empty where the gun is closed: on links and where the output is off
+on the approach and retract), report.json's ``quality`` and report.html's
 plot with the band shaded, all saying the same as the plan."""
 
 import csv
@@ -28,17 +29,18 @@ def test_the_column_and_the_report_say_the_same(planned_job, name):
         rows = list(csv.DictReader(stream))
     values = np.array([float(r[column]) if r[column] else np.nan for r in rows])
     on_process = np.array([r["segment"].startswith("process:") for r in rows])
-    assert np.all(np.isnan(values[~on_process]))  # only where the process runs
+    on_seam = np.array([r["segment"] != "link" for r in rows])  # approach, seam, retract
+    assert np.all(np.isnan(values[~on_seam]))  # only where the gun can be open
     assert np.isfinite(values[on_process]).mean() > 0.99
     assert np.nanmin(values) == pytest.approx(report["min"], rel=1e-9)
     assert np.nanmax(values) == pytest.approx(report["max"], rel=1e-9)
     np.testing.assert_allclose(values, job.quality.column, rtol=1e-9)  # CSV: 10 digits
-    # Each stretch outside lies on the process rows, and its worst value is outside.
+    # Each stretch outside lies on a seam's moves, and its worst value is outside.
     low, high = report["band"]
     t = np.array([float(r["t"]) for r in rows])
     for stretch in report["stretches_outside"]:
         inside = (t >= stretch["t_start_s"]) & (t <= stretch["t_end_s"])
-        assert on_process[inside].all()
+        assert on_seam[inside].all()
         assert stretch["worst"] is None or not low <= stretch["worst"] <= high
     assert report["seams"]["seam"]["share_within_band"] == report["share_within_band"]
     assert 0.95 < report["share_within_band"] <= 1.0  # the demos' process models fit them
@@ -58,7 +60,11 @@ def test_report_page_plots_the_quality_with_its_band(planned_job):
     assert low < report["band"][0] and high > report["band"][1]
     assert f"{100 * report['share_within_band']:.1f} %" in page
     assert f"{100 * report['share_within_band_uncompensated']:.1f} %" in page
-    causes = re.findall(r"<td>(standstill|start ramp|end ramp|lag|slowdown)</td></tr>", page)
+    causes = re.findall(
+        r"<td>(standstill|output saturated|approach|retract|start ramp|end ramp|lag|slowdown"
+        r"|process speed)</td></tr>",
+        page,
+    )
     assert causes == [s["cause"] for s in report["stretches_outside"]]
     boxes = layout(folder / "report.html")
     panels = {p["id"]: p["panels"] for p in boxes["plots"]}

@@ -259,3 +259,37 @@ def test_two_seams_and_the_gun_switched_off_early():
     assert report["share_within_band"] == pytest.approx((lengths * shares).sum() / lengths.sum())
     (stretch,) = report["stretches_outside"]
     assert stretch["seam"] == "a" and stretch["cause"] == "slowdown"
+
+
+def test_the_part_gets_the_arc_on_the_approach_and_retract_where_it_is_on():
+    """A torch switched on 10 mm before the seam's start and off 10 mm after its end:
+    the gun-on rows of the approach and retract carry the predicted heat input and count
+    in the dispensed length, the seam's own length stays the process length, and the
+    rows where the gun is off (and links) stay NaN."""
+    model = process_model(WELD)
+    v = 0.008
+    t = np.arange(0.0, 15.0 + DT / 2, DT)  # 5 s approach, 5 s seam, 5 s retract
+    path = v * t - 0.04  # −40 mm .. 80 mm: the seam runs over [0, 40] mm
+    kinds = [("approach", 0, 5000), ("process", 5000, 10000), ("retract", 10000, len(t))]
+    segments = [Segment(k, "a", a, b, t[a], t[min(b, len(t) - 1)]) for k, a, b in kinds]
+    digital = ((path >= -0.01) & (path < 0.05)).astype(float)
+    result = process_quality(
+        model,
+        t=t,
+        v_tcp=np.full(len(t), v),
+        path_m=path,
+        segments=segments,
+        command=None,
+        digital=digital,
+        settings=None,
+        events=[],
+    )
+    expected = 0.6 * 12 * 120 / v  # J/m
+    on = digital > 0
+    np.testing.assert_allclose(result.values[on], expected, rtol=1e-9)
+    assert np.isnan(result.values[~on]).all()
+    assert np.isfinite(result.values[:5000]).sum() == on[:5000].sum() > 1200  # 10 mm
+    summary = result.seams["a"]
+    assert summary.dispensed_length_m == pytest.approx(0.06, abs=2 * v * DT)
+    assert summary.process_length_m == pytest.approx(0.04, abs=2 * v * DT)
+    assert summary.share_within_band == pytest.approx(1.0)

@@ -78,20 +78,29 @@ def plan_folder(capsys, tmp_path, text: str):
 
 
 def compare(job, folder, t, quality_prog):
-    """Rows of the seam where the plan's quality is defined and the tool moves (the
-    report's stretches name the standstills): the replay within 1 %; and the share."""
+    """Rows of the seam's moves (approach, seam, retract: wherever the gun may be open)
+    where the plan's quality is defined and the tool moves (the report's stretches name
+    the standstills): the replay within 1 %; and the share."""
     report = json.loads((folder / "report.json").read_text())["quality"]
     column = job.quality.column
-    process = next(g for g in job.samples.segments if g.kind == "process")
-    rows = slice(process.start, process.stop)
+    moves = [g for g in job.samples.segments if g.kind != "link"]
+    rows = slice(moves[0].start, moves[-1].stop)
     plan_t, plan_q = job.samples.t[rows], column[rows]
     keep = np.isfinite(plan_q)
     inside = (t > plan_t[keep][0]) & (t < plan_t[keep][-1])
     expected = np.interp(t[inside], plan_t[keep], plan_q[keep])
     top = job.tcp_speed[rows].max()  # the seam's (links move the part faster)
     moving = np.interp(t[inside], job.samples.t, job.tcp_speed) > 0.05 * top
-    assert moving.sum() > 0.9 * inside.sum()
-    np.testing.assert_allclose(quality_prog[inside][moving], expected[moving], rtol=REPLAY_TOL)
+    assert moving.sum() > 0.8 * inside.sum()  # the approach and retract start and stop
+    # Within 1 % of the value, or of the target where the gun's lag fills or drains the
+    # bead on the approach or retract (small values changing fast between samples).
+    model = process_model(job.cell.process)
+    np.testing.assert_allclose(
+        quality_prog[inside][moving],
+        expected[moving],
+        rtol=REPLAY_TOL,
+        atol=REPLAY_TOL * model.target * model.unit_scale,
+    )
     low, high = report["band"]
     v = np.interp(t[inside], job.samples.t, job.tcp_speed)
     w = v * np.gradient(t[inside])  # path length each command stands for

@@ -377,8 +377,13 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     np.testing.assert_allclose(bead[rows][near], plan[near], rtol=0.01)
     inside_plan = (plan >= low) & (plan <= high)
     inside_replay = (bead[rows] >= low) & (bead[rows] <= high)
-    w = np.gradient(s.path_m[rows])
-    share = (w * inside_replay).sum() / (w * np.isfinite(plan)).sum()
+    # The report's share counts wherever the gun is open: approach, seam and retract.
+    moves = [g for g in s.segments if g.kind != "link"]
+    every = np.arange(moves[0].start, moves[-1].stop)
+    plan_every = job.quality.column[every]
+    replay_every = (bead[every] >= low) & (bead[every] <= high)
+    w = np.gradient(s.path_m[every])
+    share = (w * replay_every).sum() / (w * np.isfinite(plan_every)).sum()
     report = json.loads((folder / "report.json").read_text())["quality"]
     assert report["model"] == "bead"
     assert share == pytest.approx(report["share_within_band"], abs=0.01)

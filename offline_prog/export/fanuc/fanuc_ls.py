@@ -252,7 +252,7 @@ class _Chain:
         except ValueError as error:  # the cell's switch positions: one line, exit 2
             raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
         configs = config_strings(post.robot, samples.q)
-        speed = job.seams[job.seam_names.index(seam)].process_speed_m_s  # approach, retract
+        speed = job.seams[job.seam_names.index(seam)].off_seam_speed_m_s  # approach, retract
         process = [m.end for m in motions if n_a < m.end <= n_p]
         speeds = dict(
             zip(

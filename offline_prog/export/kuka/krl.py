@@ -52,7 +52,9 @@ from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRe
 from offline_prog.export.text import krl_comment
 
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
-PTP_VEL_PERCENT, PTP_ACC_PERCENT = 100, 100  # links: the planned joint moves at full rate
+# Links: the planned joint moves at full acceleration; their speed override is the
+# plan's motion.link_speed_percent (ProgramData.link_speed_percent).
+PTP_ACC_PERCENT = 100
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
@@ -191,7 +193,7 @@ class KrlPost(CartesianPost):
             "$IPO_MODE=#TCP",
             "$ORI_TYPE=#VAR",
             "$ADVANCE=3",
-            f"BAS(#VEL_PTP,{PTP_VEL_PERCENT})",
+            f"BAS(#VEL_PTP,{rows.link_speed_percent:g})",
             f"BAS(#ACC_PTP,{PTP_ACC_PERCENT})",
             f"$VEL.ORI1={ori:.0f}",
             f"$VEL.ORI2={ori:.0f}",

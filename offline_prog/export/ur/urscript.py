@@ -62,7 +62,9 @@ class UrScriptPost(ControllerPost):
         super().__init__(job, options, forced=forced)
         if not options.period_s > 0:
             raise ValueError(f"period_s={options.period_s}: need a period > 0 s")
-        self.v_link = float(self.robot.qd_max.min())  # movej: the joints' common limits
+        # movej: the joints' common limits, at the plan's motion.link_speed_percent
+        share = self.job.job.link_speed_percent / 100.0
+        self.v_link = float(self.robot.qd_max.min()) * share
         self.a_link = float(self.robot.qdd_max.min())
         self.lines: list[str] = []
 

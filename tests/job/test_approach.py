@@ -1,0 +1,50 @@
+"""Approach and retract (job.approach) run at motion.approach_speed when the cell gives
+it, else at the seam's process speed; the programs' linear moves carry that speed."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from offline_prog.config.process_speed import approach_speed
+from offline_prog.job.approach import plan_ends
+from offline_prog.job.seams import job_seams, seam_inputs
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.stages import load_inputs
+
+from conftest import CELLS
+
+WELD = "weld_seam_irb2400"  # TIG at 8 mm/s, approach and retract 50 mm along the normal
+
+
+def _ends(planned_job, speed):
+    """(approach, retract) of the weld demo's seam with motion.approach_speed = speed."""
+    job, _ = planned_job(WELD)
+    inputs = load_inputs(CELLS / f"{WELD}.yaml", ROBOTS_DIR)
+    motion = dataclasses.replace(inputs.cell.motion, approach_speed=speed)
+    inputs = dataclasses.replace(inputs, cell=dataclasses.replace(inputs.cell, motion=motion))
+    option = job.chosen[0]
+    return plan_ends(seam_inputs(inputs, 0), option.plan, job_seams(inputs.cell)[0])
+
+
+@pytest.mark.parametrize("speed", [None, 0.05])
+def test_approach_and_retract_run_at_the_approach_speed(planned_job, speed):
+    """The tool's peak speed along the move is the approach speed (default: the process
+    speed, 8 mm/s); at 50 mm/s both moves take under 1.5 s instead of over 6 s."""
+    approach, retract = _ends(planned_job, speed)
+    expected = 0.008 if speed is None else speed
+    for move in (approach, retract):
+        v = np.abs(np.gradient(move.delta, move.t))
+        assert v.max() == pytest.approx(expected, rel=0.01)
+        assert np.linalg.norm(move.p_PT[-1] - move.p_PT[0]) == pytest.approx(0.05, abs=1e-9)
+    total = approach.duration + retract.duration
+    assert (total > 12.0) if speed is None else (total < 3.0)
+
+
+def test_the_choice_is_made_once():
+    inputs = load_inputs(CELLS / f"{WELD}.yaml", ROBOTS_DIR)
+    process = seam_inputs(inputs, 0).speed
+    assert approach_speed(inputs.cell, process) is process  # default: the process speed
+    motion = dataclasses.replace(inputs.cell.motion, approach_speed=0.05)
+    chosen = approach_speed(dataclasses.replace(inputs.cell, motion=motion), process)
+    assert (chosen.v_m_s, chosen.key) == (0.05, "motion.approach_speed")
