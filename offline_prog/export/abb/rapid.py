@@ -119,7 +119,11 @@ class RapidPost(CartesianPost):
             "tframe = tool in world; robot-held wobj: uframe = part in tool0; robtarget = tool "
             "on the part.",
             "Axes: URDF joints"
-            + (", axis 3 = q2 + q3 (J2/J3 linkage)" if self.robot.j23_coupled else "")
+            + (
+                f", axis 3 = q3 + {self.robot.j23_factor:g} x q2 (J2/J3 linkage)"
+                if self.robot.j23_coupled
+                else ""
+            )
             + ".",
             f"Links: MoveAbsJ to fine points ({LINK_SPEED}); approach, seams, retract: MoveL / "
             "TriggL at the planned speeds.",
@@ -163,7 +167,7 @@ class RapidPost(CartesianPost):
         n = move.number
         names = ["jHome"] if n == 0 else [f"jL{n}_{w}" for w in range(1, len(move.targets) + 1)]
         for name, q in zip(names, move.targets, strict=True):
-            axes = abb_axes_deg(q[None], j23_coupled=self.robot.j23_coupled)[0]
+            axes = abb_axes_deg(self.robot, q[None])[0]
             self.decls.append(
                 f"LOCAL CONST jointtarget {name} := [{_list(axes, DEG_DIGITS)},{EXTAX}];"
             )
