@@ -173,6 +173,13 @@ def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
         on, off = asked(folders.cells["krl"], data, k)
         assert switched[k][True] == pytest.approx(on, abs=IO_TOL_M)
         assert switched[k][False] == pytest.approx(off, abs=IO_TOL_M)
+    # The cell's frame numbers (tool.controller_frame 3, part.controller_frame 2).
+    cell = load_cell(folders.cells["krl"])
+    base, tool = cell.tool.controller_frame, cell.part.controller_frame
+    assert (base, tool) == (3, 2)
+    assert {f"$BASE=BASE_DATA[{base}]", f"$TOOL=TOOL_DATA[{tool}]"} <= {line for _, line in run}
+    frames = (folder / "offline_prog_frm.src").read_text()
+    assert f"BASE_DATA[{base}]={{" in frames and f"TOOL_DATA[{tool}]={{" in frames
     assert_krllint_clean(folder, tmp_path)
 
 

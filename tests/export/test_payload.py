@@ -73,11 +73,15 @@ def test_krl_load(plans, tmp_path):
 def test_rapid_loads(plans, tmp_path):
     data = with_payload(plans[1])
     text = program(data, "rapid", tmp_path)
-    assert re.search(r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", text)
+    frames = (tmp_path / "OfflineProgFrames.mod").read_text()  # the tool's tload: the gripper
+    assert re.search(
+        r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", frames
+    )
     assert "PERS loaddata partLoad := [2,[10,0,5],[1,0,0,0],0,0,0];" in text
     assert text.index("GripLoad partLoad;") < text.index("MoveAbsJ jHome")
     rapidchecker = pytest.importorskip("rapidchecker.cli")
     assert [str(e) for e in rapidchecker.check_file(text)] == []
+    assert [str(e) for e in rapidchecker.check_file(frames)] == []
 
 
 def test_urscript_payload(plans, tmp_path):

@@ -66,6 +66,7 @@ PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pg
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
 NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
 MODULE_NAME_MAX = NAME_MAX - 6  # the module's name (room for a suffix)
+FRAMES_SUFFIX = "Frames"  # <module>Frames.mod: the nominal PERS tooldata and wobjdata
 # The triggdata of each kind of event; a second one of a kind on the same move gets a
 # number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
 TRIGGERS = {
@@ -115,6 +116,11 @@ class RapidPost(CartesianPost):
         io, names = record.job.process_io, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            f"Frames: tool T = PERS tooldata {self.tool}, part P = PERS wobjdata {self.wobj} "
+            "(named after tool.name and part.name: RAPID names its frames, the cell's "
+            "controller_frame numbers are not used), as calibrated on the controller; their "
+            f"nominal values: {self.options.module}{FRAMES_SUFFIX}.mod (load it once, it is "
+            "not part of the .pgf).",
             "Units: mm, deg; quaternions [w,x,y,z]. World = robot base. Stationary tool: "
             "tframe = tool in world; robot-held wobj: uframe = part in tool0; robtarget = tool "
             "on the part.",
@@ -148,14 +154,9 @@ class RapidPost(CartesianPost):
         self.head = ["! " + rapid_comment(line) for line in lines]
 
     def frames(self) -> None:
-        """The stationary tool (its tload: the gripper), the robot-held work object, the
-        part's load (GripLoad) and the seams' zone."""
-        rows, load = self.job.job, payload(self.job.job.payload)
-        gripper = GRIPPER_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
-        self.decls += [
-            f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
-            f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
-        ]
+        """The part's load (GripLoad) and the seams' zone. The stationary tool and the
+        robot-held work object are the controller's PERS data (``_nominal_frames``)."""
+        load = payload(self.job.job.payload)
         if load is not None:
             self.decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
         zone = self.options.zone_mm
@@ -212,7 +213,25 @@ class RapidPost(CartesianPost):
         write_atomic(files[0], text)
         listing = f"<Program>\n  <Module>{files[0].name}</Module>\n</Program>\n"
         write_atomic(files[1], PGF_HEAD + listing)
-        return files
+        return files + [self._nominal_frames(out_dir)]
+
+    def _nominal_frames(self, folder: Path) -> Path:
+        """``<module>Frames.mod``: the PERS tooldata (the stationary tool T in the world
+        W = B; its tload the gripper's) and wobjdata (the part P: uframe in tool0 = E)
+        with the cell's nominal values, a module to load once (not in the .pgf): the
+        controller's calibration then updates them, and every program uses them."""
+        rows, load = self.job.job, payload(self.job.job.payload)
+        gripper = GRIPPER_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
+        name = f"{self.options.module}{FRAMES_SUFFIX}"
+        body = self.head + [
+            "! NOMINAL FRAMES of the cell (its CAD values): load this module once, then",
+            "! calibrate these data on the controller; the program only names them.",
+            f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
+            f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
+        ]
+        file = folder / f"{name}.mod"
+        write_atomic(file, _module_text(name, body, {}))
+        return file
 
     def _speed(self, v_mms: float) -> str:
         """The speeddata of v_tcp [mm/s] (``v<mm/s>_<tenth>``), declared at first use."""

@@ -1,15 +1,19 @@
 """KUKA KRL for KSS 8: a job as ``name.src`` / ``.dat`` plus one ``name_<k>`` module per
 seam, in the external-TCP style.
 
-Frames: ``$IPO_MODE=#TCP``, ``$BASE`` = the fixed tool T in ``$WORLD`` (KSS keeps a fixed
-tool as a base), ``$TOOL`` = the part P in ``$FLANGE`` (the robot-carried workpiece is the
-"tool"); each LIN point is a pose between P and T, written as ``tcp_pose_convention``
-says: "X_TP" (P in T, the default: flange = ``$BASE:POS:inv($TOOL)``, KSS's rule for
-every Cartesian position) or "X_PF" (T in P: flange = ``$BASE:inv(POS):inv($TOOL)``).
-The controller then moves the fixed TCP in straight lines across the part, which is
-what the point selection assumes (``export.points``, external_tcp). Besides I, B, E, P,
-F, T: K = KUKA's ``$FLANGE``, the URDF ``tool0`` (``kuka.X_KE``); B = ``base_link`` =
-``$ROBROOT``, taken as ``$WORLD``.
+Frames: ``$IPO_MODE=#TCP``, ``$BASE = BASE_DATA[tool.controller_frame]`` = the fixed
+tool T in ``$WORLD`` (KSS keeps a fixed tool as a base), ``$TOOL =
+TOOL_DATA[part.controller_frame]`` = the part P in ``$FLANGE`` (the robot-carried
+workpiece is the "tool"): the controller's calibrated frames by number
+(``export.frames``), so a calibration moves every program with it. Their nominal values
+(the cell's) are in ``<name>_frm.src`` only, a routine the technician may run once (it
+sets ``BASE_DATA``/``BASE_TYPE`` and ``TOOL_DATA``/``TOOL_TYPE``). Each LIN point is a
+pose between P and T, written as ``tcp_pose_convention`` says: "X_TP" (P in T, the
+default: flange = ``$BASE:POS:inv($TOOL)``, KSS's rule for every Cartesian position) or
+"X_PF" (T in P: flange = ``$BASE:inv(POS):inv($TOOL)``). The controller then moves the
+fixed TCP in straight lines across the part, which is what the point selection assumes
+(``export.points``, external_tcp). Besides I, B, E, P, F, T: K = KUKA's ``$FLANGE``, the
+URDF ``tool0`` (``kuka.X_KE``); B = ``base_link`` = ``$ROBROOT``, taken as ``$WORLD``.
 
 Main program: home (``PTP`` to an ``E6AXIS``), then per seam: the link (``PTP`` through
 its ``E6AXIS`` waypoints, fine points), the approach (``LIN`` to the seam's first
@@ -44,6 +48,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
+from offline_prog.export.frames import controller_frames
 from offline_prog.export.kuka.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
 from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
@@ -54,6 +59,7 @@ from offline_prog.export.text import krl_comment
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
 PTP_VEL_PERCENT, PTP_ACC_PERCENT = 100, 100  # links: the planned joint moves at full rate
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
+FRAMES_SUFFIX = "_frm"  # <name>_frm: the nominal frames (KRL names: ≤ 24 characters)
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
 
@@ -87,16 +93,21 @@ class KrlPost(CartesianPost):
         io = job.process_io
         self.flow = io is not None and io.analog_output is not None
         self.factor = f"{options.name.upper()}_FK"  # the flow's factor: live while $OUT is on
+        self.numbers = controller_frames(job.job)
 
     def point_rule(self) -> PointRule:
         return self.rule
 
     def conventions(self, record: ProgramRecord) -> list[str]:
         io, names = record.job.process_io, record.job.seam_names
+        base, tool = self.numbers.tool, self.numbers.part
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
-            "Style external_tcp: $BASE = fixed tool T in $WORLD (= base_link), $TOOL = part P "
-            "in $FLANGE, $IPO_MODE = #TCP; E6POS = "
+            self.numbers.note(f"BASE_DATA[{base}]", f"TOOL_DATA[{tool}]"),
+            f"Style external_tcp: $BASE = BASE_DATA[{base}] = fixed tool T in $WORLD (= "
+            f"base_link), $TOOL = TOOL_DATA[{tool}] = part P in $FLANGE, $IPO_MODE = #TCP, as "
+            f"calibrated on the controller; their nominal values: {self.options.name}"
+            f"{FRAMES_SUFFIX}.src (run once, or calibrate instead). E6POS = "
             + ("T in P (X_PF)" if self.rule.convention == "X_PF" else "P in T (X_TP)")
             + "; E6AXIS = q [deg].",
             "Links: PTP to E6AXIS fine points (the planned, collision-checked joint moves); "
@@ -186,8 +197,8 @@ class KrlPost(CartesianPost):
             "BAS(#INITMOV,0)",
             ";ENDFOLD (INI)",
             *_load(rows),
-            "$BASE=FIXED_TOOL",
-            "$TOOL=PART_ON_FLANGE",
+            f"$BASE=BASE_DATA[{self.numbers.tool}]",
+            f"$TOOL=TOOL_DATA[{self.numbers.part}]",
             "$IPO_MODE=#TCP",
             "$ORI_TYPE=#VAR",
             "$ADVANCE=3",
@@ -203,15 +214,32 @@ class KrlPost(CartesianPost):
         main_dat = [
             f"DEFDAT {name}" + (" PUBLIC" if self.flow else ""),
             "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
-            f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ rows.X_EP)}}}",
-            f"DECL FRAME FIXED_TOOL={{{krl_frame(rows.X_BT)}}}",
             *self.decl,
             "ENDDAT",
         ]
         files = _write(out_dir, name, self.head + main_src, self.head + main_dat)
         for module, process in self.modules:
             files += self._seam_module(out_dir, module, process)
-        return files
+        return files + self._nominal_frames(out_dir)
+
+    def _nominal_frames(self, folder: Path) -> list[Path]:
+        """``<name>_frm.src`` / ``.dat``: the cell's nominal frames written into the
+        numbered ``BASE_DATA`` (the fixed tool T in $WORLD = B, external TCP: BASE_TYPE
+        #TCP) and ``TOOL_DATA`` (the part P in $FLANGE, TOOL_TYPE #BASE), to run once."""
+        rows, module = self.job.job, f"{self.options.name}{FRAMES_SUFFIX}"
+        base, tool = self.numbers.tool, self.numbers.part
+        src = [
+            f"DEF {module}( )",
+            "; NOMINAL FRAMES of the cell (its CAD values): run once to load them into the",
+            "; controller, or calibrate these frames on the controller instead.",
+            f"BASE_DATA[{base}]={{{krl_frame(rows.X_BT)}}}",
+            f"BASE_TYPE[{base}]=#TCP",
+            f"TOOL_DATA[{tool}]={{{krl_frame(X_KE @ rows.X_EP)}}}",
+            f"TOOL_TYPE[{tool}]=#BASE",
+            "END",
+        ]
+        dat = [f"DEFDAT {module}", "ENDDAT"]
+        return _write(folder, module, self.head + src, self.head + dat)
 
     def _point(self, X_PT: np.ndarray) -> np.ndarray:
         """(…, 4, 4) the E6POS of the tool frame T in P: P in T (X_TP) or T in P."""
