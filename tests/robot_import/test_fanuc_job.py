@@ -128,11 +128,31 @@ def _run(folder, name="OFFLINE_PROG"):
     return out
 
 
+def nominal_frames(folder, robot, name="OFFLINE_PROG"):
+    """{"UFRAME": (number, X_BT), "UTOOL": (number, X_EP)} (4, 4) [m] as ``<name>_FRAMES``
+    sets them (``PR[r]=P[j]`` then ``UFRAME[i]=PR[r]``); the user frame turned from FANUC's
+    world (on axis 1 at axis 2's height: base_link raised by c1) into base_link."""
+    ls, held, frames = read_ls(folder / f"{name}_FRAMES.ls"), {}, {}
+    for statement in ls["mn"]:
+        if m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", statement):
+            held[m[1]] = pose(ls["pos"][int(m[2])]["xyzwpr"])
+        elif m := re.fullmatch(r"(UFRAME|UTOOL)\[(\d+)\]=PR\[(\d+)\]", statement):
+            frames[m[1]] = (int(m[2]), held[m[3]])
+    number, X_WT = frames["UFRAME"]
+    X_BW = np.eye(4)
+    X_BW[2, 3] = robot.params.c1
+    frames["UFRAME"] = (number, X_BW @ X_WT)
+    return frames
+
+
 def _walk(data, folder, robot):
     """Replays the program: per seam (in run order), the DB switches as (output, state,
     position [m]) and the L motions as (start, end [m], AO value), positions along the
-    tool's path on the part from the seam's start, from the program's own poses."""
-    X_PE, p_BT = np.linalg.inv(data.job.X_EP), data.job.X_BT[:3, 3]
+    tool's path on the part from the seam's start, from the program's own poses in the
+    frames the frames program sets."""
+    frames = nominal_frames(folder, robot)
+    (uf, X_BT), (ut, X_EP) = frames["UFRAME"], frames["UTOOL"]
+    X_PE, p_BT = np.linalg.inv(X_EP), X_BT[:3, 3]
     here, cumulative, ao, seams = None, 0.0, None, []
     starts = [seam.X_PT[0, :3, 3] for seam in data.seams]  # the seams' planned starts
     for statement, entry in _run(folder):
@@ -144,10 +164,11 @@ def _walk(data, folder, robot):
             q = robot.urdf_joints(np.radians(entry["joints"])[None])[0]
             X_BE = robot.forward(q[None])[0]
         else:
-            X_BE = pose(entry["xyzwpr"]) @ X_PE
+            assert (entry["uf"], entry["ut"]) == (uf, ut)
+            X_BE = X_BT @ pose(entry["xyzwpr"]) @ X_PE
             q = joints_from_config(robot, X_BE, entry["config"], entry["turns"])
             np.testing.assert_allclose(robot.forward(q[None])[0], X_BE, atol=1e-9)
-        X_BP = X_BE @ data.job.X_EP
+        X_BP = X_BE @ X_EP
         p_PT = X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])  # the fixed tool's point on the part
         if statement.startswith("J "):
             if seams and "open" in seams[-1]:
@@ -380,3 +401,80 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     assert report["model"] == "bead"
     assert share == pytest.approx(report["share_within_band"], abs=0.01)
     assert np.mean(inside_plan[check] == inside_replay[check]) > 0.99
+
+
+def _moved(X: np.ndarray, rng) -> np.ndarray:
+    """X (4, 4) moved by a calibration-sized error: up to 3 mm and 1.2 deg."""
+    from scipy.spatial.transform import Rotation
+
+    delta = np.eye(4)
+    delta[:3, :3] = Rotation.from_rotvec(rng.uniform(-1, 1, 3) * np.deg2rad(1.2)).as_matrix()
+    delta[:3, 3] = rng.uniform(-3e-3, 3e-3, 3)
+    return X @ delta
+
+
+def _with_frame(text: str, index: int, X: np.ndarray) -> str:
+    """The LS text with /POS entry P[index]'s X..R replaced by X (4, 4) [m]."""
+    from pydrake.math import RollPitchYaw, RotationMatrix
+
+    w, p, r = np.degrees(RollPitchYaw(RotationMatrix(X[:3, :3])).vector())
+    x, y, z = X[:3, 3] * 1e3
+    values = (
+        f"X = {x:.4f}  mm,\tY = {y:.4f}  mm,\tZ = {z:.4f}  mm,\n"
+        f"\tW = {w:.5f} deg,\tP = {p:.5f} deg,\tR = {r:.5f} deg"
+    )
+    return re.sub(
+        rf"(P\[{index}\]\{{.*?CONFIG : '[^']*',\n\t)X = .*? deg,\tP = .*? deg,\tR = \S+ deg",
+        lambda m: m[1] + values,
+        text,
+        flags=re.S,
+    )
+
+
+def _l_flange_poses(folder, robot) -> np.ndarray:
+    """(n, 4, 4) the faceplate at each L position: UFRAME · position · UTOOL⁻¹."""
+    frames = nominal_frames(folder, robot)
+    X_BT, X_EP = frames["UFRAME"][1], frames["UTOOL"][1]
+    entries = [e for s, e in _run(folder) if s.startswith("L ")]
+    return np.array([X_BT @ pose(e["xyzwpr"]) @ np.linalg.inv(X_EP) for e in entries])
+
+
+def test_fanuc_programs_select_the_cells_frames_and_follow_their_calibration(stripe, tmp_path):
+    """The stripe's cell numbers its frames (tool 3, part 2): every program selects
+    UFRAME_NUM=3 and UTOOL_NUM=2, its positions name them, no program but
+    OFFLINE_PROG_FRAMES sets a frame; editing the frames program (as a calibration
+    changes the frames) moves every L position with the frames and leaves the switch
+    positions along the part's path where they were."""
+    data, plan, robot = stripe
+    cell = load_cell(next(plan.parent.glob("*.yaml")))
+    uf, ut = cell.tool.controller_frame, cell.part.controller_frame
+    assert (uf, ut) == (3, 2)
+    files = write_fanuc_job(data, tmp_path)
+    assert files[-1].name == "OFFLINE_PROG_FRAMES.ls"
+    for file in files[:-1]:
+        ls = read_ls(file)
+        assert ls["mn"][:2] == [f"UFRAME_NUM={uf}", f"UTOOL_NUM={ut}"]
+        assert not any(re.match(r"(UFRAME|UTOOL|PR)\[", s) for s in ls["mn"])
+        assert all((e["uf"], e["ut"]) == (uf, ut) for e in ls["pos"].values())
+    frames = nominal_frames(tmp_path, robot)
+    assert (frames["UFRAME"][0], frames["UTOOL"][0]) == (uf, ut)
+    np.testing.assert_allclose(frames["UFRAME"][1], data.job.X_BT, atol=1e-5)
+    np.testing.assert_allclose(frames["UTOOL"][1], data.job.X_EP, atol=1e-5)
+    before, (seam,) = _l_flange_poses(tmp_path, robot), _walk(data, tmp_path, robot)
+    rng = np.random.default_rng(0)
+    X_WT_new = _moved(frames["UFRAME"][1], rng)
+    X_WT_new[2, 3] -= robot.params.c1  # into FANUC's world
+    X_EP_new = _moved(data.job.X_EP, rng)
+    file = tmp_path / "OFFLINE_PROG_FRAMES.ls"
+    file.write_text(_with_frame(_with_frame(file.read_text(), 1, X_WT_new), 2, X_EP_new))
+    edited = nominal_frames(tmp_path, robot)
+    np.testing.assert_allclose(edited["UTOOL"][1], X_EP_new, atol=1e-6)
+    X_BT_new = edited["UFRAME"][1]
+    after = _l_flange_poses(tmp_path, robot)
+    X_BT, X_EP = frames["UFRAME"][1], frames["UTOOL"][1]
+    expected = X_BT_new @ np.linalg.inv(X_BT) @ before @ X_EP @ np.linalg.inv(X_EP_new)
+    np.testing.assert_allclose(after, expected, atol=1e-6)
+    assert np.abs(after[:, :3, 3] - before[:, :3, 3]).max() > 1e-3  # it did move
+    (moved_seam,) = _walk(data, tmp_path, robot)
+    for (n, s, p), (n2, s2, p2) in zip(seam["db"], moved_seam["db"], strict=True):
+        assert (n, s) == (n2, s2) and p2 == pytest.approx(p, abs=1e-6)
