@@ -1,6 +1,8 @@
 """Universal Robots URScript: a job as one ``.script``.
 
-Plain URScript has no remote TCP, so the program runs the planned joints. Links:
+Plain URScript has no remote TCP, so the program runs the planned joints; it names no
+frame and holds no frame value (no TCP or feature of the installation moves a joint
+target: the header says to re-plan after a calibration). Links:
 ``movej`` through the link's joint waypoints (the planned, collision-checked straight
 joint moves; the controller's own timing at the joints' common limits). Each seam with
 its approach and retract: the planned joint trajectory resampled to the controller
@@ -71,6 +73,9 @@ class UrScriptPost(ControllerPost):
         lines = [
             "Units: m, rad, s. Joint order: " + ", ".join(rows.joint_names) + ".",
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            "Frames: none. This program streams joint positions, which no installation TCP "
+            "or feature moves: after calibrating the tool or the grasp, plan again with the "
+            "calibrated cell (offline-prog calibrate) and export again.",
             f"Links: movej through joint waypoints (a={self.a_link:.3f}, v={self.v_link:.3f}); "
             f"seams with approach and retract: servoj every {self.options.period_s} s "
             "(resampled from the plan).",
