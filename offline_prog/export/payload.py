@@ -2,9 +2,12 @@
 
 The record is the plan's (``scene.payload.payload_record``, stored in plan.npz): the
 gripper's mass and centre of mass in E, the part's in P, their inertias and the two as
-one load. A program states the load only when both masses are given; otherwise every
-program header and report.json say that the payload is not set, so that nobody runs
-the robot with a wrong load unknowingly. The programs write point masses (no inertia).
+one load. A program states the load only when both masses are given, and never a load
+the cell does not give: ``export`` of a controller program refuses a plan without them
+(one line: add the masses, or ``--no-payload``), and ``plan`` writes its programs
+without a load statement; then every program header and report.json say that the
+payload is not set and the controller's active load is used, so that nobody runs the
+robot with a wrong load unknowingly. The programs write point masses (no inertia).
 """
 
 from __future__ import annotations
@@ -45,20 +48,43 @@ def payload(record: dict | None) -> Payload | None:
     )
 
 
-def payload_note(record: dict | None, X_EP: np.ndarray) -> str:
-    """One header line: the payload written, or a warning naming the missing keys."""
+def missing_keys(record: dict | None) -> list[str]:
+    """The cell keys of the masses the record lacks, as the user writes them."""
+    return [
+        cell_key
+        for key, cell_key in (
+            ("gripper_mass_kg", "gripper.mass_kg"),
+            ("part_mass_kg", "part.mass_kg"),
+        )
+        if key not in (record or {})
+    ]
+
+
+def refusal(record: dict | None) -> str:
+    """Why export refuses a controller program of a plan without both masses, and the
+    way out ("" when the record has them)."""
+    if payload(record) is not None:
+        return ""
+    return (
+        f"the cell gives no {' / '.join(missing_keys(record))}: add the masses to the cell "
+        "and plan again, or export with --no-payload (no load statement; the controller's "
+        "active load is used)"
+    )
+
+
+def payload_note(record: dict | None, X_EP: np.ndarray, *, written: bool = True) -> str:
+    """One header line: the payload written, or a warning naming the missing keys;
+    ``written`` False: the user asked for no load statement (``--no-payload``)."""
     load = payload(record)
     if load is None:
-        missing = [  # the cell file's keys, as the user writes them
-            cell_key
-            for key, cell_key in (
-                ("gripper_mass_kg", "gripper.mass_kg"),
-                ("part_mass_kg", "part.mass_kg"),
-            )
-            if key not in (record or {})
-        ]
         return (
-            f"WARNING: PAYLOAD NOT SET (the cell gives no {' / '.join(missing)}): "
+            f"WARNING: PAYLOAD NOT SET (the cell gives no {' / '.join(missing_keys(record))}): "
+            "no load statement, the controller's active load is used: set the load of "
+            "gripper and part on the controller before running."
+        )
+    if not written:
+        return (
+            "Payload: not written (--no-payload): the controller's active load is used; "
             "set the load of gripper and part on the controller before running."
         )
     mass, p_EC = load.total(X_EP)

@@ -42,9 +42,14 @@ def plans(planned_job):
     return [JobProgramData.load(planned_job(name)[1]) for name in names]
 
 
-def program(data, fmt, folder) -> str:
+def program(data, fmt, folder, **options) -> str:
     """The main program's text (force: a test cell's plan may fail its link budget)."""
-    return export(data, fmt, folder, force=True)[0].read_text()
+    return export(data, fmt, folder, force=True, **options)[0].read_text()
+
+
+def unwrapped(text: str) -> str:
+    """A program's text with its comment lines joined (KRL wraps its header at 100)."""
+    return re.sub(r"\s*\n\s*[;!#]\s*", " ", text)
 
 
 def test_cell_keys(tmp_path):
@@ -98,15 +103,26 @@ def test_without_payload_every_header_and_the_report_warn(plans, planned_job, tm
     kuka, abb, ur = (  # no masses
         dataclasses.replace(data, job=dataclasses.replace(data.job, payload={})) for data in plans
     )
+    for data, fmt in ((kuka, "krl"), (abb, "rapid"), (ur, "urscript")):
+        # export refuses to invent a load: one line naming the keys and the way out
+        with pytest.raises(ValueError) as refused:
+            export(data, fmt, tmp_path / "refused", force=True)
+        assert "\n" not in str(refused.value) and "--no-payload" in str(refused.value)
+        assert "gripper.mass_kg / part.mass_kg" in str(refused.value)
+        assert not (tmp_path / "refused").exists() or not any((tmp_path / "refused").iterdir())
     texts = [
-        program(kuka, "krl", tmp_path / "k"),
-        program(abb, "rapid", tmp_path / "r"),
-        program(ur, "urscript", tmp_path / "u"),
+        program(kuka, "krl", tmp_path / "k", no_payload=True),
+        program(abb, "rapid", tmp_path / "r", no_payload=True),
+        program(ur, "urscript", tmp_path / "u", no_payload=True),
     ]
     for text in texts:
         assert "WARNING: PAYLOAD NOT SET" in text
-        assert "$LOAD={" not in text and "GripLoad partLoad" not in text
+        assert "the controller's active load is used" in unwrapped(text)
+        assert "$LOAD" not in text and "GripLoad" not in text and "loaddata" not in text
         assert "set_payload(" not in text
+    # No RAPID load anywhere but the frames module's tooldata, which says none is given.
+    frames = (tmp_path / "r" / "OfflineProgFrames.mod").read_text()
+    assert "[0.001,[0,0,0],[1,0,0,0],0,0,0]" in frames and "gives no gripper load" in frames
     without = payload_summary(load_cell(write_cell(tmp_path)), tmp_path / "cell.yaml")
     assert without["set"] is False and "PAYLOAD NOT SET" in without["warning"]
     # The demo cells give both masses: their programs and reports set the load.
@@ -152,3 +168,28 @@ def test_a_job_reports_and_prints_the_payload_warning(planned_job, tmp_path):
     out = io.StringIO()
     print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
     assert out.getvalue().count(f"payload   {report['payload']['warning']}") == 1  # once
+
+
+def test_no_payload_writes_no_load_even_when_the_cell_gives_one(plans, tmp_path):
+    """``--no-payload`` with masses in the cell: no load statement, and the header says
+    the controller's active load is used."""
+    for data, fmt in zip(plans, ("krl", "rapid", "urscript"), strict=True):
+        text = program(with_payload(data), fmt, tmp_path / fmt, no_payload=True)
+        note = "Payload: not written (--no-payload): the controller's active load is used"
+        assert note in unwrapped(text)
+        assert "$LOAD" not in text and "GripLoad" not in text and "set_payload(" not in text
+
+
+def test_cli_export_refuses_a_plan_without_masses_in_one_line(plans, tmp_path, capsys):
+    """``plan`` wrote the folder; ``export`` of its controller program without masses
+    is one line (exit 2) until ``--no-payload``."""
+    from offline_prog.cli import main
+
+    data = dataclasses.replace(plans[0], job=dataclasses.replace(plans[0].job, payload={}))
+    data.save(tmp_path / "plan")
+    argv = ["export", str(tmp_path / "plan"), "--format", "krl", "--out", str(tmp_path / "p")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--no-payload" in err[0] and "part.mass_kg" in err[0], err
+    assert main([*argv, "--no-payload"]) == 0
+    assert "WARNING: PAYLOAD NOT SET" in (tmp_path / "p" / "offline_prog.src").read_text()

@@ -46,7 +46,6 @@ from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.abb.abb import abb_axes_deg, confdata
-from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.program import ProgramData
@@ -58,9 +57,10 @@ LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the 
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
 MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
-# PLACEHOLDER gripper load (tload of a stationary tool) when the cell gives no payload:
-# 5 kg, 100 mm along tool0's z (the header warns: PAYLOAD NOT SET).
-GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
+# The tooldata's tload in the frames module when the program states no load: RAPID's
+# smallest (mass > 0), with a remark to set the gripper's load there; no program uses it
+# as a load statement.
+NO_LOAD = "[0.001,[0,0,0],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
@@ -93,8 +93,8 @@ class RapidPost(CartesianPost):
     NAME_OPTION = "module"
     NAME_MAX = MODULE_NAME_MAX
 
-    def __init__(self, job, options: RapidOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: RapidOptions, **flags):
+        super().__init__(job, options, **flags)
         if not options.zone_mm >= 0:
             raise ValueError(f"zone_mm={options.zone_mm}: need a zone >= 0 mm")
         rows = job.job
@@ -156,7 +156,7 @@ class RapidPost(CartesianPost):
     def frames(self) -> None:
         """The part's load (GripLoad) and the seams' zone. The stationary tool and the
         robot-held work object are the controller's PERS data (``_nominal_frames``)."""
-        load = payload(self.job.job.payload)
+        load = self.load
         if load is not None:
             self.decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
         zone = self.options.zone_mm
@@ -220,12 +220,17 @@ class RapidPost(CartesianPost):
         W = B; its tload the gripper's) and wobjdata (the part P: uframe in tool0 = E)
         with the cell's nominal values, a module to load once (not in the .pgf): the
         controller's calibration then updates them, and every program uses them."""
-        rows, load = self.job.job, payload(self.job.job.payload)
-        gripper = GRIPPER_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
+        rows, load = self.job.job, self.load
+        gripper = NO_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
         name = f"{self.options.module}{FRAMES_SUFFIX}"
         body = self.head + [
             "! NOMINAL FRAMES of the cell (its CAD values): load this module once, then",
             "! calibrate these data on the controller; the program only names them.",
+            *(
+                ["! tload: the cell gives no gripper load; set it here (0.001 kg: none given)."]
+                if load is None
+                else []
+            ),
             f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
             f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
         ]

@@ -66,7 +66,6 @@ from offline_prog.export.fanuc.fanuc_frames import (
 )
 from offline_prog.export.fanuc.fanuc_io import Samples, place_events
 from offline_prog.export.frames import ControllerFrames, controller_frames
-from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
@@ -123,8 +122,8 @@ class FanucPost(ControllerPost):
     Options = FanucOptions
     NAME_MAX = NAME_MAX - 8
 
-    def __init__(self, job, options: FanucOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: FanucOptions, **flags):
+        super().__init__(job, options, **flags)
         if options.line_limit < 8:
             raise ValueError(f"line_limit={options.line_limit}: need at least 8 lines per program")
         self.numbers = controller_frames(job.job)
@@ -156,7 +155,7 @@ class FanucPost(ControllerPost):
                 f"[m/s], in [{io.min:g}, {io.max:g}] while DO is on, {io.idle:g} otherwise; AO "
                 f"statements take effect as the next motion starts, {io.lag_s:g} s ahead."
             )
-        return lines + payload_conventions(rows)
+        return lines + payload_conventions(self.load, rows.X_EP)
 
     def header(self, lines: list[str]) -> None:
         self.head = lines
@@ -165,7 +164,8 @@ class FanucPost(ControllerPost):
     def frames(self) -> None:
         """UFRAME/UTOOL (in every program's head), the payload schedule, the flow idle."""
         io = self.job.process_io
-        self.main.lines.append("  PAYLOAD[1]")
+        if self.load is not None:
+            self.main.lines.append("  PAYLOAD[1]")
         if io is not None and io.analog_output is not None:  # idle until a seam's output
             self.main.lines.append(self.ao_statement(io.idle))
 
@@ -323,12 +323,11 @@ def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray) -> np.n
     return np.clip(np.round(speeds), 1, MAX_SPEED_MMS).astype(int)
 
 
-def payload_conventions(rows) -> list[str]:
-    """The PAYLOAD[1] header line, when the cell gives the masses."""
-    load = payload(rows.payload)
+def payload_conventions(load, X_EP: np.ndarray) -> list[str]:
+    """The PAYLOAD[1] header line of the program's load (None: no line)."""
     if load is None:
         return []
-    mass, p_EC = load.total(rows.X_EP)
+    mass, p_EC = load.total(X_EP)
     return [
         f"PAYLOAD[1]: {mass:.3f} kg at ({', '.join(f'{v * 100:.2f}' for v in p_EC)}) cm "
         "in the faceplate frame: set it in the payload schedule before running."

@@ -50,7 +50,6 @@ from scipy.spatial.transform import Rotation
 from offline_prog.atomic import write_atomic
 from offline_prog.export.frames import controller_frames
 from offline_prog.export.kuka.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
-from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
@@ -82,8 +81,8 @@ class KrlPost(CartesianPost):
     NAME_MAX = 20
     FLOW_WHERE_SET = True  # TRIGGERs set the flow's factor where the plan sets the flow
 
-    def __init__(self, job, options: KrlOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: KrlOptions, **flags):
+        super().__init__(job, options, **flags)
         self.rule = PointRule(
             "external_tcp", options.tcp_pose_convention, options.chord_tol_m, options.angle_tol_rad
         )
@@ -196,7 +195,7 @@ class KrlPost(CartesianPost):
             ";FOLD INI",
             "BAS(#INITMOV,0)",
             ";ENDFOLD (INI)",
-            *_load(rows),
+            *_load(self.load, rows.X_EP),
             f"$BASE=BASE_DATA[{self.numbers.tool}]",
             f"$TOOL=TOOL_DATA[{self.numbers.part}]",
             "$IPO_MODE=#TCP",
@@ -283,12 +282,12 @@ def _path(switch: Switch) -> str:
     return krl_num(-switch.before_end_m * 1e3, 3)
 
 
-def _load(rows) -> list[str]:
-    """``$LOAD`` (gripper + part on $FLANGE = E, point mass) when the cell gives both."""
-    load = payload(rows.payload)
+def _load(load, X_EP: np.ndarray) -> list[str]:
+    """``$LOAD`` (gripper + part on $FLANGE = E, point mass) of the program's load
+    (``export.payload.Payload`` or None: no statement, the header says why)."""
     if load is None:
-        return []  # the header warns: PAYLOAD NOT SET
-    mass, p_EC = load.total(rows.X_EP)
+        return []
+    mass, p_EC = load.total(X_EP)
     x, y, z = (krl_num(v, 1) for v in (X_KE[:3, :3] @ p_EC + X_KE[:3, 3]) * 1e3)
     return [
         f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A 0,B 0,C 0}},J {{X 0,Y 0,Z 0}}}}"

@@ -27,7 +27,6 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.payload import payload
 from offline_prog.export.post import ControllerPost
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
 from offline_prog.export.text import urscript_comment
@@ -60,8 +59,8 @@ class UrScriptPost(ControllerPost):
     NAME_MAX = 63
     OPW_ONLY = False
 
-    def __init__(self, job, options: UrScriptOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: UrScriptOptions, **flags):
+        super().__init__(job, options, **flags)
         if not options.period_s > 0:
             raise ValueError(f"period_s={options.period_s}: need a period > 0 s")
         self.v_link = float(self.robot.qd_max.min())  # movej: the joints' common limits
@@ -102,7 +101,7 @@ class UrScriptPost(ControllerPost):
         """The payload (gripper + part, centre of mass in the flange) when the cell
         gives it; the program moves the flange's joints, so it sets no TCP."""
         rows = self.job.job
-        if (load := payload(rows.payload)) is not None:
+        if (load := self.load) is not None:
             mass, p_EC = load.total(rows.X_EP)
             self.lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
 
