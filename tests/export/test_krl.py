@@ -8,6 +8,7 @@ import re
 
 import numpy as np
 import pytest
+from calibrated import moved
 from krl_lint import assert_krllint_clean
 from scipy.spatial.transform import Rotation
 
@@ -410,14 +411,6 @@ def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, co
         assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
     assert not lin
     assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
-
-
-def moved(X: np.ndarray, rng) -> np.ndarray:
-    """X (4, 4) moved by a calibration-sized error: up to 5 mm and 2 deg."""
-    delta = np.eye(4)
-    delta[:3, :3] = Rotation.from_rotvec(rng.uniform(-1, 1, 3) * np.deg2rad(1.2)).as_matrix()
-    delta[:3, 3] = rng.uniform(-3e-3, 3e-3, 3)
-    return X @ delta
 
 
 def test_programs_run_the_controllers_numbered_frames(data, tmp_path):

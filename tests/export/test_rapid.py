@@ -10,6 +10,7 @@ import re
 
 import numpy as np
 import pytest
+from calibrated import moved
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.spatial.transform import Rotation, Slerp
@@ -349,14 +350,6 @@ def test_a_calibration_of_the_pers_data_moves_the_whole_program(data, written, t
     distance, angle = pose_errors(X_WE, expected)
     assert distance.max() <= POSITION_TOL_MM and angle.max() <= ANGLE_TOL_DEG
     assert pose_errors(X_WE, seam.X_BE[indices])[0].max() > 1.0  # [mm]: it did move
-
-
-def moved(X: np.ndarray, rng) -> np.ndarray:
-    """X (4, 4) moved by a calibration-sized error: up to 3 mm and 1.2 deg."""
-    delta = np.eye(4)
-    delta[:3, :3] = Rotation.from_rotvec(rng.uniform(-1, 1, 3) * np.deg2rad(1.2)).as_matrix()
-    delta[:3, 3] = rng.uniform(-3e-3, 3e-3, 3)
-    return X @ delta
 
 
 def rapid_pose(X: np.ndarray) -> str:

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from calibrated import moved
 from fanuc_reader import joints_from_config, pose, read_ls
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -403,16 +404,6 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     assert np.mean(inside_plan[check] == inside_replay[check]) > 0.99
 
 
-def _moved(X: np.ndarray, rng) -> np.ndarray:
-    """X (4, 4) moved by a calibration-sized error: up to 3 mm and 1.2 deg."""
-    from scipy.spatial.transform import Rotation
-
-    delta = np.eye(4)
-    delta[:3, :3] = Rotation.from_rotvec(rng.uniform(-1, 1, 3) * np.deg2rad(1.2)).as_matrix()
-    delta[:3, 3] = rng.uniform(-3e-3, 3e-3, 3)
-    return X @ delta
-
-
 def _with_frame(text: str, index: int, X: np.ndarray) -> str:
     """The LS text with /POS entry P[index]'s X..R replaced by X (4, 4) [m]."""
     from pydrake.math import RollPitchYaw, RotationMatrix
@@ -462,9 +453,9 @@ def test_fanuc_programs_select_the_cells_frames_and_follow_their_calibration(str
     np.testing.assert_allclose(frames["UTOOL"][1], data.job.X_EP, atol=1e-5)
     before, (seam,) = _l_flange_poses(tmp_path, robot), _walk(data, tmp_path, robot)
     rng = np.random.default_rng(0)
-    X_WT_new = _moved(frames["UFRAME"][1], rng)
+    X_WT_new = moved(frames["UFRAME"][1], rng)
     X_WT_new[2, 3] -= robot.params.c1  # into FANUC's world
-    X_EP_new = _moved(data.job.X_EP, rng)
+    X_EP_new = moved(data.job.X_EP, rng)
     file = tmp_path / "OFFLINE_PROG_FRAMES.ls"
     file.write_text(_with_frame(_with_frame(file.read_text(), 1, X_WT_new), 2, X_EP_new))
     edited = nominal_frames(tmp_path, robot)
