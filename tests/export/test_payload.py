@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pytest
 from config.test_cell_errors import BASE, write_cell  # tests/config
+from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
@@ -67,7 +68,9 @@ def test_cell_keys(tmp_path):
 def test_krl_load(plans, tmp_path):
     data = with_payload(plans[0])
     text = program(data, "krl", tmp_path)
-    m = re.search(r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0,B 0,C 0\}", text, re.M)
+    m = re.search(
+        r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0\.0+,B 0\.0+,C 0\.0+\}", text, re.M
+    )
     mass, p_EC = expected_total(data)
     assert float(m.group(1)) == pytest.approx(mass)
     np.testing.assert_allclose([float(m.group(i)) for i in (2, 3, 4)], p_EC * 1e3, atol=0.06)
@@ -193,3 +196,64 @@ def test_cli_export_refuses_a_plan_without_masses_in_one_line(plans, tmp_path, c
     assert len(err) == 1 and "--no-payload" in err[0] and "part.mass_kg" in err[0], err
     assert main([*argv, "--no-payload"]) == 0
     assert "WARNING: PAYLOAD NOT SET" in (tmp_path / "p" / "offline_prog.src").read_text()
+
+
+def inertia_record(data) -> dict:
+    """RECORD with inertias about each centre of mass (gripper in E, part in P, seeded
+    random) and the total the plan would store (scene.payload.combined)."""
+    from pydrake.math import RigidTransform
+
+    from offline_prog.scene.payload import MassProperties, combined
+
+    rng = np.random.default_rng(3)
+
+    def inertia():
+        A = rng.uniform(-1, 1, (3, 3))
+        return A @ A.T * 0.01 + np.eye(3) * 0.005
+
+    record = dict(RECORD, gripper_inertia_E_kgm2=inertia().tolist())
+    record["part_inertia_P_kgm2"] = inertia().tolist()
+    bodies = [
+        MassProperties(
+            4.0,
+            np.array(RECORD["gripper_com_E_m"]),
+            np.array(record["gripper_inertia_E_kgm2"]),
+            "",
+            "",
+        ),
+        MassProperties(
+            2.0, np.array(RECORD["part_com_P_m"]), np.array(record["part_inertia_P_kgm2"]), "", ""
+        ),
+    ]
+    record["total"] = combined(*bodies, RigidTransform(data.job.X_EP))
+    return record
+
+
+def test_programs_carry_the_inertia_the_cell_gives(plans, tmp_path):
+    """KRL $LOAD's J about the axes CM's A, B, C name and RAPID's loaddata (ix, iy, iz
+    about aom) give back the inertia matrices of the record: the total on $FLANGE, the
+    gripper's (tload) in tool0 and the part's (GripLoad) in the object frame."""
+    kuka = plans[0]
+    record = inertia_record(kuka)
+    data = dataclasses.replace(kuka, job=dataclasses.replace(kuka.job, payload=record))
+    text = program(data, "krl", tmp_path / "k")
+    m = re.search(r"A (\S+),B (\S+),C (\S+)\},J \{X (\S+),Y (\S+),Z (\S+)\}\}", text)
+    R = Rotation.from_euler("ZYX", [float(m[i]) for i in (1, 2, 3)], degrees=True).as_matrix()
+    J = np.diag([float(m[i]) for i in (4, 5, 6)])
+    np.testing.assert_allclose(R @ J @ R.T, record["total"]["inertia_E_kgm2"], atol=2e-5)
+    abb = plans[1]
+    record = inertia_record(abb)
+    data = dataclasses.replace(abb, job=dataclasses.replace(abb.job, payload=record))
+    text = program(data, "rapid", tmp_path / "r")
+    frames = (tmp_path / "r" / "OfflineProgFrames.mod").read_text()
+    loads = {
+        "gripper_inertia_E_kgm2": re.search(
+            r"tooldata \w+ := \[FALSE,\[\[.*?\]\],(\[.*\])\];", frames
+        )[1],
+        "part_inertia_P_kgm2": re.search(r"partLoad := (\[.*\]);", text)[1],
+    }
+    for key, load in loads.items():
+        value = json.loads(load)
+        R = Rotation.from_quat(value[2], scalar_first=True).as_matrix()
+        inertia = R @ np.diag(value[3:6]) @ R.T
+        np.testing.assert_allclose(inertia, record[key], atol=2e-5)

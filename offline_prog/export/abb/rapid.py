@@ -46,6 +46,7 @@ from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.abb.abb import abb_axes_deg, confdata
+from offline_prog.export.payload import principal
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.program import ProgramData
@@ -158,7 +159,9 @@ class RapidPost(CartesianPost):
         robot-held work object are the controller's PERS data (``_nominal_frames``)."""
         load = self.load
         if load is not None:
-            self.decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
+            self.decls.append(
+                f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC, load.I_C_P)};"
+            )
         zone = self.options.zone_mm
         z = _list((zone,) * 3 + (zone / 10, zone, zone / 10), 5)[1:-1]
         self.decls.append(f"LOCAL CONST zonedata zPath := [FALSE,{z}];")
@@ -221,7 +224,7 @@ class RapidPost(CartesianPost):
         with the cell's nominal values, a module to load once (not in the .pgf): the
         controller's calibration then updates them, and every program uses them."""
         rows, load = self.job.job, self.load
-        gripper = NO_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
+        gripper = NO_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG, load.I_G_E)
         name = f"{self.options.module}{FRAMES_SUFFIX}"
         body = self.head + [
             "! NOMINAL FRAMES of the cell (its CAD values): load this module once, then",
@@ -308,10 +311,16 @@ def _pose(X: np.ndarray) -> str:
     return f"[{_list(X[:3, 3] * 1e3, MM_DIGITS)},{_list(q, QUAT_DIGITS)}]"
 
 
-def _load(mass_kg: float, p_m: np.ndarray) -> str:
-    """loaddata ``[mass, cog [mm], [1,0,0,0], 0, 0, 0]`` of a point mass (no inertia);
-    RAPID needs mass > 0, so 0 kg is written as 0.001 kg."""
-    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[1,0,0,0],0,0,0]"
+def _load(mass_kg: float, p_m: np.ndarray, inertia: np.ndarray) -> str:
+    """loaddata ``[mass, cog [mm], aom, ix, iy, iz]``: aom the principal axes of the
+    inertia (3, 3) [kg m²] about cog, ix..iz the moments about them [kg m²]; RAPID needs
+    mass > 0, so 0 kg is written as 0.001 kg."""
+    axes = principal(inertia)
+    X = np.eye(4)
+    X[:3, :3] = axes.R
+    aom = _pose(X).split("],[")[1].rstrip("]")
+    moments = ",".join(_num(v, 5) for v in axes.moments)
+    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[{aom}],{moments}]"
 
 
 def _robtarget(name: str, X: np.ndarray, conf: np.ndarray) -> str:

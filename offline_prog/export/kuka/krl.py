@@ -49,7 +49,15 @@ from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.frames import controller_frames
-from offline_prog.export.kuka.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
+from offline_prog.export.kuka.kuka import (
+    X_KE,
+    krl_frame,
+    krl_num,
+    kuka_abc_deg,
+    status_turn,
+    vel_cp,
+)
+from offline_prog.export.payload import Principal
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
@@ -289,8 +297,13 @@ def _load(load, X_EP: np.ndarray) -> list[str]:
         return []
     mass, p_EC = load.total(X_EP)
     x, y, z = (krl_num(v, 1) for v in (X_KE[:3, :3] @ p_EC + X_KE[:3, 3]) * 1e3)
+    # CM's A, B, C: the principal axes of inertia in $FLANGE; J: the moments about them.
+    inertia = load.total_inertia or Principal(np.zeros(3), np.eye(3))
+    a, b, c = (krl_num(v, 4) for v in kuka_abc_deg((X_KE[:3, :3] @ inertia.R)[None])[0])
+    jx, jy, jz = (krl_num(v, 5) for v in inertia.moments)
     return [
-        f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A 0,B 0,C 0}},J {{X 0,Y 0,Z 0}}}}"
+        f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A {a},B {b},C {c}}},"
+        f"J {{X {jx},Y {jy},Z {jz}}}}}"
     ]
 
 
