@@ -110,7 +110,8 @@ def _run_export(args, console: Console) -> None:
     data = JobProgramData.load(args.plan_dir)
     check_export(data, args.format, force=args.force)  # before the flags: the plan's words
     out = args.out or args.plan_dir / "programs"
-    files = export(data, args.format, out, force=args.force, **_export_options(args))
+    options = _export_options(args)
+    files = export(data, args.format, out, force=args.force, no_payload=args.no_payload, **options)
     for file in files:
         console.print(f"  {args.format:<9} {file}")
     console.print(f"exported {len(files)} file(s) from {args.plan_dir}")

@@ -146,6 +146,13 @@ def parser() -> argparse.ArgumentParser:
         "--force", action="store_true", help="export even if the plan failed (the header says so)"
     )
     export.add_argument(
+        "--no-payload",
+        action="store_true",
+        help="controller programs state no load: the controller's active load is used (the "
+        "header says so); without it a cell that gives no gripper.mass_kg / part.mass_kg is "
+        "refused",
+    )
+    export.add_argument(
         "--tcp-pose-convention",
         choices=["X_TP", "X_PF"],
         default=None,

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from offline_prog.atomic import read_manifest, remove_stale, temp_prefix, write_manifest
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.payload import refusal
 from offline_prog.export.post import ControllerPost, write_program
 
 # A controller's own language (only for a plan of that controller's robot): its writer,
@@ -81,33 +82,52 @@ def check_export(data: JobProgramData, fmt: str, *, force: bool = False) -> None
 
 
 def export(
-    data: JobProgramData, fmt: str, out_dir: Path, *, force: bool = False, **options
+    data: JobProgramData,
+    fmt: str,
+    out_dir: Path,
+    *,
+    force: bool = False,
+    no_payload: bool = False,
+    **options,
 ) -> list[Path]:
     """Write ``fmt`` for the plan into ``out_dir``; returns the files written.
 
+    Args:
+        no_payload: a controller program states no load (the controller's active load
+            is used, as its header says); without it a plan whose cell gives no masses
+            is refused.
+
     Raises:
         ExportRefusedError: the plan failed and force is False.
-        ValueError: unknown format or option, or an option value the writer refuses.
+        ValueError: unknown format or option, an option value the writer refuses, a
+            controller program of a plan without masses and no_payload False.
     """
     check_export(data, fmt, force=force)
     _check_options(fmt, options)
     if fmt in JOINT_FORMATS:
         write = _writer(JOINT_FORMATS[fmt])
         return replace_owned(Path(out_dir), fmt, lambda folder: write(data, folder))
-    post = controller_post(data, fmt, **options)  # its options checked before any file
+    if not no_payload and (why := refusal(data.job.payload)):
+        raise ValueError(f"{fmt}: {why}")
+    # its options checked before any file
+    post = controller_post(data, fmt, no_payload=no_payload, **options)
     return replace_owned(Path(out_dir), fmt, lambda folder: write_program(post, folder))
 
 
-def controller_post(data: JobProgramData, fmt: str, **options) -> ControllerPost:
+def controller_post(
+    data: JobProgramData, fmt: str, *, no_payload: bool = False, **options
+) -> ControllerPost:
     """The writer of controller format ``fmt`` for the plan, with its options (a failed
-    plan's header says so); ``write_program(post, folder)`` writes its files.
+    plan's header says so; ``no_payload``: it states no load); ``write_program(post,
+    folder)`` writes its files.
 
     Raises:
         ValueError: an option value the writer refuses, a robot it cannot write for.
     """
     _check_options(fmt, options)
     post_class = _writer(CONTROLLER_FORMATS[fmt])
-    return post_class(data, post_class.Options(**options), forced=not data.feasible)
+    options = post_class.Options(**options)
+    return post_class(data, options, forced=not data.feasible, no_payload=no_payload)
 
 
 def _check_options(fmt: str, options: dict) -> None:

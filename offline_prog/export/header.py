@@ -9,7 +9,9 @@ from offline_prog.export.payload import payload_note
 from offline_prog.export.program import ProgramData
 
 
-def header_lines(data: ProgramData, *, conventions: list[str], forced: bool = False) -> list[str]:
+def header_lines(
+    data: ProgramData, *, conventions: list[str], forced: bool = False, load_written: bool = True
+) -> list[str]:
     """Header text lines (without comment markers): cell, robot, tool, part, process
     speed, planned cycle time, units and conventions, and this file's generation time.
 
@@ -17,6 +19,7 @@ def header_lines(data: ProgramData, *, conventions: list[str], forced: bool = Fa
         data: the plan.
         conventions: lines that state the units and angle/frame conventions used.
         forced: the plan failed and the user exported it anyway (``--force``).
+        load_written: False: the program states no load (``--no-payload``).
     """
     now = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
     lines = [
@@ -29,5 +32,5 @@ def header_lines(data: ProgramData, *, conventions: list[str], forced: bool = Fa
     ]
     if forced or not data.feasible:
         lines.append(f"WARNING: EXPORTED WITH --force FROM A FAILED PLAN: {data.failure}")
-    lines.append(payload_note(data.payload, data.X_EP))
+    lines.append(payload_note(data.payload, data.X_EP, written=load_written))
     return lines + conventions

@@ -38,6 +38,7 @@ from typing import ClassVar
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
 from offline_prog.export.header import header_lines
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.record import (
     JointMove,
@@ -79,10 +80,16 @@ class ControllerPost(abc.ABC):
     OPW_ONLY: ClassVar[bool] = True
     FLOW_WHERE_SET: ClassVar[bool] = False
 
-    def __init__(self, job: JobProgramData, options, *, forced: bool = False):
-        """Raises ValueError: a program name that is no identifier, a robot the
+    def __init__(
+        self, job: JobProgramData, options, *, forced: bool = False, no_payload: bool = False
+    ):
+        """``no_payload``: state no load (the controller's active load is used).
+
+        Raises ValueError: a program name that is no identifier, a robot the
         controller's conventions do not cover."""
         self.job, self.options, self.forced = job, options, forced
+        # The load the program states: the cell's (export.payload), or None.
+        self.load = None if no_payload else payload(job.job.payload)
         identifier(
             getattr(options, self.NAME_OPTION), max_chars=self.NAME_MAX, what=self.NAME_OPTION
         )
@@ -163,7 +170,13 @@ def write_program(post: ControllerPost, out_dir: Path) -> list[Path]:
     order (see the module docstring); returns the files written."""
     job = post.job
     record = program_record(job, post.point_rule(), flow_where_set=post.FLOW_WHERE_SET)
-    post.header(header_lines(job.job, conventions=post.conventions(record), forced=post.forced))
+    lines = header_lines(
+        job.job,
+        conventions=post.conventions(record),
+        forced=post.forced,
+        load_written=post.load is not None or payload(job.job.payload) is None,
+    )
+    post.header(lines)
     post.frames()
     for step in record.steps:
         if isinstance(step, JointMove):

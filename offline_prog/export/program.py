@@ -102,6 +102,9 @@ class ProgramData:
     robots_dir: str = ""  # the folder the plan's robot folder was found in ("": search)
     language: str | None = None  # the controller's program format (robot.yaml)
     payload: dict | None = None  # export.payload.payload_record (None: plan before payloads)
+    # The controller's frame numbers from the cell: {"tool": n | None, "part": m | None}
+    # (export.frames; None: a plan made before programs referenced them).
+    controller_frames: dict | None = None
     # The process time law (motion.time_law, and motion.process for time_optimal).
     time_law: str = "sin2"
     path_dense_m: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0))

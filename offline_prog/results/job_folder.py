@@ -24,6 +24,7 @@ from offline_prog.atomic import staged_folder, write_atomic, write_manifest
 from offline_prog.collision.check import write_collisions_json
 from offline_prog.export.formats import PROGRAMS_DIR, default_formats, export
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.payload import payload
 from offline_prog.export.program import PLAN_FILE
 from offline_prog.job.records import JobPlan
 from offline_prog.results.job_report import job_report
@@ -91,11 +92,14 @@ def plan_files(done: FinishedJob, folder: Path) -> dict[str, Path]:
 
 
 def program_files(done: FinishedJob, folder: Path) -> dict[str, Path]:
-    """Every default format; none of a failed plan (``offline-prog export --force`` can)."""
+    """Every default format; none of a failed plan (``offline-prog export --force`` can).
+    A cell without masses: programs without a load statement, which their headers say
+    (the controller's active load is used; report.json and the summary warn)."""
     data, files = done.programs, {}
+    unset = payload(data.job.payload) is None
     if data.feasible:
         for fmt in default_formats(data.language):
-            for file in export(data, fmt, folder / PROGRAMS_DIR):
+            for file in export(data, fmt, folder / PROGRAMS_DIR, no_payload=unset):
                 files[f"{fmt}:{file.name}"] = file
     return files
 

@@ -55,6 +55,10 @@ def program_names(cell, cell_file: Path, robot, summary: dict) -> dict:
         "robots_dir": str(robot.urdf_path.parent.parent),
         "language": robot.language,
         "payload": payload_record(cell, cell_file),
+        "controller_frames": {
+            "tool": cell.tool.controller_frame,
+            "part": cell.part.controller_frame,
+        },
         "robot_record": robot_record(robot),
         "link_speed_percent": cell.motion.link_speed_percent,
     }

@@ -5,7 +5,10 @@ Summary: the verdict, the seam order (and the estimated saving against the given
 order), the cycle time split into process and air time, one row per seam and per link,
 and the process I/O switches. Plots (uPlot, inlined, as in the one-seam report): the
 TCP speed over the whole job with the process output and the flow value on the same
-time axis (the I/O timeline), and the joints against their limits.
+time axis (the I/O timeline), and the joints against their limits. Views (SVG, as in
+the one-seam report): the part with each seam's path and process frames and the
+gripper's outline in P, and the flange path of the whole job in the cell I, from
+plan.npz + job.npz.
 """
 
 from __future__ import annotations
@@ -17,12 +20,14 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import MANIFEST, write_atomic
+from offline_prog.export.job_program import JobProgramData
 from offline_prog.viz.report_html import _CSS, PROGRAMS_DIR, REPORT_FILE
-from offline_prog.viz.report_plots import PLOT_SCRIPT, plot_assets
+from offline_prog.viz.report_plots import PLOT_SCRIPT, plot_assets, views_svg
 from offline_prog.viz.report_summary import escape as _e
 
 JOINT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 MAX_PLOT_POINTS = 6000  # rows kept for the page's plots (every k-th row beyond)
+XYZ_ABG = ("x", "y", "z", "alpha", "beta", "gamma")  # the flange in I (trajectory.csv)
 QUALITY_SPAN = 3.0  # the quality plot's value axis: at most this many band widths beyond
 
 
@@ -320,6 +325,7 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
         "</figcaption></figure>"
         for p in data["plots"]
     )
+    figures += _views(plan_dir, report)
     css, script = plot_assets()
     title = f"Job report: {report.get('name') or folder_name}"
     return (
@@ -333,6 +339,23 @@ def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) ->
         f"reset.</p>{figures}"
         f'<script type="application/json" id="plot-data">{text}</script>'
         f"<script>{script}</script><script>{PLOT_SCRIPT}</script></body></html>\n"
+    )
+
+
+def _views(plan_dir: Path, report: dict) -> str:
+    """The four SVG views of the job (``report_plots.views_svg``): each seam's path in
+    P, the job's flange path in I, the gripper's outline in both."""
+    data = JobProgramData.load(plan_dir)
+    with open(plan_dir / "trajectory.csv", encoding="utf-8") as stream:
+        header, first = (next(csv.reader([stream.readline()])) for _ in range(2))
+    col = {name: np.array([float(first[header.index(name)])]) for name in XYZ_ABG}
+    seams = [(name, seam.X_PT) for name, seam in zip(data.seam_names, data.seams, strict=True)]
+    svg = views_svg(col, data.job, report.get("gripper"), seams=seams)
+    return (
+        f'<h2>Views</h2><figure><div class="views">{svg}</div><figcaption>The part with '
+        "each seam's path and its process frames F (x = t red, y = n green, z = b blue), and "
+        "the flange path of the whole job in the cell; the gripper's outline (blue-grey) on "
+        "the part and at the flange at t = 0.</figcaption></figure>"
     )
 
 

@@ -13,6 +13,7 @@ Frames: I inertial, B robot base, E flange, P part, F process frame, T fixed too
 
 from __future__ import annotations
 
+import html
 import json
 from pathlib import Path
 
@@ -244,26 +245,47 @@ def _triad_lines(X: np.ndarray, length: float, width: float) -> list:
     ]
 
 
-def views_svg(col: dict, data: ProgramData, gripper: list[dict] | None = None) -> str:
+def views_svg(
+    col: dict,
+    data: ProgramData,
+    gripper: list[dict] | None = None,
+    *,
+    seams: list[tuple[str, np.ndarray]] | None = None,
+) -> str:
     """Four SVG views: the part's path with process frames F in P (top, side), and
     the flange path with the part's path at t = 0, base B and tool T in I (top, side);
-    the gripper's outline (its shapes in E, report.json's ``gripper``) in both."""
-    X_PF = data.X_PT  # the tool frame T in P: the process frame F on the seams
-    p_PF = X_PF[:, :3, 3]
-    length = float(np.sum(np.linalg.norm(np.diff(p_PF, axis=0), axis=1)))
-    pick = np.linspace(0, len(p_PF) - 1, N_TRIADS).round().astype(int)
-    part = [(p_PF, "#000", 1.5), *_triad_lines(X_PF[pick], 0.7 * length / N_TRIADS, 1.0)]
-    part_labels = [(np.zeros(3), "P"), (p_PF[0], "start")]
+    the gripper's outline (its shapes in E, report.json's ``gripper``) in both.
+
+    Args:
+        col: trajectory.csv's columns by name; its first row's x, y, z, alpha, beta,
+            gamma (the flange in I) place the robot base.
+        data: the plan's rows (a seam's, or a whole job's: the flange path X_BE).
+        seams: (name, X_PF (N, 4, 4) in P) of each seam of a job, drawn and named on
+            the part; None: the rows' own X_PT, one seam.
+    """
+    seams = seams or [("start", data.X_PT)]  # the tool frame T in P: F on the seams
+    length = sum(
+        float(np.sum(np.linalg.norm(np.diff(X[:, :3, 3], axis=0), axis=1))) for _, X in seams
+    )
+    part, part_labels = [], [(np.zeros(3), "P")]
+    for k, (name, X_PF) in enumerate(seams):
+        color = "#000" if len(seams) == 1 else GROUP_COLORS[k % len(GROUP_COLORS)]
+        n = max(2, N_TRIADS // len(seams))
+        pick = np.linspace(0, len(X_PF) - 1, n).round().astype(int)
+        part += [(X_PF[:, :3, 3], color, 1.5)]
+        part += _triad_lines(X_PF[pick], 0.7 * length / N_TRIADS, 1.0)
+        part_labels.append((X_PF[0, :3, 3], html.escape(name)))
     # The cell in I from sample 0: X_IB from the CSV's X_IE and plan.npz's X_BE.
     angles = np.column_stack([col["alpha"][:1], col["beta"][:1], col["gamma"][:1]])
     X_IE0 = np.eye(4)
     X_IE0[:3, :3] = Rotation.from_euler("XYZ", angles).as_matrix()[0]
     X_IE0[:3, 3] = [col["x"][0], col["y"][0], col["z"][0]]
     X_IB = X_IE0 @ np.linalg.inv(data.X_BE[0])
-    p_IE = (X_IB @ np.c_[data.X_BE[:, :3, 3], np.ones(len(p_PF))].T).T[:, :3]
-    p_IF0 = (X_IE0 @ data.X_EP @ np.c_[p_PF, np.ones(len(p_PF))].T).T[:, :3]
+    p_IE = (X_IB @ np.c_[data.X_BE[:, :3, 3], np.ones(len(data.X_BE))].T).T[:, :3]
+    X_IP0 = X_IE0 @ data.X_EP
     X_IT = X_IB @ data.X_BT
-    cell = [(p_IE, XYZ_COLORS[0], 1.5), (p_IF0, "#888", 1.0)]
+    cell = [(p_IE, XYZ_COLORS[0], 1.5)]
+    cell += [(X[:, :3, 3] @ X_IP0[:3, :3].T + X_IP0[:3, 3], "#888", 1.0) for _, X in seams]
     size = 0.08 * float(
         np.ptp(np.vstack([p_IE, X_IB[None, :3, 3], X_IT[None, :3, 3]]), axis=0).max()
     )
@@ -271,11 +293,12 @@ def views_svg(col: dict, data: ProgramData, gripper: list[dict] | None = None) -
     cell_labels = [(X_IB[:3, 3], "B (robot base)"), (X_IT[:3, 3], "T (tool)")]
     for frame_pose, lines in ((np.linalg.inv(data.X_EP), part), (X_IE0, cell)):
         lines += [(p, GRIPPER_COLOR, 1.0) for p in outline_in(frame_pose, gripper or [])]
+    paths = "path" if len(seams) == 1 else "seams' paths"
     return "".join(
         [
-            _svg_view(part, part_labels, (0, 1), "Part P: path and frames F, top"),
+            _svg_view(part, part_labels, (0, 1), f"Part P: {paths} and frames F, top"),
             _svg_view(part, part_labels, (0, 2), "Part P: side"),
-            _svg_view(cell, cell_labels, (0, 1), "Cell I: flange path, part path at t=0, top"),
+            _svg_view(cell, cell_labels, (0, 1), f"Cell I: flange path, {paths} at t=0, top"),
             _svg_view(cell, cell_labels, (0, 2), "Cell I: side"),
         ]
     )

@@ -8,12 +8,13 @@ import re
 
 import numpy as np
 import pytest
+from calibrated import moved
 from krl_lint import assert_krllint_clean
 from scipy.spatial.transform import Rotation
 
 from offline_prog.export.formats import export
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.export.kuka.kuka import kuka_abc_deg, status_turn
+from offline_prog.export.kuka.kuka import krl_frame, kuka_abc_deg, status_turn
 from offline_prog.export.points import PointRule
 from offline_prog.export.record import program_record
 from offline_prog.robot.model import load_robot
@@ -85,6 +86,20 @@ def pose(fields):
     return X
 
 
+FRAME_DATA = re.compile(r"^((?:BASE|TOOL)_DATA\[\d+\])=\{(.*)\}$")
+
+
+def nominal_frames(folder, name="offline_prog"):
+    """{"BASE_DATA[n]": ("FRAME", fields), ...}: the frames ``<name>_frm.src`` loads
+    into the controller (the nominal values, the only file that holds them)."""
+    frames = {}
+    for line in (folder / f"{name}_frm.src").read_text().splitlines():
+        if m := FRAME_DATA.match(line):
+            items = (item.split(" ") for item in m.group(2).split(","))
+            frames[m.group(1)] = ("FRAME", {k: float(v) for k, v in items})
+    return frames
+
+
 def read_program(folder, name="offline_prog"):
     """Motions in execution order, following the calls of the seams' modules.
 
@@ -94,9 +109,10 @@ def read_program(folder, name="offline_prog"):
         (FRAME names resolved to their fields).
     """
     motions, settings = [], {}
+    frames = nominal_frames(folder, name)
 
     def run(module, vel):
-        decls = {}
+        decls = dict(frames)
         for line in (folder / f"{module}.dat").read_text().splitlines():
             if m := DECL.match(line):
                 items = (item.split(" ") for item in m.group(3).split(","))
@@ -314,6 +330,8 @@ def test_files_are_plain_krl(data, tmp_path):
         "offline_prog.dat",
         "offline_prog_1.src",
         "offline_prog_1.dat",
+        "offline_prog_frm.src",
+        "offline_prog_frm.dat",
     ]
     for file in files:
         raw = file.read_bytes()
@@ -393,3 +411,48 @@ def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, co
         assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
     assert not lin
     assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
+
+
+def test_programs_run_the_controllers_numbered_frames(data, tmp_path):
+    """The cell gives no numbers: BASE_DATA[1] and TOOL_DATA[1], and the header says
+    so; the nominal values are in offline_prog_frm.src only."""
+    files = export(data, "krl", tmp_path)
+    main = (tmp_path / "offline_prog.src").read_text()
+    assert {"$BASE=BASE_DATA[1]", "$TOOL=TOOL_DATA[1]"} <= set(main.splitlines())
+    assert "part.controller_frame not given in the cell: frame 1 by default" in main
+    frames = nominal_frames(tmp_path)
+    assert sorted(frames) == ["BASE_DATA[1]", "TOOL_DATA[1]"]
+    rows = data.job
+    np.testing.assert_allclose(pose(frames["BASE_DATA[1]"][1]), rows.X_BT, atol=1e-6)
+    np.testing.assert_allclose(pose(frames["TOOL_DATA[1]"][1]), rows.X_EP, atol=1e-6)
+    frm = (tmp_path / "offline_prog_frm.src").read_text()
+    assert "BASE_TYPE[1]=#TCP" in frm and "TOOL_TYPE[1]=#BASE" in frm
+    # No frame value in any motion program: no FRAME, no *_DATA assignment.
+    for file in files:
+        if not file.stem.endswith("_frm"):
+            text = file.read_text()
+            assert "FRAME" not in text and not re.search(r"(BASE|TOOL)_DATA\[\d+\]=\{", text)
+
+
+def test_a_calibration_of_the_frames_moves_the_whole_program(data, tmp_path):
+    """Export → edit the nominal frames (as a calibration changes BASE_DATA and
+    TOOL_DATA) → parse → reconstruct: every LIN target is where the new frames put
+    the unchanged tool-on-part pose, X_BE' = X_BT' · X_BT⁻¹ · X_BE · X_EP · X_EP'⁻¹."""
+    export(data, "krl", tmp_path)
+    seam, indices = record_points(data)
+    rng, rows = np.random.default_rng(0), data.job
+    X_BT, X_EP = moved(rows.X_BT, rng), moved(rows.X_EP, rng)
+    frm = tmp_path / "offline_prog_frm.src"
+    text = re.sub(
+        r"BASE_DATA\[1\]=\{[^}]*\}", f"BASE_DATA[1]={{{krl_frame(X_BT)}}}", frm.read_text()
+    )
+    text = re.sub(r"TOOL_DATA\[1\]=\{[^}]*\}", f"TOOL_DATA[1]={{{krl_frame(X_EP)}}}", text)
+    frm.write_text(text)
+    motions, settings = read_program(tmp_path)
+    X_BE = flange_poses(seam_lins(motions), settings)
+    expected = (
+        X_BT @ np.linalg.inv(rows.X_BT) @ seam.X_BE[indices] @ rows.X_EP @ np.linalg.inv(X_EP)
+    )
+    dp, da = pose_errors(X_BE, expected)
+    assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
+    assert pose_errors(X_BE, seam.X_BE[indices])[0] > 1e-3  # the program did move

@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pytest
 from config.test_cell_errors import BASE, write_cell  # tests/config
+from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import load_cell
 from offline_prog.config.checks import check_cell
@@ -42,9 +43,14 @@ def plans(planned_job):
     return [JobProgramData.load(planned_job(name)[1]) for name in names]
 
 
-def program(data, fmt, folder) -> str:
+def program(data, fmt, folder, **options) -> str:
     """The main program's text (force: a test cell's plan may fail its link budget)."""
-    return export(data, fmt, folder, force=True)[0].read_text()
+    return export(data, fmt, folder, force=True, **options)[0].read_text()
+
+
+def unwrapped(text: str) -> str:
+    """A program's text with its comment lines joined (KRL wraps its header at 100)."""
+    return re.sub(r"\s*\n\s*[;!#]\s*", " ", text)
 
 
 def test_cell_keys(tmp_path):
@@ -62,7 +68,9 @@ def test_cell_keys(tmp_path):
 def test_krl_load(plans, tmp_path):
     data = with_payload(plans[0])
     text = program(data, "krl", tmp_path)
-    m = re.search(r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0,B 0,C 0\}", text, re.M)
+    m = re.search(
+        r"^\$LOAD=\{M ([\d.]+),CM \{X (\S+),Y (\S+),Z (\S+),A 0\.0+,B 0\.0+,C 0\.0+\}", text, re.M
+    )
     mass, p_EC = expected_total(data)
     assert float(m.group(1)) == pytest.approx(mass)
     np.testing.assert_allclose([float(m.group(i)) for i in (2, 3, 4)], p_EC * 1e3, atol=0.06)
@@ -73,11 +81,15 @@ def test_krl_load(plans, tmp_path):
 def test_rapid_loads(plans, tmp_path):
     data = with_payload(plans[1])
     text = program(data, "rapid", tmp_path)
-    assert re.search(r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", text)
+    frames = (tmp_path / "OfflineProgFrames.mod").read_text()  # the tool's tload: the gripper
+    assert re.search(
+        r"PERS tooldata \w+ := \[FALSE,.*,\[4,\[0,0,80\],\[1,0,0,0\],0,0,0\]\];", frames
+    )
     assert "PERS loaddata partLoad := [2,[10,0,5],[1,0,0,0],0,0,0];" in text
     assert text.index("GripLoad partLoad;") < text.index("MoveAbsJ jHome")
     rapidchecker = pytest.importorskip("rapidchecker.cli")
     assert [str(e) for e in rapidchecker.check_file(text)] == []
+    assert [str(e) for e in rapidchecker.check_file(frames)] == []
 
 
 def test_urscript_payload(plans, tmp_path):
@@ -94,15 +106,26 @@ def test_without_payload_every_header_and_the_report_warn(plans, planned_job, tm
     kuka, abb, ur = (  # no masses
         dataclasses.replace(data, job=dataclasses.replace(data.job, payload={})) for data in plans
     )
+    for data, fmt in ((kuka, "krl"), (abb, "rapid"), (ur, "urscript")):
+        # export refuses to invent a load: one line naming the keys and the way out
+        with pytest.raises(ValueError) as refused:
+            export(data, fmt, tmp_path / "refused", force=True)
+        assert "\n" not in str(refused.value) and "--no-payload" in str(refused.value)
+        assert "gripper.mass_kg / part.mass_kg" in str(refused.value)
+        assert not (tmp_path / "refused").exists() or not any((tmp_path / "refused").iterdir())
     texts = [
-        program(kuka, "krl", tmp_path / "k"),
-        program(abb, "rapid", tmp_path / "r"),
-        program(ur, "urscript", tmp_path / "u"),
+        program(kuka, "krl", tmp_path / "k", no_payload=True),
+        program(abb, "rapid", tmp_path / "r", no_payload=True),
+        program(ur, "urscript", tmp_path / "u", no_payload=True),
     ]
     for text in texts:
         assert "WARNING: PAYLOAD NOT SET" in text
-        assert "$LOAD={" not in text and "GripLoad partLoad" not in text
+        assert "the controller's active load is used" in unwrapped(text)
+        assert "$LOAD" not in text and "GripLoad" not in text and "loaddata" not in text
         assert "set_payload(" not in text
+    # No RAPID load anywhere but the frames module's tooldata, which says none is given.
+    frames = (tmp_path / "r" / "OfflineProgFrames.mod").read_text()
+    assert "[0.001,[0,0,0],[1,0,0,0],0,0,0]" in frames and "gives no gripper load" in frames
     without = payload_summary(load_cell(write_cell(tmp_path)), tmp_path / "cell.yaml")
     assert without["set"] is False and "PAYLOAD NOT SET" in without["warning"]
     # The demo cells give both masses: their programs and reports set the load.
@@ -148,3 +171,89 @@ def test_a_job_reports_and_prints_the_payload_warning(planned_job, tmp_path):
     out = io.StringIO()
     print_job_summary(Console(file=out, width=400), report, {"report": folder / "x"}, 1.0)
     assert out.getvalue().count(f"payload   {report['payload']['warning']}") == 1  # once
+
+
+def test_no_payload_writes_no_load_even_when_the_cell_gives_one(plans, tmp_path):
+    """``--no-payload`` with masses in the cell: no load statement, and the header says
+    the controller's active load is used."""
+    for data, fmt in zip(plans, ("krl", "rapid", "urscript"), strict=True):
+        text = program(with_payload(data), fmt, tmp_path / fmt, no_payload=True)
+        note = "Payload: not written (--no-payload): the controller's active load is used"
+        assert note in unwrapped(text)
+        assert "$LOAD" not in text and "GripLoad" not in text and "set_payload(" not in text
+
+
+def test_cli_export_refuses_a_plan_without_masses_in_one_line(plans, tmp_path, capsys):
+    """``plan`` wrote the folder; ``export`` of its controller program without masses
+    is one line (exit 2) until ``--no-payload``."""
+    from offline_prog.cli import main
+
+    data = dataclasses.replace(plans[0], job=dataclasses.replace(plans[0].job, payload={}))
+    data.save(tmp_path / "plan")
+    argv = ["export", str(tmp_path / "plan"), "--format", "krl", "--out", str(tmp_path / "p")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--no-payload" in err[0] and "part.mass_kg" in err[0], err
+    assert main([*argv, "--no-payload"]) == 0
+    assert "WARNING: PAYLOAD NOT SET" in (tmp_path / "p" / "offline_prog.src").read_text()
+
+
+def inertia_record(data) -> dict:
+    """RECORD with inertias about each centre of mass (gripper in E, part in P, seeded
+    random) and the total the plan would store (scene.payload.combined)."""
+    from pydrake.math import RigidTransform
+
+    from offline_prog.scene.payload import MassProperties, combined
+
+    rng = np.random.default_rng(3)
+
+    def inertia():
+        A = rng.uniform(-1, 1, (3, 3))
+        return A @ A.T * 0.01 + np.eye(3) * 0.005
+
+    record = dict(RECORD, gripper_inertia_E_kgm2=inertia().tolist())
+    record["part_inertia_P_kgm2"] = inertia().tolist()
+    bodies = [
+        MassProperties(
+            4.0,
+            np.array(RECORD["gripper_com_E_m"]),
+            np.array(record["gripper_inertia_E_kgm2"]),
+            "",
+            "",
+        ),
+        MassProperties(
+            2.0, np.array(RECORD["part_com_P_m"]), np.array(record["part_inertia_P_kgm2"]), "", ""
+        ),
+    ]
+    record["total"] = combined(*bodies, RigidTransform(data.job.X_EP))
+    return record
+
+
+def test_programs_carry_the_inertia_the_cell_gives(plans, tmp_path):
+    """KRL $LOAD's J about the axes CM's A, B, C name and RAPID's loaddata (ix, iy, iz
+    about aom) give back the inertia matrices of the record: the total on $FLANGE, the
+    gripper's (tload) in tool0 and the part's (GripLoad) in the object frame."""
+    kuka = plans[0]
+    record = inertia_record(kuka)
+    data = dataclasses.replace(kuka, job=dataclasses.replace(kuka.job, payload=record))
+    text = program(data, "krl", tmp_path / "k")
+    m = re.search(r"A (\S+),B (\S+),C (\S+)\},J \{X (\S+),Y (\S+),Z (\S+)\}\}", text)
+    R = Rotation.from_euler("ZYX", [float(m[i]) for i in (1, 2, 3)], degrees=True).as_matrix()
+    J = np.diag([float(m[i]) for i in (4, 5, 6)])
+    np.testing.assert_allclose(R @ J @ R.T, record["total"]["inertia_E_kgm2"], atol=2e-5)
+    abb = plans[1]
+    record = inertia_record(abb)
+    data = dataclasses.replace(abb, job=dataclasses.replace(abb.job, payload=record))
+    text = program(data, "rapid", tmp_path / "r")
+    frames = (tmp_path / "r" / "OfflineProgFrames.mod").read_text()
+    loads = {
+        "gripper_inertia_E_kgm2": re.search(
+            r"tooldata \w+ := \[FALSE,\[\[.*?\]\],(\[.*\])\];", frames
+        )[1],
+        "part_inertia_P_kgm2": re.search(r"partLoad := (\[.*\]);", text)[1],
+    }
+    for key, load in loads.items():
+        value = json.loads(load)
+        R = Rotation.from_quat(value[2], scalar_first=True).as_matrix()
+        inertia = R @ np.diag(value[3:6]) @ R.T
+        np.testing.assert_allclose(inertia, record[key], atol=2e-5)

@@ -10,6 +10,7 @@ import re
 
 import numpy as np
 import pytest
+from calibrated import moved
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.spatial.transform import Rotation, Slerp
@@ -288,3 +289,70 @@ def test_output_passes_rapidchecker(written):
         assert [str(e) for e in rapidchecker.check_file(text)] == []
     broken = written[1].texts[0].replace("MoveL seam_1_1, ", "MoveL seam_1_1 ")
     assert rapidchecker.check_file(broken)  # the checker does catch errors
+
+
+def test_the_program_names_the_controllers_frames_and_holds_no_frame_value(data, written):
+    """The motion module uses the PERS tooldata / wobjdata named after the cell's tool
+    and part and declares neither; their nominal values are in OfflineProgFrames.mod
+    only, which the .pgf does not load."""
+    files, program = written
+    assert [f.name for f in files] == [
+        "OfflineProg.mod",
+        "OfflineProg.pgf",
+        "OfflineProgFrames.mod",
+    ]
+    motion, frames = (f.read_text() for f in (files[0], files[2]))
+    code = [line for line in motion.splitlines() if not line.strip().startswith("!")]
+    assert not [line for line in code if "tooldata" in line or "wobjdata" in line]
+    assert "OfflineProgFrames" not in files[1].read_text()
+    assert "PERS tooldata tool_welding_torch :=" in frames
+    assert "PERS wobjdata wobj_bracket :=" in frames
+    assert "! Frames: tool T = PERS tooldata tool_welding_torch" in motion  # the header
+    moves = program.moves
+    assert {m[4] for m in moves} == {"tool_welding_torch"} and {m[5] for m in moves} == {
+        "wobj_bracket"
+    }
+
+
+def test_a_calibration_of_the_pers_data_moves_the_whole_program(data, written, tmp_path):
+    """Export → edit tframe and uframe in the frames module (as a calibration does) →
+    parse → compose: X_WE' = tframe' · robtarget⁻¹ · uframe'⁻¹ is where the new frames
+    put the unchanged tool-on-part pose, X_BT' · X_BT⁻¹ · X_BE · X_EP · X_EP'⁻¹."""
+    files, _ = written
+    rng, rows = np.random.default_rng(0), data.job
+    X_BT, X_EP = (moved(X, rng) for X in (rows.X_BT, rows.X_EP))
+    edited = []
+    for file in files:
+        text = file.read_text()
+        if file.name == "OfflineProgFrames.mod":
+            text = re.sub(
+                r"(tool_welding_torch := \[FALSE,)\[\[[^\]]*\],\[[^\]]*\]\]",
+                lambda m: m[1] + rapid_pose(X_BT),
+                text,
+            )
+            text = re.sub(
+                r'(wobj_bracket := \[TRUE,TRUE,"",)\[\[[^\]]*\],\[[^\]]*\]\]',
+                lambda m: m[1] + rapid_pose(X_EP),
+                text,
+            )
+        edited.append(tmp_path / file.name)
+        edited[-1].write_text(text)
+    program = parse_rapid(edited)
+    X_WT = pose_matrix(program.data["tool_welding_torch"][1][1])
+    X_EU = pose_matrix(program.data["wobj_bracket"][1][3])
+    np.testing.assert_allclose(X_WT, X_BT, atol=1e-6)
+    X_OT = np.array([pose_matrix(program.data[m[1]][1][:2]) for m in seam_moves(program)])
+    X_WE = X_WT @ np.linalg.inv(X_OT) @ np.linalg.inv(X_EU)
+    seam, indices = record_points(data)
+    expected = (
+        X_BT @ np.linalg.inv(rows.X_BT) @ seam.X_BE[indices] @ rows.X_EP @ np.linalg.inv(X_EP)
+    )
+    distance, angle = pose_errors(X_WE, expected)
+    assert distance.max() <= POSITION_TOL_MM and angle.max() <= ANGLE_TOL_DEG
+    assert pose_errors(X_WE, seam.X_BE[indices])[0].max() > 1.0  # [mm]: it did move
+
+
+def rapid_pose(X: np.ndarray) -> str:
+    """``[[x,y,z],[q1,q2,q3,q4]]`` [mm] of X (4, 4) [m], by scipy (scalar first)."""
+    q = Rotation.from_matrix(X[:3, :3]).as_quat(scalar_first=True)
+    return f"[[{','.join(f'{v:.4f}' for v in X[:3, 3] * 1e3)}],[{','.join(f'{v:.9f}' for v in q)}]]"

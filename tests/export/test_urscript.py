@@ -155,3 +155,12 @@ def test_cli_export_refuses_flags_its_format_does_not_take(plan_dir, tmp_path):
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
     assert "--chord-tol-mm: not an option of --format urscript" in done.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_the_joint_stream_holds_no_frame_and_says_how_to_follow_a_calibration(data, tmp_path):
+    """No TCP, feature or pose in the program (its targets are joints); the header says
+    that a calibration needs a new plan."""
+    (file,) = export(data, "urscript", tmp_path, force=True)
+    code = [line for line in file.read_text().splitlines() if not line.startswith("#")]
+    assert not [line for line in code if re.search(r"set_tcp|p\[|pose_trans|get_.*feature", line)]
+    assert "# Frames: none. This program streams joint positions" in file.read_text()

@@ -98,11 +98,12 @@ def test_reexport_removes_its_own_stale_parts_only(kuka, planned_job, tmp_path):
     out.mkdir()
     (out / "offline_prog_9.src").write_text("a user's file, not in the manifest")
     four = export(JobProgramData.load(planned_job("seal_job_kr16")[1]), "krl", out)
-    assert len(four) == 10 and (out / "offline_prog_4.src").is_file()
+    assert len(four) == 12 and (out / "offline_prog_4.src").is_file()  # + the nominal frames
     data = JobProgramData.load(kuka[1])
     export(data, "csv", out)
     one = export(data, "krl", out)
     names = ["offline_prog.src", "offline_prog.dat", "offline_prog_1.src", "offline_prog_1.dat"]
+    names += ["offline_prog_frm.src", "offline_prog_frm.dat"]
     assert [p.name for p in one] == names
     assert sorted(p.name for p in out.iterdir()) == sorted(
         [*names, "joint_trajectory.csv", "offline_prog_9.src", MANIFEST]

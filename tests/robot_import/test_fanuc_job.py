@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from calibrated import moved
 from fanuc_reader import joints_from_config, pose, read_ls
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -130,11 +131,31 @@ def _run(folder, name="OFFLINE_PROG"):
     return out
 
 
+def nominal_frames(folder, robot, name="OFFLINE_PROG"):
+    """{"UFRAME": (number, X_BT), "UTOOL": (number, X_EP)} (4, 4) [m] as ``<name>_FRAMES``
+    sets them (``PR[r]=P[j]`` then ``UFRAME[i]=PR[r]``); the user frame turned from FANUC's
+    world (on axis 1 at axis 2's height: base_link raised by c1) into base_link."""
+    ls, held, frames = read_ls(folder / f"{name}_FRAMES.ls"), {}, {}
+    for statement in ls["mn"]:
+        if m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", statement):
+            held[m[1]] = pose(ls["pos"][int(m[2])]["xyzwpr"])
+        elif m := re.fullmatch(r"(UFRAME|UTOOL)\[(\d+)\]=PR\[(\d+)\]", statement):
+            frames[m[1]] = (int(m[2]), held[m[3]])
+    number, X_WT = frames["UFRAME"]
+    X_BW = np.eye(4)
+    X_BW[2, 3] = robot.params.c1
+    frames["UFRAME"] = (number, X_BW @ X_WT)
+    return frames
+
+
 def _walk(data, folder, robot):
     """Replays the program: per seam (in run order), the DB switches as (output, state,
     position [m]) and the L motions as (start, end [m], AO value), positions along the
-    tool's path on the part from the seam's start, from the program's own poses."""
-    X_PE, p_BT = np.linalg.inv(data.job.X_EP), data.job.X_BT[:3, 3]
+    tool's path on the part from the seam's start, from the program's own poses in the
+    frames the frames program sets."""
+    frames = nominal_frames(folder, robot)
+    (uf, X_BT), (ut, X_EP) = frames["UFRAME"], frames["UTOOL"]
+    X_PE, p_BT = np.linalg.inv(X_EP), X_BT[:3, 3]
     here, cumulative, ao, seams = None, 0.0, None, []
     starts = [seam.X_PT[0, :3, 3] for seam in data.seams]  # the seams' planned starts
     for statement, entry in _run(folder):
@@ -146,10 +167,11 @@ def _walk(data, folder, robot):
             q = robot.urdf_joints(np.radians(entry["joints"])[None])[0]
             X_BE = robot.forward(q[None])[0]
         else:
-            X_BE = pose(entry["xyzwpr"]) @ X_PE
+            assert (entry["uf"], entry["ut"]) == (uf, ut)
+            X_BE = X_BT @ pose(entry["xyzwpr"]) @ X_PE
             q = joints_from_config(robot, X_BE, entry["config"], entry["turns"])
             np.testing.assert_allclose(robot.forward(q[None])[0], X_BE, atol=1e-9)
-        X_BP = X_BE @ data.job.X_EP
+        X_BP = X_BE @ X_EP
         p_PT = X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])  # the fixed tool's point on the part
         if statement.startswith("J "):
             if seams and "open" in seams[-1]:
@@ -391,8 +413,8 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
 
 
 def _seam_motions(folder, name="OFFLINE_PROG"):
-    """Per seam program: its L motions in order as (statement, X_BP (4, 4), the lines
-    before and after it), read back from the LS text."""
+    """Per seam program: its L motions in order as (statement, X_TP (4, 4): the part in
+    the tool's user frame, the lines before and after it), read back from the LS text."""
     seams = []
     for file in sorted(folder.glob(f"{name}_S*.ls")):
         ls = read_ls(file)
@@ -417,18 +439,17 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
 
     data, _, _, _ = fanuc_job
     write_fanuc_job(data, tmp_path)
-    p_BT = data.job.X_BT[:3, 3]
     for k, (mn, motions) in enumerate(_seam_motions(tmp_path)):
         stated = re.search(r"deviation <= ([\d.]+)", " ".join(s.lstrip("! ") for s in mn))
         assert stated and float(stated[1]) * 1e-3 <= DEFAULT_CHORD_TOL_M
-        X_BP = np.array([X for _, X, _ in motions])
+        X_TP = np.array([X for _, X, _ in motions])
         curve = []
-        for a, b in zip(X_BP, X_BP[1:], strict=False):
+        for a, b in zip(X_TP, X_TP[1:], strict=False):
             length = np.linalg.norm(b[:3, 3] - a[:3, 3])
             lam = np.linspace(0.0, 1.0, max(2, int(length / 1e-5) + 2))
             R = Slerp([0, 1], Rotation.from_matrix([a[:3, :3], b[:3, :3]]))(lam).as_matrix()
             p = a[:3, 3] + lam[:, None] * (b[:3, 3] - a[:3, 3])
-            curve.append(np.einsum("gji,gj->gi", R, p_BT - p))  # the tool's point on P
+            curve.append(np.einsum("gji,gj->gi", R, -p))  # the tool's point (T's origin) on P
         planned = data.seams[k].X_PT_dense[:, :3, 3]
         gap, _ = cKDTree(np.concatenate(curve)).query(planned)
         assert gap.max() <= DEFAULT_CHORD_TOL_M + 1e-5, gap.max()  # + the curve's spacing
@@ -455,3 +476,70 @@ def test_fanuc_ao_in_counts_is_the_volts_times_the_cells_counts_per_volt(stripe,
     mn = read_ls(tmp_path / "counts" / "OFFLINE_PROG.ls")["mn"]
     head = " ".join(s.removeprefix("! ") for s in mn if s.startswith("!"))
     assert "in counts: 3276.7 counts per V" in head, head
+
+
+def _with_frame(text: str, index: int, X: np.ndarray) -> str:
+    """The LS text with /POS entry P[index]'s X..R replaced by X (4, 4) [m]."""
+    from pydrake.math import RollPitchYaw, RotationMatrix
+
+    w, p, r = np.degrees(RollPitchYaw(RotationMatrix(X[:3, :3])).vector())
+    x, y, z = X[:3, 3] * 1e3
+    values = (
+        f"X = {x:.4f}  mm,\tY = {y:.4f}  mm,\tZ = {z:.4f}  mm,\n"
+        f"\tW = {w:.5f} deg,\tP = {p:.5f} deg,\tR = {r:.5f} deg"
+    )
+    return re.sub(
+        rf"(P\[{index}\]\{{.*?CONFIG : '[^']*',\n\t)X = .*? deg,\tP = .*? deg,\tR = \S+ deg",
+        lambda m: m[1] + values,
+        text,
+        flags=re.S,
+    )
+
+
+def _l_flange_poses(folder, robot) -> np.ndarray:
+    """(n, 4, 4) the faceplate at each L position: UFRAME · position · UTOOL⁻¹."""
+    frames = nominal_frames(folder, robot)
+    X_BT, X_EP = frames["UFRAME"][1], frames["UTOOL"][1]
+    entries = [e for s, e in _run(folder) if s.startswith("L ")]
+    return np.array([X_BT @ pose(e["xyzwpr"]) @ np.linalg.inv(X_EP) for e in entries])
+
+
+def test_fanuc_programs_select_the_cells_frames_and_follow_their_calibration(stripe, tmp_path):
+    """The stripe's cell numbers its frames (tool 3, part 2): every program selects
+    UFRAME_NUM=3 and UTOOL_NUM=2, its positions name them, no program but
+    OFFLINE_PROG_FRAMES sets a frame; editing the frames program (as a calibration
+    changes the frames) moves every L position with the frames and leaves the switch
+    positions along the part's path where they were."""
+    data, plan, robot = stripe
+    cell = load_cell(next(plan.parent.glob("*.yaml")))
+    uf, ut = cell.tool.controller_frame, cell.part.controller_frame
+    assert (uf, ut) == (3, 2)
+    files = write_fanuc_job(data, tmp_path)
+    assert files[-1].name == "OFFLINE_PROG_FRAMES.ls"
+    for file in files[:-1]:
+        ls = read_ls(file)
+        assert ls["mn"][:2] == [f"UFRAME_NUM={uf}", f"UTOOL_NUM={ut}"]
+        assert not any(re.match(r"(UFRAME|UTOOL|PR)\[", s) for s in ls["mn"])
+        assert all((e["uf"], e["ut"]) == (uf, ut) for e in ls["pos"].values())
+    frames = nominal_frames(tmp_path, robot)
+    assert (frames["UFRAME"][0], frames["UTOOL"][0]) == (uf, ut)
+    np.testing.assert_allclose(frames["UFRAME"][1], data.job.X_BT, atol=1e-5)
+    np.testing.assert_allclose(frames["UTOOL"][1], data.job.X_EP, atol=1e-5)
+    before, (seam,) = _l_flange_poses(tmp_path, robot), _walk(data, tmp_path, robot)
+    rng = np.random.default_rng(0)
+    X_WT_new = moved(frames["UFRAME"][1], rng)
+    X_WT_new[2, 3] -= robot.params.c1  # into FANUC's world
+    X_EP_new = moved(data.job.X_EP, rng)
+    file = tmp_path / "OFFLINE_PROG_FRAMES.ls"
+    file.write_text(_with_frame(_with_frame(file.read_text(), 1, X_WT_new), 2, X_EP_new))
+    edited = nominal_frames(tmp_path, robot)
+    np.testing.assert_allclose(edited["UTOOL"][1], X_EP_new, atol=1e-6)
+    X_BT_new = edited["UFRAME"][1]
+    after = _l_flange_poses(tmp_path, robot)
+    X_BT, X_EP = frames["UFRAME"][1], frames["UTOOL"][1]
+    expected = X_BT_new @ np.linalg.inv(X_BT) @ before @ X_EP @ np.linalg.inv(X_EP_new)
+    np.testing.assert_allclose(after, expected, atol=1e-6)
+    assert np.abs(after[:, :3, 3] - before[:, :3, 3]).max() > 1e-3  # it did move
+    (moved_seam,) = _walk(data, tmp_path, robot)
+    for (n, s, p), (n2, s2, p2) in zip(seam["db"], moved_seam["db"], strict=True):
+        assert (n, s) == (n2, s2) and p2 == pytest.approx(p, abs=1e-6)

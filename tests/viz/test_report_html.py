@@ -326,3 +326,18 @@ def test_the_views_draw_the_gripper(planned_folder):
     p_PC = X_PE[:3, :3] @ [0.035, 0.04, 0.08] + X_PE[:3, 3]
     assert p_P[:, 2].min() == pytest.approx(0.005)
     assert np.linalg.norm(p_P[:, :2] - p_PC[:2], axis=1).max() == pytest.approx(0.02)
+
+
+def test_a_jobs_views_draw_every_seam_on_the_part(planned_job):
+    """A job of four seams: the part's two views name each seam (at its start), and
+    the cell's views draw the flange path of the whole job."""
+    job, folder = planned_job("seal_job_kr16")
+    page = (folder / REPORT_FILE).read_text()
+    views = re.findall(r"<svg class=\"view\".*?</svg>", page, re.S)
+    assert len(views) == 4 and "Part P: seams' paths and frames F, top" in views[0]
+    names = [o.name for o in job.chosen]
+    for view in views[:2]:
+        assert sorted(re.findall(r"<text x=\"[\d.]+\" y=\"[\d.]+\">(\w+)</text>", view)) == sorted(
+            ["P", *names]
+        )
+    assert "Cell I: flange path, seams' paths at t=0, top" in views[2]

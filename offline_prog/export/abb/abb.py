@@ -7,12 +7,11 @@ import numpy as np
 from offline_prog.robot.model import RobotModel
 
 
-def abb_axes_deg(q: np.ndarray, *, j23_coupled: bool) -> np.ndarray:
-    """Controller axis values (N, 6) [deg] from URDF joint positions q (N, 6) [rad]."""
-    axes = np.rad2deg(np.asarray(q, dtype=float))
-    if j23_coupled:
-        axes[:, 2] += axes[:, 1]
-    return axes
+def abb_axes_deg(robot: RobotModel, q: np.ndarray) -> np.ndarray:
+    """Controller axis values (N, 6) [deg] from URDF joint positions q (N, 6) [rad]:
+    axis 3 = q3 + j23_factor · q2 on a robot whose controller couples them (the robot
+    record's ``controller.j23_factor``, ``RobotModel.controller_joints``)."""
+    return np.rad2deg(robot.controller_joints(np.asarray(q, dtype=float)))
 
 
 def confdata(robot: RobotModel, q: np.ndarray) -> np.ndarray:

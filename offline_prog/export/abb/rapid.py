@@ -46,7 +46,7 @@ from pydrake.math import RotationMatrix
 
 from offline_prog.atomic import write_atomic
 from offline_prog.export.abb.abb import abb_axes_deg, confdata
-from offline_prog.export.payload import payload
+from offline_prog.export.payload import principal
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.program import ProgramData
@@ -58,14 +58,16 @@ LINK_SPEED = "v1000"  # predefined speeddata of the MoveAbsJ links (timing: the 
 SPEED_REST = "500,5000,1000"  # v_ori [deg/s], v_leax [mm/s], v_reax [deg/s], as v5..v1000
 MIN_SPEED_MMS = 0.1  # smallest v_tcp written
 MAX_SPEED_MMS = 7000.0  # largest v_tcp of RAPID's predefined speeddata (v7000)
-# PLACEHOLDER gripper load (tload of a stationary tool) when the cell gives no payload:
-# 5 kg, 100 mm along tool0's z (the header warns: PAYLOAD NOT SET).
-GRIPPER_LOAD = "[5,[0,0,100],[1,0,0,0],0,0,0]"
+# The tooldata's tload in the frames module when the program states no load: RAPID's
+# smallest (mass > 0), with a remark to set the gripper's load there; no program uses it
+# as a load statement.
+NO_LOAD = "[0.001,[0,0,0],[1,0,0,0],0,0,0]"
 EXTAX = "[9E9,9E9,9E9,9E9,9E9,9E9]"  # external axes: none
 PGF_HEAD = '<?xml version="1.0" encoding="ISO-8859-1" ?>\n'  # program file (.pgf)
 MM_DIGITS, QUAT_DIGITS, DEG_DIGITS = 3, 7, 4  # 0.5 µm, ~1e-5 deg, 5e-5 deg
 NAME_MAX = 32  # RAPID identifiers: letter first, letters / digits / _, ≤ 32 characters
 MODULE_NAME_MAX = NAME_MAX - 6  # the module's name (room for a suffix)
+FRAMES_SUFFIX = "Frames"  # <module>Frames.mod: the nominal PERS tooldata and wobjdata
 # The triggdata of each kind of event; a second one of a kind on the same move gets a
 # number (tOn2): a TriggL holds up to 8 triggers, each its own triggdata.
 TRIGGERS = {
@@ -92,8 +94,8 @@ class RapidPost(CartesianPost):
     NAME_OPTION = "module"
     NAME_MAX = MODULE_NAME_MAX
 
-    def __init__(self, job, options: RapidOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: RapidOptions, **flags):
+        super().__init__(job, options, **flags)
         if not options.zone_mm >= 0:
             raise ValueError(f"zone_mm={options.zone_mm}: need a zone >= 0 mm")
         rows = job.job
@@ -115,11 +117,20 @@ class RapidPost(CartesianPost):
         io, names = record.job.process_io, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            f"Frames: tool T = PERS tooldata {self.tool}, part P = PERS wobjdata {self.wobj} "
+            "(named after tool.name and part.name: RAPID names its frames, the cell's "
+            "controller_frame numbers are not used), as calibrated on the controller; their "
+            f"nominal values: {self.options.module}{FRAMES_SUFFIX}.mod (load it once, it is "
+            "not part of the .pgf).",
             "Units: mm, deg; quaternions [w,x,y,z]. World = robot base. Stationary tool: "
             "tframe = tool in world; robot-held wobj: uframe = part in tool0; robtarget = tool "
             "on the part.",
             "Axes: URDF joints"
-            + (", axis 3 = q2 + q3 (J2/J3 linkage)" if self.robot.j23_coupled else "")
+            + (
+                f", axis 3 = q3 + {self.robot.j23_factor:g} x q2 (J2/J3 linkage)"
+                if self.robot.j23_coupled
+                else ""
+            )
             + ".",
             f"Links: MoveAbsJ to fine points ({LINK_SPEED}); approach, seams, retract: MoveL / "
             "TriggL at the planned speeds.",
@@ -144,16 +155,13 @@ class RapidPost(CartesianPost):
         self.head = ["! " + rapid_comment(line) for line in lines]
 
     def frames(self) -> None:
-        """The stationary tool (its tload: the gripper), the robot-held work object, the
-        part's load (GripLoad) and the seams' zone."""
-        rows, load = self.job.job, payload(self.job.job.payload)
-        gripper = GRIPPER_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG)
-        self.decls += [
-            f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
-            f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
-        ]
+        """The part's load (GripLoad) and the seams' zone. The stationary tool and the
+        robot-held work object are the controller's PERS data (``_nominal_frames``)."""
+        load = self.load
         if load is not None:
-            self.decls.append(f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC)};")
+            self.decls.append(
+                f"PERS loaddata partLoad := {_load(load.part_mass_kg, load.p_PC, load.I_C_P)};"
+            )
         zone = self.options.zone_mm
         z = _list((zone,) * 3 + (zone / 10, zone, zone / 10), 5)[1:-1]
         self.decls.append(f"LOCAL CONST zonedata zPath := [FALSE,{z}];")
@@ -163,7 +171,7 @@ class RapidPost(CartesianPost):
         n = move.number
         names = ["jHome"] if n == 0 else [f"jL{n}_{w}" for w in range(1, len(move.targets) + 1)]
         for name, q in zip(names, move.targets, strict=True):
-            axes = abb_axes_deg(q[None], j23_coupled=self.robot.j23_coupled)[0]
+            axes = abb_axes_deg(self.robot, q[None])[0]
             self.decls.append(
                 f"LOCAL CONST jointtarget {name} := [{_list(axes, DEG_DIGITS)},{EXTAX}];"
             )
@@ -208,7 +216,30 @@ class RapidPost(CartesianPost):
         write_atomic(files[0], text)
         listing = f"<Program>\n  <Module>{files[0].name}</Module>\n</Program>\n"
         write_atomic(files[1], PGF_HEAD + listing)
-        return files
+        return files + [self._nominal_frames(out_dir)]
+
+    def _nominal_frames(self, folder: Path) -> Path:
+        """``<module>Frames.mod``: the PERS tooldata (the stationary tool T in the world
+        W = B; its tload the gripper's) and wobjdata (the part P: uframe in tool0 = E)
+        with the cell's nominal values, a module to load once (not in the .pgf): the
+        controller's calibration then updates them, and every program uses them."""
+        rows, load = self.job.job, self.load
+        gripper = NO_LOAD if load is None else _load(load.gripper_mass_kg, load.p_EG, load.I_G_E)
+        name = f"{self.options.module}{FRAMES_SUFFIX}"
+        body = self.head + [
+            "! NOMINAL FRAMES of the cell (its CAD values): load this module once, then",
+            "! calibrate these data on the controller; the program only names them.",
+            *(
+                ["! tload: the cell gives no gripper load; set it here (0.001 kg: none given)."]
+                if load is None
+                else []
+            ),
+            f"PERS tooldata {self.tool} := [FALSE,{_pose(rows.X_BT)},{gripper}];",
+            f'PERS wobjdata {self.wobj} := [TRUE,TRUE,"",{_pose(rows.X_EP)},[[0,0,0],[1,0,0,0]]];',
+        ]
+        file = folder / f"{name}.mod"
+        write_atomic(file, _module_text(name, body, {}))
+        return file
 
     def _speed(self, v_mms: float) -> str:
         """The speeddata of v_tcp [mm/s] (``v<mm/s>_<tenth>``), declared at first use."""
@@ -280,10 +311,16 @@ def _pose(X: np.ndarray) -> str:
     return f"[{_list(X[:3, 3] * 1e3, MM_DIGITS)},{_list(q, QUAT_DIGITS)}]"
 
 
-def _load(mass_kg: float, p_m: np.ndarray) -> str:
-    """loaddata ``[mass, cog [mm], [1,0,0,0], 0, 0, 0]`` of a point mass (no inertia);
-    RAPID needs mass > 0, so 0 kg is written as 0.001 kg."""
-    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[1,0,0,0],0,0,0]"
+def _load(mass_kg: float, p_m: np.ndarray, inertia: np.ndarray) -> str:
+    """loaddata ``[mass, cog [mm], aom, ix, iy, iz]``: aom the principal axes of the
+    inertia (3, 3) [kg m²] about cog, ix..iz the moments about them [kg m²]; RAPID needs
+    mass > 0, so 0 kg is written as 0.001 kg."""
+    axes = principal(inertia)
+    X = np.eye(4)
+    X[:3, :3] = axes.R
+    aom = _pose(X).split("],[")[1].rstrip("]")
+    moments = ",".join(_num(v, 5) for v in axes.moments)
+    return f"[{_num(max(mass_kg, 1e-3), 3)},{_list(p_m * 1e3, 1)},[{aom}],{moments}]"
 
 
 def _robtarget(name: str, X: np.ndarray, conf: np.ndarray) -> str:

@@ -17,8 +17,8 @@ states them in each program's header):
   geometric tests as ABB's cfx bits, ``export.abb.abb.confdata``); turn numbers of J1, J4,
   J6: 0 for (-180°, 180°], 1 for (180°, 540°], -1 for (-540°, -180°].
 - World: FANUC's world frame sits on axis 1 at the height of axis 2 (the ROS-Industrial
-  FANUC support packages' ``base`` frame: base_link raised by c1); positions here are in
-  a user frame equal to the URDF base_link, i.e. UFRAME = (0, 0, -c1 mm, 0, 0, 0) in world.
+  FANUC support packages' ``base`` frame: base_link raised by c1); the user frame is the
+  fixed tool T in that world (``export.fanuc.fanuc_frames``).
 """
 
 from __future__ import annotations

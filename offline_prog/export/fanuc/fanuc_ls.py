@@ -3,14 +3,16 @@
 Form: **flange-style, dense point list**. FANUC sells a Remote TCP option for a robot
 that carries the part past a fixed tool, but this writer has no FANUC document at hand
 to cite for its instructions, so it does not use it (the issue's rule: cite the source
-or write the flange form and say so). The tool frame is the part: UTOOL[1] = X_EP (P in
-the faceplate = URDF tool0, z out of the flange), and every position is the part frame
-X_BP = X_BE · X_EP in a user frame equal to the URDF base_link (UFRAME[1] = 0, 0, -c1,
-0, 0, 0 in FANUC's world, see export.fanuc.fanuc). The controller interpolates P
-linearly between the points while the tool stays fixed, so the points are split until
-the tool's curve on the part also stays within the chord and angle tolerances
-(``PointRule("flange")``). Speeds are each segment's planned mean speed of P's origin
-[mm/sec]; CNT100 between points, FINE at the ends of each move.
+or write the flange form and say so). The frames are the controller's, by number
+(``export.fanuc.fanuc_frames``): ``UFRAME_NUM`` = ``tool.controller_frame`` (the fixed
+tool T as the user frame), ``UTOOL_NUM`` = ``part.controller_frame`` (the part P in the
+faceplate as the tool frame), and every position is the part frame's pose in the user
+frame, X_TP = X_BT⁻¹ · X_BE · X_EP; the nominal values of the two frames are in
+``<name>_FRAMES.ls`` only. The controller interpolates P linearly between the points
+while the tool stays fixed, so the points are split until the tool's curve on the part
+also stays within the chord and angle tolerances (``PointRule("flange")``). Speeds are
+each segment's planned mean speed of P's origin [mm/sec]; CNT100 between points, FINE at
+the ends of each move.
 
 ``<name>.ls``: ``J`` home; per seam the link (``J`` through its joint-represented
 points, FINE: the planned, collision-checked joint moves) and ``CALL <name>_S<k>``: the
@@ -55,11 +57,16 @@ from offline_prog.export.fanuc.fanuc import (
     joint_pos,
     ls_text,
     remarks,
-    wpr_deg,
+)
+from offline_prog.export.fanuc.fanuc_frames import (
+    FRAMES_SUFFIX,
+    X_WB,
+    frame_conventions,
+    frames_program,
 )
 from offline_prog.export.fanuc.fanuc_io import Samples, place_events
+from offline_prog.export.frames import ControllerFrames, controller_frames
 from offline_prog.export.merge import PathCheck
-from offline_prog.export.payload import payload
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
@@ -68,7 +75,6 @@ NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 charact
 DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
 JOINT_SPEED_PCT = 20  # J moves of the links
 MIN_SPEED_MMS, MAX_SPEED_MMS = 1, 2000  # FANUC L moves take 1 to 2000 mm/sec
-UF, UT = 1, 1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -80,29 +86,30 @@ class FanucOptions(PointOptions):
 
 
 class _Program:
-    """One LS program being written: statements and its own /POS entries."""
+    """One LS program being written: statements and its own /POS entries, in the user
+    frame and tool frame numbered ``frames`` (``export.fanuc.fanuc_frames``)."""
 
-    def __init__(self, name: str):
-        self.name, self.lines, self.positions = (
-            name,
-            [f"  UFRAME_NUM={UF}", f"  UTOOL_NUM={UT}"],
-            [],
-        )
+    def __init__(self, name: str, frames: ControllerFrames):
+        self.name, self.uf, self.ut = name, frames.tool, frames.part
+        self.lines = [f"  UFRAME_NUM={self.uf}", f"  UTOOL_NUM={self.ut}"]
+        self.positions = []
 
     def joint(self, robot, q: np.ndarray) -> None:
         k = len(self.positions) + 1
-        self.positions.append(joint_pos(k, fanuc_axes_deg(robot, q[None])[0], uf=UF, ut=UT))
+        self.positions.append(
+            joint_pos(k, fanuc_axes_deg(robot, q[None])[0], uf=self.uf, ut=self.ut)
+        )
         self.lines.append(f"J P[{k}] {JOINT_SPEED_PCT}% FINE")
 
     def add(self, items: list) -> None:
-        """Statements: a str as it is, or ((X_BP, config), rest) for ``L P[k] rest``."""
+        """Statements: a str as it is, or ((X_TP, config), rest) for ``L P[k] rest``."""
         for item in items:
             if isinstance(item, str):
                 self.lines.append(item)
                 continue
-            (X_BP, config), rest = item
+            (X_TP, config), rest = item
             k = len(self.positions) + 1
-            self.positions.append(cartesian_pos(k, X_BP, config, uf=UF, ut=UT))
+            self.positions.append(cartesian_pos(k, X_TP, config, uf=self.uf, ut=self.ut))
             self.lines.append(f"L P[{k}] {rest}")
 
     def text(self) -> str:
@@ -116,11 +123,12 @@ class FanucPost(ControllerPost):
     Options = FanucOptions
     NAME_MAX = NAME_MAX - 8
 
-    def __init__(self, job, options: FanucOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: FanucOptions, **flags):
+        super().__init__(job, options, **flags)
         if options.line_limit < 8:
             raise ValueError(f"line_limit={options.line_limit}: need at least 8 lines per program")
-        self.main, self.seams = _Program(options.name), []
+        self.numbers = controller_frames(job.job)
+        self.main, self.seams = _Program(options.name, self.numbers), []
 
     def point_rule(self) -> PointRule:
         return PointRule("flange", "X_TP", self.options.chord_tol_m, self.options.angle_tol_rad)
@@ -129,7 +137,9 @@ class FanucPost(ControllerPost):
         io, rows, names = record.job.process_io, record.job.job, record.job.seam_names
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
-            *frame_conventions(self.robot, rows.X_EP),
+            *frame_conventions(
+                self.robot, self.numbers, frames_program_name=self._frames_name() + ".ls"
+            ),
             f"Links: J to joint positions, {JOINT_SPEED_PCT}%, FINE; approach, seams, retract: "
             "L at the planned speeds of P.",
         ]
@@ -152,15 +162,17 @@ class FanucPost(ControllerPost):
                 if io.ao_unit == "counts"
                 else f"AO[{io.analog_output}] values in volts (tool.process_io.flow.ao_unit)."
             )
-        return lines + payload_conventions(rows)
+        return lines + payload_conventions(self.load, rows.X_EP)
 
     def header(self, lines: list[str]) -> None:
+        self.head = lines
         self.main.lines += remarks(lines)
 
     def frames(self) -> None:
         """UFRAME/UTOOL (in every program's head), the payload schedule, the flow idle."""
         io = self.job.process_io
-        self.main.lines.append("  PAYLOAD[1]")
+        if self.load is not None:
+            self.main.lines.append("  PAYLOAD[1]")
         if io is not None and io.analog_output is not None:  # idle until a seam's output
             self.main.lines.append(self.ao_statement(io.idle))
 
@@ -196,7 +208,21 @@ class FanucPost(ControllerPost):
         for program in [self.main, *self.seams]:
             files.append(out_dir / f"{program.name}.ls")
             write_atomic(files[-1], program.text())
+        rows = self.job.job
+        files.append(out_dir / f"{self._frames_name()}.ls")
+        text = frames_program(
+            self._frames_name(),
+            self.head,
+            X_WT=X_WB(self.robot) @ rows.X_BT,
+            X_EP=rows.X_EP,
+            numbers=self.numbers,
+        )
+        write_atomic(files[-1], text)
         return files
+
+    def _frames_name(self) -> str:
+        """The nominal frames' program: ``<NAME>_FRAMES``."""
+        return f"{self.options.name}{FRAMES_SUFFIX}"
 
     def ao_statement(self, value_v: float) -> str:
         """``AO[n]=value`` of the flow output at value_v [V], in the cell's
@@ -209,10 +235,10 @@ class FanucPost(ControllerPost):
     def _parts(self, name: str, lines: list) -> list[_Program]:
         """The seam's statements in programs of at most line_limit lines (``name``, or
         ``name_1``, ``name_2`` ... called in turn)."""
-        parts = [_Program(name)]
+        parts = [_Program(name, self.numbers)]
         for line in lines:
             if len(parts[-1].lines) + 2 > self.options.line_limit:  # an AO and its move
-                parts.append(_Program(f"{name}_{len(parts) + 1}"))
+                parts.append(_Program(f"{name}_{len(parts) + 1}", self.numbers))
             parts[-1].add([line])
         if len(parts) > 1:
             parts[0].name = f"{name}_1"
@@ -263,6 +289,7 @@ class _Chain:
         )
         # The seam program's first lines: its deviation from the plan, re-checked.
         self.lines: list = _deviation_remarks(check, motions, (n_a, n_p), run.process.residual)
+        X_TB = np.linalg.inv(job.job.X_BT)
         current = None if io is None else io.idle
         for m in motions:
             if m.flow is not None and post.ao_statement(m.flow) != post.ao_statement(current):
@@ -275,7 +302,7 @@ class _Chain:
             last = m.end in (n_a, n_p, len(samples.path_m) - 1)
             mms = speeds.get(m.end, max(1, int(round(speed * 1e3))))
             switch = "" if m.event is None else post.set_output(Switch(0, m.before_end_m, m.event))
-            entry = (samples.X_BP[m.end], configs[m.end])
+            entry = (X_TB @ samples.X_BP[m.end], configs[m.end])  # P in the user frame T
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
         if current is not None and post.ao_statement(current) != post.ao_statement(io.idle):
             self.lines.append(post.ao_statement(io.idle))
@@ -348,30 +375,11 @@ def segment_speeds_mms(t: np.ndarray, X_BU: np.ndarray, idx: np.ndarray, *, clip
     return np.clip(np.round(speeds), MIN_SPEED_MMS, MAX_SPEED_MMS).astype(int)
 
 
-def frame_conventions(robot, X_EP: np.ndarray) -> list[str]:
-    """Header lines: the program's form, frames, configuration and axis conventions."""
-    frame = ", ".join(f"{v:.3f}" for v in [*(X_EP[:3, 3] * 1e3), *wpr_deg(X_EP[:3, :3])])
-    return [
-        "FLANGE-STYLE PROGRAM, DENSE POINT LIST: not FANUC Remote TCP (no FANUC document",
-        "cited for it). UTOOL[1] = the part frame P in the faceplate (URDF tool0):",
-        f"({frame}).",
-        f"UFRAME[1] = URDF base_link = (0,0,{-robot.params.c1 * 1e3:.3f},0,0,0) in FANUC world.",
-        "Positions: P in UFRAME[1]; frames (X,Y,Z mm, W,P,R deg about fixed x, y, z).",
-        "CONFIG: N/F = J5 <= 0 / > 0, U/D elbow, T/B wrist centre front/back of J1;",
-        "turns of J1, J4, J6. Joint positions: FANUC axes, J3 from the horizontal",
-        f"(J3 = q3 {'+' if robot.j23_factor > 0 else '-'} q2 of the URDF, "
-        "ROS-I fanuc_driver J23_factor)."
-        if robot.j23_coupled
-        else "(J1..J6 = the URDF joints).",
-    ]
-
-
-def payload_conventions(rows) -> list[str]:
-    """The PAYLOAD[1] header line, when the cell gives the masses."""
-    load = payload(rows.payload)
+def payload_conventions(load, X_EP: np.ndarray) -> list[str]:
+    """The PAYLOAD[1] header line of the program's load (None: no line)."""
     if load is None:
         return []
-    mass, p_EC = load.total(rows.X_EP)
+    mass, p_EC = load.total(X_EP)
     return [
         f"PAYLOAD[1]: {mass:.3f} kg at ({', '.join(f'{v * 100:.2f}' for v in p_EC)}) cm "
         "in the faceplate frame: set it in the payload schedule before running."

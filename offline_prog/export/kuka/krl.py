@@ -1,15 +1,19 @@
 """KUKA KRL for KSS 8: a job as ``name.src`` / ``.dat`` plus one ``name_<k>`` module per
 seam, in the external-TCP style.
 
-Frames: ``$IPO_MODE=#TCP``, ``$BASE`` = the fixed tool T in ``$WORLD`` (KSS keeps a fixed
-tool as a base), ``$TOOL`` = the part P in ``$FLANGE`` (the robot-carried workpiece is the
-"tool"); each LIN point is a pose between P and T, written as ``tcp_pose_convention``
-says: "X_TP" (P in T, the default: flange = ``$BASE:POS:inv($TOOL)``, KSS's rule for
-every Cartesian position) or "X_PF" (T in P: flange = ``$BASE:inv(POS):inv($TOOL)``).
-The controller then moves the fixed TCP in straight lines across the part, which is
-what the point selection assumes (``export.points``, external_tcp). Besides I, B, E, P,
-F, T: K = KUKA's ``$FLANGE``, the URDF ``tool0`` (``kuka.X_KE``); B = ``base_link`` =
-``$ROBROOT``, taken as ``$WORLD``.
+Frames: ``$IPO_MODE=#TCP``, ``$BASE = BASE_DATA[tool.controller_frame]`` = the fixed
+tool T in ``$WORLD`` (KSS keeps a fixed tool as a base), ``$TOOL =
+TOOL_DATA[part.controller_frame]`` = the part P in ``$FLANGE`` (the robot-carried
+workpiece is the "tool"): the controller's calibrated frames by number
+(``export.frames``), so a calibration moves every program with it. Their nominal values
+(the cell's) are in ``<name>_frm.src`` only, a routine the technician may run once (it
+sets ``BASE_DATA``/``BASE_TYPE`` and ``TOOL_DATA``/``TOOL_TYPE``). Each LIN point is a
+pose between P and T, written as ``tcp_pose_convention`` says: "X_TP" (P in T, the
+default: flange = ``$BASE:POS:inv($TOOL)``, KSS's rule for every Cartesian position) or
+"X_PF" (T in P: flange = ``$BASE:inv(POS):inv($TOOL)``). The controller then moves the
+fixed TCP in straight lines across the part, which is what the point selection assumes
+(``export.points``, external_tcp). Besides I, B, E, P, F, T: K = KUKA's ``$FLANGE``, the
+URDF ``tool0`` (``kuka.X_KE``); B = ``base_link`` = ``$ROBROOT``, taken as ``$WORLD``.
 
 Main program: home (``PTP`` to an ``E6AXIS``), then per seam: the link (``PTP`` through
 its ``E6AXIS`` waypoints, fine points), the approach (``LIN`` to the seam's first
@@ -44,8 +48,16 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.kuka.kuka import X_KE, krl_frame, krl_num, status_turn, vel_cp
-from offline_prog.export.payload import payload
+from offline_prog.export.frames import controller_frames
+from offline_prog.export.kuka.kuka import (
+    X_KE,
+    krl_frame,
+    krl_num,
+    kuka_abc_deg,
+    status_turn,
+    vel_cp,
+)
+from offline_prog.export.payload import Principal
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
@@ -56,6 +68,7 @@ ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
 # plan's motion.link_speed_percent (ProgramData.link_speed_percent).
 PTP_ACC_PERCENT = 100
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
+FRAMES_SUFFIX = "_frm"  # <name>_frm: the nominal frames (KRL names: ≤ 24 characters)
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
 
@@ -78,8 +91,8 @@ class KrlPost(CartesianPost):
     NAME_MAX = 20
     FLOW_WHERE_SET = True  # TRIGGERs set the flow's factor where the plan sets the flow
 
-    def __init__(self, job, options: KrlOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: KrlOptions, **flags):
+        super().__init__(job, options, **flags)
         self.rule = PointRule(
             "external_tcp", options.tcp_pose_convention, options.chord_tol_m, options.angle_tol_rad
         )
@@ -89,16 +102,21 @@ class KrlPost(CartesianPost):
         io = job.process_io
         self.flow = io is not None and io.analog_output is not None
         self.factor = f"{options.name.upper()}_FK"  # the flow's factor: live while $OUT is on
+        self.numbers = controller_frames(job.job)
 
     def point_rule(self) -> PointRule:
         return self.rule
 
     def conventions(self, record: ProgramRecord) -> list[str]:
         io, names = record.job.process_io, record.job.seam_names
+        base, tool = self.numbers.tool, self.numbers.part
         lines = [
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
-            "Style external_tcp: $BASE = fixed tool T in $WORLD (= base_link), $TOOL = part P "
-            "in $FLANGE, $IPO_MODE = #TCP; E6POS = "
+            self.numbers.note(f"BASE_DATA[{base}]", f"TOOL_DATA[{tool}]"),
+            f"Style external_tcp: $BASE = BASE_DATA[{base}] = fixed tool T in $WORLD (= "
+            f"base_link), $TOOL = TOOL_DATA[{tool}] = part P in $FLANGE, $IPO_MODE = #TCP, as "
+            f"calibrated on the controller; their nominal values: {self.options.name}"
+            f"{FRAMES_SUFFIX}.src (run once, or calibrate instead). E6POS = "
             + ("T in P (X_PF)" if self.rule.convention == "X_PF" else "P in T (X_TP)")
             + "; E6AXIS = q [deg].",
             "Links: PTP to E6AXIS fine points (the planned, collision-checked joint moves); "
@@ -187,9 +205,9 @@ class KrlPost(CartesianPost):
             ";FOLD INI",
             "BAS(#INITMOV,0)",
             ";ENDFOLD (INI)",
-            *_load(rows),
-            "$BASE=FIXED_TOOL",
-            "$TOOL=PART_ON_FLANGE",
+            *_load(self.load, rows.X_EP),
+            f"$BASE=BASE_DATA[{self.numbers.tool}]",
+            f"$TOOL=TOOL_DATA[{self.numbers.part}]",
             "$IPO_MODE=#TCP",
             "$ORI_TYPE=#VAR",
             "$ADVANCE=3",
@@ -205,15 +223,32 @@ class KrlPost(CartesianPost):
         main_dat = [
             f"DEFDAT {name}" + (" PUBLIC" if self.flow else ""),
             "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
-            f"DECL FRAME PART_ON_FLANGE={{{krl_frame(X_KE @ rows.X_EP)}}}",
-            f"DECL FRAME FIXED_TOOL={{{krl_frame(rows.X_BT)}}}",
             *self.decl,
             "ENDDAT",
         ]
         files = _write(out_dir, name, self.head + main_src, self.head + main_dat)
         for module, process in self.modules:
             files += self._seam_module(out_dir, module, process)
-        return files
+        return files + self._nominal_frames(out_dir)
+
+    def _nominal_frames(self, folder: Path) -> list[Path]:
+        """``<name>_frm.src`` / ``.dat``: the cell's nominal frames written into the
+        numbered ``BASE_DATA`` (the fixed tool T in $WORLD = B, external TCP: BASE_TYPE
+        #TCP) and ``TOOL_DATA`` (the part P in $FLANGE, TOOL_TYPE #BASE), to run once."""
+        rows, module = self.job.job, f"{self.options.name}{FRAMES_SUFFIX}"
+        base, tool = self.numbers.tool, self.numbers.part
+        src = [
+            f"DEF {module}( )",
+            "; NOMINAL FRAMES of the cell (its CAD values): run once to load them into the",
+            "; controller, or calibrate these frames on the controller instead.",
+            f"BASE_DATA[{base}]={{{krl_frame(rows.X_BT)}}}",
+            f"BASE_TYPE[{base}]=#TCP",
+            f"TOOL_DATA[{tool}]={{{krl_frame(X_KE @ rows.X_EP)}}}",
+            f"TOOL_TYPE[{tool}]=#BASE",
+            "END",
+        ]
+        dat = [f"DEFDAT {module}", "ENDDAT"]
+        return _write(folder, module, self.head + src, self.head + dat)
 
     def _point(self, X_PT: np.ndarray) -> np.ndarray:
         """(…, 4, 4) the E6POS of the tool frame T in P: P in T (X_TP) or T in P."""
@@ -257,15 +292,20 @@ def _path(switch: Switch) -> str:
     return krl_num(-switch.before_end_m * 1e3, 3)
 
 
-def _load(rows) -> list[str]:
-    """``$LOAD`` (gripper + part on $FLANGE = E, point mass) when the cell gives both."""
-    load = payload(rows.payload)
+def _load(load, X_EP: np.ndarray) -> list[str]:
+    """``$LOAD`` (gripper + part on $FLANGE = E, point mass) of the program's load
+    (``export.payload.Payload`` or None: no statement, the header says why)."""
     if load is None:
-        return []  # the header warns: PAYLOAD NOT SET
-    mass, p_EC = load.total(rows.X_EP)
+        return []
+    mass, p_EC = load.total(X_EP)
     x, y, z = (krl_num(v, 1) for v in (X_KE[:3, :3] @ p_EC + X_KE[:3, 3]) * 1e3)
+    # CM's A, B, C: the principal axes of inertia in $FLANGE; J: the moments about them.
+    inertia = load.total_inertia or Principal(np.zeros(3), np.eye(3))
+    a, b, c = (krl_num(v, 4) for v in kuka_abc_deg((X_KE[:3, :3] @ inertia.R)[None])[0])
+    jx, jy, jz = (krl_num(v, 5) for v in inertia.moments)
     return [
-        f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A 0,B 0,C 0}},J {{X 0,Y 0,Z 0}}}}"
+        f"$LOAD={{M {krl_num(mass, 3)},CM {{X {x},Y {y},Z {z},A {a},B {b},C {c}}},"
+        f"J {{X {jx},Y {jy},Z {jz}}}}}"
     ]
 
 

@@ -1,6 +1,8 @@
 """Universal Robots URScript: a job as one ``.script``.
 
-Plain URScript has no remote TCP, so the program runs the planned joints. Links:
+Plain URScript has no remote TCP, so the program runs the planned joints; it names no
+frame and holds no frame value (no TCP or feature of the installation moves a joint
+target: the header says to re-plan after a calibration). Links:
 ``movej`` through the link's joint waypoints (the planned, collision-checked straight
 joint moves; the controller's own timing at the joints' common limits). Each seam with
 its approach and retract: the planned joint trajectory resampled to the controller
@@ -25,7 +27,6 @@ from pathlib import Path
 import numpy as np
 
 from offline_prog.atomic import write_atomic
-from offline_prog.export.payload import payload
 from offline_prog.export.post import ControllerPost
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
 from offline_prog.export.text import urscript_comment
@@ -58,8 +59,8 @@ class UrScriptPost(ControllerPost):
     NAME_MAX = 63
     OPW_ONLY = False
 
-    def __init__(self, job, options: UrScriptOptions, *, forced: bool = False):
-        super().__init__(job, options, forced=forced)
+    def __init__(self, job, options: UrScriptOptions, **flags):
+        super().__init__(job, options, **flags)
         if not options.period_s > 0:
             raise ValueError(f"period_s={options.period_s}: need a period > 0 s")
         # movej: the joints' common limits, at the plan's motion.link_speed_percent
@@ -73,6 +74,9 @@ class UrScriptPost(ControllerPost):
         lines = [
             "Units: m, rad, s. Joint order: " + ", ".join(rows.joint_names) + ".",
             f"Job: {len(names)} seams in this order: {', '.join(names)}.",
+            "Frames: none. This program streams joint positions, which no installation TCP "
+            "or feature moves: after calibrating the tool or the grasp, plan again with the "
+            "calibrated cell (offline-prog calibrate) and export again.",
             f"Links: movej through joint waypoints (a={self.a_link:.3f}, v={self.v_link:.3f}); "
             f"seams with approach and retract: servoj every {self.options.period_s} s "
             "(resampled from the plan).",
@@ -99,7 +103,7 @@ class UrScriptPost(ControllerPost):
         """The payload (gripper + part, centre of mass in the flange) when the cell
         gives it; the program moves the flange's joints, so it sets no TCP."""
         rows = self.job.job
-        if (load := payload(rows.payload)) is not None:
+        if (load := self.load) is not None:
             mass, p_EC = load.total(rows.X_EP)
             self.lines.append(f"  set_payload({mass:.3f}, {_list(p_EC, 4)})")
 
