@@ -45,6 +45,8 @@ def test_the_one_liner_exports_what_the_command_writes(tmp_path, planned_job):
     assert [f.name for f in exported] == ["offline_prog.dat", "offline_prog.src"] + [
         "offline_prog_1.dat",
         "offline_prog_1.src",
+        "offline_prog_frm.dat",  # the nominal frames, loaded once on the controller
+        "offline_prog_frm.src",
     ]
     for file in exported:
         # The fixture planned the cell by its absolute path; the header names it as given.

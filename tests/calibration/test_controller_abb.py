@@ -73,11 +73,12 @@ def test_the_names_are_the_writers():
 
 
 def test_the_rapid_writers_declarations_read_back(planned_folder):
-    """Export → parse → compare: the weld demo's RAPID module declares the tooldata and
+    """Export → parse → compare: the weld demo's RAPID frames module declares the tooldata and
     wobjdata the reader derives from the cell, and they hold the cell's frames (X_IB is
     the identity in the demo)."""
     plan, folder = planned_folder("weld_seam_irb2400")
-    data = read_rapid("OfflineProg.mod", (folder / "programs" / "OfflineProg.mod").read_text())
+    frames = folder / "programs" / "OfflineProgFrames.mod"  # the nominal frames' module
+    data = read_rapid(frames.name, frames.read_text(encoding="utf-8"))
     tool, wobj = data_names(plan.cell.tool.name, plan.cell.part.name)
     X_IT = stationary_tool("m", tool, data.tooldata[tool])
     X_EP = held_work_object("m", wobj, data.wobjdata[wobj])
