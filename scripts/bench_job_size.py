@@ -4,7 +4,8 @@ of 30 and 100 seams, and the share of it the seam-order search takes.
 The jobs: n short seams on the demo plate (scripts/support/many_seams.py: stripes and circles
 on a grid, each allowed to run either way), order auto. Each command is a fresh process
 as a user runs it (stdout piped: no progress display); its wall time includes imports
-and writing the plan folder. The stage times and the order search's counters come from
+and writing the plan folder, its CPU time (user + system, both of its processes) says
+more on a busy machine. The stage times and the order search's counters come from
 the command's own report.json.
 
     python scripts/bench_job_size.py [--seams 30 100]
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import resource
 import subprocess
 import sys
 import tempfile
@@ -29,10 +31,12 @@ from many_seams import many_seam_cell  # noqa: E402
 def bench(n: int, folder: Path) -> None:
     cell = many_seam_cell(folder, n)
     out = folder / f"out_{n}"
-    start = time.perf_counter()
+    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     command = [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)]
     done = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
     wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     if done.returncode not in (0, 1):
         print(f"{n} seams: exit {done.returncode}: {done.stderr.strip()}")
         return
@@ -40,7 +44,9 @@ def bench(n: int, folder: Path) -> None:
     job, search = report["job"], report["job"]["order_search"]
     stages = ", ".join(f"{k} {v:.1f} s" for k, v in report["timings_s"].items())
     print(f"== {n} seams ({sum(job['options_per_seam'])} options), exit {done.returncode} ==")
-    print(f"whole command: {wall:.1f} s (stages: {stages})")
+    print(f"whole command: {wall:.1f} s wall, {cpu:.1f} s CPU (stages: {stages})")
+    if not report["feasible"]:
+        print(f"not feasible: {report['failure']}")
     print(
         f"order search: {search['method']}, {search['time_s']:.2f} s = "
         f"{100 * search['time_s'] / wall:.1f} % of the command; {search['rounds']} rounds in "
