@@ -218,7 +218,8 @@ def _check_program(program: Path, plan_dir: Path, robot):
             i += int(np.argmin(error))
             assert error.min() <= np.radians(0.5e-4) + 1e-12, k
             continue
-        X = pose(entry["xyzwpr"]) @ X_PE  # the written TCP is P (UTOOL[1] = X_EP)
+        # P in the user frame T (UFRAME = X_BT), the written TCP is P (UTOOL = X_EP)
+        X = data.X_BT @ pose(entry["xyzwpr"]) @ X_PE
         q = joints_from_config(robot, X, entry["config"], entry["turns"])
         # the planned row this point was written from (points follow the plan in order)
         gap = np.linalg.norm(X_plan[i:, :3, 3] - X[:3, 3], axis=1)

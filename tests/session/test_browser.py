@@ -122,7 +122,8 @@ def test_session_in_the_browser(session):
             executable_path=chromium, args=["--no-sandbox", *WEBGL_ARGS[:2]]
         )
         page = browser.new_page(viewport={"width": 1400, "height": 900})
-        page.goto(url)
+        # The panel itself; the MeshCat frame in it loads while the first plan runs.
+        page.goto(url, wait_until="domcontentloaded", timeout=TIMEOUT_MS)
         line = page.locator("#status")
         expect(line).to_have_class("feasible", timeout=TIMEOUT_MS)
         first = status(page)
@@ -163,6 +164,7 @@ def test_session_in_the_browser(session):
 
         # The scene: the tool at the new X_IT, the part where the plan puts it at σ = 0.
         page.locator("#sigma").fill("0")  # scrub to the start
+        page.wait_for_load_state("load", timeout=TIMEOUT_MS)  # the MeshCat frame too
         viewer = next(f for f in page.frames if f.url.startswith(f"http://localhost:{port + 1}"))
         viewer.wait_for_function("typeof viewer !== 'undefined'", timeout=TIMEOUT_MS)
 
