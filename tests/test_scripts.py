@@ -42,10 +42,12 @@ print(json.dumps(found))
 
 
 def _tree_digest(folder: Path) -> dict[str, str]:
+    """{file: sha256} of the folder's files, without the ``_test_*`` cells other tests
+    write beside the demos for a moment (the suite runs on two workers)."""
     return {
         str(f.relative_to(folder)): hashlib.sha256(f.read_bytes()).hexdigest()
         for f in sorted(folder.rglob("*"))
-        if f.is_file()
+        if f.is_file() and not f.name.startswith("_test_")
     }
 
 
