@@ -27,7 +27,7 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 # The Python API (offline_prog.api), imported on first use: `import offline_prog` stays
 # cheap (no pydrake) for the command's flag parsing and for `__version__`.
-__all__ = ["Plan", "load_cell", "place", "plan"]
+__all__ = ["Calibrated", "Plan", "calibrate", "export_programs", "load_cell", "place", "plan"]
 
 
 def _api_name(name: str) -> property:
@@ -51,7 +51,10 @@ def _api_name(name: str) -> property:
 class _Package(types.ModuleType):
     """The package module, with the API's names (see :func:`_api_name`)."""
 
+    Calibrated = _api_name("Calibrated")
     Plan = _api_name("Plan")
+    calibrate = _api_name("calibrate")
+    export_programs = _api_name("export_programs")
     load_cell = _api_name("load_cell")
     place = _api_name("place")
     plan = _api_name("plan")

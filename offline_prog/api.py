@@ -7,6 +7,8 @@ export programs, search a placement; what ``offline-prog`` does, without a shell
     print(plan.cycle_time_s, plan.feasible)
     plan.write("out/seal_plate_kr16")  # the plan folder, as `offline-prog plan --out`
     plan.export("krl", "out/krl")  # the programs, as `offline-prog export --format krl`
+    op.export_programs("out/seal_plate_kr16", "krl")  # from a plan folder written before
+    op.calibrate("cells/seal_plate_kr16.yaml", "out/calibrated.yaml", touches="t.csv")
 
 Errors are the exception types the command turns into exit codes:
 :class:`~offline_prog.errors.InputError` (bad input; exit 2),
@@ -20,7 +22,9 @@ Frames: I inertial, B robot base, E flange, P part, F process frame, T fixed too
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import json
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -157,7 +161,13 @@ class Plan:
         return files
 
     def export(
-        self, format: str, out_dir: PathLike, *, force: bool = False, **options
+        self,
+        format: str,
+        out_dir: PathLike,
+        *,
+        force: bool = False,
+        no_payload: bool = False,
+        **options,
     ) -> list[Path]:
         """Write one program format, as ``offline-prog export --format format``.
 
@@ -167,6 +177,9 @@ class Plan:
             out_dir: the folder the files go to (created; files we wrote before there
                 are replaced).
             force: export a plan that failed (its header says so).
+            no_payload: state no load in a controller program (the controller's active
+                load is used, as its header says); without it a cell without masses is
+                refused.
             options: the format's options (``chord_tol_m``, ``angle_tol_rad``,
                 ``tcp_pose_convention``, ``line_limit``; SI units).
 
@@ -179,7 +192,14 @@ class Plan:
         """
         from offline_prog.export.formats import export
 
-        return export(self._finished.programs, format, Path(out_dir), force=force, **options)
+        return export(
+            self._finished.programs,
+            format,
+            Path(out_dir),
+            force=force,
+            no_payload=no_payload,
+            **options,
+        )
 
     def __repr__(self) -> str:
         verdict = "feasible" if self.feasible else f"failed: {self.failure}"
@@ -250,4 +270,102 @@ def place(
         workers=workers,
         scheduler=scheduler,
         progress=progress or (lambda stage, done, total: None),
+    )
+
+
+def export_programs(
+    plan_dir: PathLike,
+    format: str,
+    out_dir: PathLike | None = None,
+    *,
+    force: bool = False,
+    no_payload: bool = False,
+    **options,
+) -> list[Path]:
+    """Write one program format from a plan folder written before (``plan --out``), as
+    ``offline-prog export PLAN_DIR --format format [--out out_dir]``.
+
+    Args:
+        plan_dir: the plan folder (its report.json and trajectory.csv are read).
+        out_dir: where the files go (default: ``plan_dir/programs``).
+        force, no_payload, options: as :meth:`Plan.export`.
+
+    Returns:
+        The files written.
+
+    Raises:
+        ExportRefusedError: the plan failed and ``force`` is False.
+        ValueError: plan_dir is not a plan folder of this version; unknown format or
+            option, another controller's language, a controller program without masses
+            and ``no_payload`` False (each one line, exit 2 on the command line).
+    """
+    from offline_prog.export.formats import check_export, export
+    from offline_prog.export.job_program import JobProgramData
+
+    data = JobProgramData.load(Path(plan_dir))
+    check_export(data, format, force=force)  # before the options: the plan's words
+    out = Path(out_dir) if out_dir is not None else Path(plan_dir) / "programs"
+    return export(data, format, out, force=force, no_payload=no_payload, **options)
+
+
+@dataclasses.dataclass(frozen=True)
+class Calibrated:
+    """What :func:`calibrate` found and wrote.
+
+    Attributes:
+        X_IT, X_PE: (4, 4) the calibrated fixed tool in I and grasp (the part in the
+            flange E) [m], as written into the calibrated cell.
+        files: ``calibrated`` (the cell file) and ``json`` (calibration.json).
+        summary: the lines ``offline-prog calibrate`` prints (one per frame, residuals).
+    """
+
+    X_IT: np.ndarray
+    X_PE: np.ndarray
+    files: dict[str, Path]
+    summary: list[str]
+
+    @property
+    def report(self) -> dict:
+        """calibration.json's content (estimates with their σ, residuals, path shift)."""
+        return json.loads(self.files["json"].read_text(encoding="utf-8"))
+
+
+def calibrate(
+    cell_file: PathLike,
+    out: PathLike,
+    *,
+    touches: PathLike | None = None,
+    from_controller: PathLike | None = None,
+    controller_angles: bool = False,
+) -> Calibrated:
+    """Calibrate the cell's fixed tool and grasp, as ``offline-prog calibrate``: from
+    touches measured on the robot (least squares) or from the frames a controller holds
+    (KUKA ``$config.dat``, an ABB RAPID module); writes the calibrated cell ``out`` and
+    calibration.json beside it. Exactly one of ``touches`` and ``from_controller``.
+
+    Args:
+        controller_angles: the touches' joint angles are the controller's (signs,
+            offsets and the J2/J3 coupling), not the model's.
+
+    Raises:
+        InputError: bad input (the cell, the touches, the controller file, ``out``);
+            degenerate touches or more than one gross outlier.
+        TypeError: neither or both of ``touches`` and ``from_controller``.
+    """
+    from offline_prog.calibration.run import calibrate_controller, calibrate_touches
+    from offline_prog.errors import InputError
+
+    if (touches is None) == (from_controller is None):
+        raise TypeError("calibrate: give exactly one of touches= and from_controller=")
+    if controller_angles and touches is None:
+        raise InputError(Path(from_controller), "--controller-angles", "applies to --touches")
+    if touches is not None:
+        run = calibrate_touches(
+            Path(cell_file), Path(touches), Path(out), controller_angles=controller_angles
+        )
+    else:
+        run = calibrate_controller(Path(cell_file), Path(from_controller), Path(out))
+    calibration, lines, files = run
+    return Calibrated(
+        calibration.X_IT.GetAsMatrix4(), calibration.X_PE.GetAsMatrix4(), files, list(lines)
     )

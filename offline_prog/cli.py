@@ -88,30 +88,30 @@ def _run_robots(args, console: Console) -> None:
 
 def _run_calibrate(args, console: Console) -> None:
     """``calibrate``: the calibrated cell and calibration.json, one line per frame."""
-    from offline_prog.calibration.run import calibrate_controller, calibrate_touches
-    from offline_prog.errors import InputError
+    from offline_prog.api import calibrate
 
-    if args.controller_angles and args.touches is None:
-        raise InputError(args.from_controller, "--controller-angles", "applies to --touches")
-    if args.touches is not None:
-        run = calibrate_touches(
-            args.cell, args.touches, args.out, controller_angles=args.controller_angles
-        )
-    else:
-        run = calibrate_controller(args.cell, args.from_controller, args.out)
-    for line in run[1]:
+    calibrated = calibrate(
+        args.cell,
+        args.out,
+        touches=args.touches,
+        from_controller=args.from_controller,
+        controller_angles=args.controller_angles,
+    )
+    for line in calibrated.summary:
         console.print(line, highlight=False, markup=False)
 
 
 def _run_export(args, console: Console) -> None:
-    from offline_prog.export.formats import check_export, export
-    from offline_prog.export.job_program import JobProgramData
+    from offline_prog.api import export_programs
 
-    data = JobProgramData.load(args.plan_dir)
-    check_export(data, args.format, force=args.force)  # before the flags: the plan's words
-    out = args.out or args.plan_dir / "programs"
-    options = _export_options(args)
-    files = export(data, args.format, out, force=args.force, no_payload=args.no_payload, **options)
+    files = export_programs(
+        args.plan_dir,
+        args.format,
+        args.out,
+        force=args.force,
+        no_payload=args.no_payload,
+        **_export_options(args),
+    )
     for file in files:
         console.print(f"  {args.format:<9} {file}")
     console.print(f"exported {len(files)} file(s) from {args.plan_dir}")

@@ -66,7 +66,9 @@ def test_import_offline_prog_loads_no_pipeline():
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    assert run.stdout.strip() == "['Plan', 'load_cell', 'place', 'plan']"
+    assert run.stdout.strip() == (
+        "['Calibrated', 'Plan', 'calibrate', 'export_programs', 'load_cell', 'place', 'plan']"
+    )
 
 
 def test_bad_input_raises_the_exit_2_error(tmp_path):
@@ -103,3 +105,48 @@ def test_an_edited_cell_plans_as_its_file_would(tmp_path):
     assert edited.cycle_time_s == pytest.approx(on_disk.cycle_time_s, abs=1e-6)
     files = edited.write(tmp_path / "out")
     assert files["report"].is_file() and files["report_html"].is_file()
+
+
+def test_export_programs_from_a_plan_folder_writes_what_the_command_writes(
+    tmp_path, planned_job, capsys
+):
+    """``op.export_programs(plan_dir, "krl", out)`` writes the programs ``offline-prog
+    export`` writes from the same folder (equal up to the time stamps); a plan folder
+    that is not one is the command's one-line ValueError (exit 2)."""
+    from offline_prog.cli import main
+
+    _, folder = planned_job("seal_plate_kr16")
+    files = op.export_programs(folder, "krl", tmp_path / "api")
+    assert main(["export", str(folder), "--format", "krl", "--out", str(tmp_path / "cli")]) == 0
+    programs = [f for f in (tmp_path / "cli").iterdir() if not f.name.endswith(".json")]
+    assert sorted(f.name for f in files) == sorted(f.name for f in programs)
+    for file in files:
+        written = (tmp_path / "cli" / file.name).read_text(encoding="utf-8")
+        assert without_time_stamps(file.read_text(encoding="utf-8")) == without_time_stamps(
+            written
+        ), file.name
+    with pytest.raises(ValueError, match="not a plan folder"):
+        op.export_programs(tmp_path / "cli", "krl", tmp_path / "nothing")
+    with pytest.raises(ValueError, match="not the controller language"):
+        op.export_programs(folder, "rapid", tmp_path / "rapid")
+
+
+def test_calibrate_returns_the_frames_the_command_writes(tmp_path):
+    """``op.calibrate`` on the demo touches: the frames it returns are those of the
+    calibrated cell it wrote (loaded back), its summary is what the command prints, and
+    asking for neither or both sources is refused."""
+    from offline_prog.cli import main
+
+    cell = CELLS / "seal_plate_kr16.yaml"
+    touches = CELLS / "calibration" / "seal_plate_kr16_touches.csv"
+    calibrated = op.calibrate(cell, tmp_path / "api" / "calibrated.yaml", touches=touches)
+    written = op.load_cell(calibrated.files["calibrated"])
+    X_IT = written.tool.X_IT
+    assert calibrated.X_IT[:3, 3] == pytest.approx(X_IT.translation, abs=1e-6)
+    assert calibrated.report["touches_file"] == str(touches)
+    out = tmp_path / "cli" / "calibrated.yaml"
+    assert main(["calibrate", str(cell), "--touches", str(touches), "--out", str(out)]) == 0
+    assert op.load_cell(out).tool.X_IT.translation == pytest.approx(X_IT.translation)
+    assert len(calibrated.summary) >= 2
+    with pytest.raises(TypeError):
+        op.calibrate(cell, tmp_path / "x.yaml")
