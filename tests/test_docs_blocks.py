@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from test_api import ONE_LINER
 from test_docs import offline_prog_commands
 
 from offline_prog.cli_flags import parser
@@ -335,3 +336,19 @@ def test_the_pages_blocks_run_as_written(tmp_path, page):
         assert not missing, f"{block}: wrote no {missing}"
     if check := AFTERWARDS.get(page.name):
         check(tmp_path)
+
+
+def test_the_readmes_inline_commands_are_run_on_getting_started():
+    """The README's quick start names its commands inline: each is a command of getting
+    started's blocks (run above) but the session (interactive: tests/session start it),
+    and its Python line is the one tests/test_api.py runs."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    inline = re.findall(r"`((?:offline-prog [^`\s]+|sed|python3 -m venv) [^`\n]+)`", text)
+    page = REPO / "docs" / "getting-started.md"
+    run = {line for block in blocks(page) if runs_here(block) for line in shell_lines(block)}
+    assert len(inline) >= 5
+    assert [line for line in inline if line not in run] == [
+        "offline-prog session cells/seal_plate_kr16.yaml"
+    ]
+    python = re.search(r"`(import offline_prog as op;[^`]+)`", text).group(1)
+    assert " ".join(python.split()).replace('"', "'") == ONE_LINER
