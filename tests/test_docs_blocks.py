@@ -102,7 +102,7 @@ def test_every_fence_and_marker_belongs_to_a_block(page):
     text = page.read_text(encoding="utf-8")
     fences = re.findall(r"(?m)^ *```", text)
     assert len(fences) == 2 * len(blocks(page)), page
-    markers = re.findall(r"<!-- docs-test:", text)
+    markers = re.findall(r"(?m)^ *<!-- docs-test:", text)
     assert len(markers) == sum(block.marker is not None for block in blocks(page)), page
 
 
