@@ -122,8 +122,8 @@ def runs_in_ci(block: Block) -> bool:
 
 
 def runs_here(block: Block) -> bool:
-    """A command or Python block the slow suite runs (the CI's own, and those that need
-    hardware, not)."""
+    """A command or Python block the slow suite runs: all but the set-up blocks CI runs
+    and those marked as needing hardware."""
     runnable = block.lang in (*COMMANDS, "python")
     return runnable and not runs_in_ci(block) and block.marker != "needs hardware"
 
@@ -172,7 +172,8 @@ def test_every_block_is_run_checked_or_marked(block):
         assert argvs, f"{block}: no offline-prog {command} to shrink"
         for argv in argvs:
             parser().parse_args(argv + options)  # exits 2 on an option it does not have
-        assert all(re.fullmatch(r"\w+\.\w+", key) for key in keys), keys
+        assert set(keys) <= {row.key for row in cell_key_rows()}, keys
+        assert all(re.fullmatch(r"\w+\.\w+", key) for key in keys), keys  # section.key
     if block.lang in COMMANDS and not runs_here(block):
         assert runs_in_ci(block) or block.marker == "needs hardware", block
 
