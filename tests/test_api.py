@@ -10,6 +10,7 @@ import sys
 import pytest
 
 import offline_prog as op
+from offline_prog.cli import main
 from offline_prog.errors import InputError
 
 from conftest import CELLS, REPO
@@ -27,8 +28,9 @@ def without_time_stamps(text: str) -> list[str]:
 
 def test_the_one_liner_exports_what_the_command_writes(tmp_path, planned_job):
     """As the issue writes it, in a fresh process from a folder holding ``cells/``: the
-    KRL programs equal those ``offline-prog plan`` writes into ``programs/``, and the
-    cycle time printed is report.json's."""
+    KRL programs equal those ``offline-prog plan`` writes into ``programs/`` and those
+    ``offline-prog export PLAN_DIR --format krl`` writes, and the cycle time printed is
+    report.json's."""
     (tmp_path / "cells").symlink_to(CELLS)
     run = subprocess.run(
         [sys.executable, "-c", ONE_LINER],
@@ -48,13 +50,16 @@ def test_the_one_liner_exports_what_the_command_writes(tmp_path, planned_job):
         "offline_prog_frm.dat",  # the nominal frames, loaded once on the controller
         "offline_prog_frm.src",
     ]
+    assert main(["export", str(folder), "--format", "krl", "--out", str(tmp_path / "cli")]) == 0
+    by_cli = sorted((tmp_path / "cli").glob("*.[sd][ra][ct]"))
+    assert [f.name for f in by_cli] == [f.name for f in exported]
     for file in exported:
-        # The fixture planned the cell by its absolute path; the header names it as given.
-        written = (folder / "programs" / file.name).read_text(encoding="utf-8")
-        written = written.replace(f"{CELLS}/", "cells/")
-        assert without_time_stamps(file.read_text(encoding="utf-8")) == without_time_stamps(
-            written
-        ), file.name
+        ours = without_time_stamps(file.read_text(encoding="utf-8"))
+        for command in (folder / "programs", tmp_path / "cli"):
+            # The fixture planned the cell by its absolute path; the header names it as given.
+            written = (command / file.name).read_text(encoding="utf-8")
+            written = written.replace(f"{CELLS}/", "cells/")
+            assert ours == without_time_stamps(written), (command, file.name)
 
 
 def test_import_offline_prog_loads_no_pipeline():
