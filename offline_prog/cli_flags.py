@@ -162,13 +162,23 @@ def parser() -> argparse.ArgumentParser:
         "--chord-tol-mm",
         type=POSITIVE,
         default=None,
-        help="KRL, RAPID, FANUC point density: chordal tolerance [mm] (default 0.05)",
+        help="KRL, RAPID, FANUC, URScript movel/movep point density: chordal tolerance "
+        "[mm] (default 0.05)",
     )
     export.add_argument(
         "--angle-tol-deg",
         type=POSITIVE,
         default=None,
-        help="KRL, RAPID, FANUC point density: orientation tolerance [deg] (default 0.1)",
+        help="KRL, RAPID, FANUC, URScript movel/movep point density: orientation "
+        "tolerance [deg] (default 0.1)",
+    )
+    export.add_argument(
+        "--mode",
+        choices=["servoj", "movel", "movep"],
+        default=None,
+        help="URScript: servoj streams the planned joints (default); movel / movep: linear "
+        "moves with blend radii within the path tolerance, the flow set per point, in the "
+        "tool's feature (editable on the pendant)",
     )
     export.add_argument(
         "--line-limit",
