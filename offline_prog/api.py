@@ -168,7 +168,7 @@ class Plan:
                 are replaced).
             force: export a plan that failed (its header says so).
             options: the format's options (``chord_tol_m``, ``angle_tol_rad``,
-                ``tcp_pose_convention``, ``line_limit``; SI units).
+                ``tcp_pose_convention``, ``line_limit``, ``mode``; SI units).
 
         Returns:
             The files written.
