@@ -174,22 +174,7 @@ class UrScriptPost(ControllerPost):
             sets.setdefault(min(max(i, 1), len(grid) - 1), []).append(event)
         flow, last = self._flow(run, grid), None
         for i in range(1, len(grid)):
-            events = sets.get(i, [])
-            self.lines += [
-                self.set_output(Switch(0, 0.0, e)) for e in events if e.signal is Signal.DIGITAL
-            ]
-            analog = [e for e in events if e.signal is Signal.ANALOG]
-            if flow is not None and (
-                last is None
-                or abs(flow[i] - last) >= min(ANALOG_STEP_V, ANALOG_STEP_SHARE * abs(last))
-                or analog
-            ):
-                last = flow[i]
-                if analog:  # the event, at the value the plan's flow has at this sample
-                    event = dataclasses.replace(analog[0], value=float(flow[i]))
-                    self.lines.append(self.follow_speed(Switch(0, 0.0, event)))
-                else:
-                    self.lines.append(self._analog_out(flow[i]))
+            last = self._io_here(sets.get(i, []), None if flow is None else flow[i], last)
             self.lines.append(
                 f"  servoj({_list(q[i])}, t={period}, lookahead_time={SERVOJ_LOOKAHEAD_S}, "
                 f"gain={SERVOJ_GAIN})"
@@ -289,18 +274,29 @@ class UrScriptPost(ControllerPost):
                 )
             if m == len(points) - 1:
                 break
-            events = at_point.get(m, [])
-            self.lines += [
-                self.set_output(Switch(0, 0.0, e)) for e in events if e.signal is Signal.DIGITAL
-            ]
-            analog = [e for e in events if e.signal is Signal.ANALOG]
-            if flow is not None and (
-                last is None
-                or abs(flow[m] - last) >= min(ANALOG_STEP_V, ANALOG_STEP_SHARE * abs(last))
-                or analog
-            ):
-                last = flow[m]
-                self.lines.append(self._analog_out(flow[m]))
+            last = self._io_here(at_point.get(m, []), None if flow is None else flow[m], last)
+
+    def _io_here(self, events: list, flow_v: float | None, last: float | None) -> float | None:
+        """The statements of the I/O events set here, and of the flow at its value here
+        flow_v [V] (None: no flow output) at an analog event or when it has changed from
+        the ``last`` value written by ANALOG_STEP_V or ANALOG_STEP_SHARE of it; returns
+        the flow value last written."""
+        self.lines += [
+            self.set_output(Switch(0, 0.0, e)) for e in events if e.signal is Signal.DIGITAL
+        ]
+        analog = [e for e in events if e.signal is Signal.ANALOG]
+        if flow_v is None or not (
+            last is None
+            or abs(flow_v - last) >= min(ANALOG_STEP_V, ANALOG_STEP_SHARE * abs(last))
+            or analog
+        ):
+            return last
+        if analog:  # the event, at the value the plan's flow has here
+            event = dataclasses.replace(analog[0], value=float(flow_v))
+            self.lines.append(self.follow_speed(Switch(0, 0.0, event)))
+        else:
+            self.lines.append(self._analog_out(flow_v))
+        return flow_v
 
     def _analog_out(self, value_v: float) -> str:
         output = self.job.process_io.analog_output
