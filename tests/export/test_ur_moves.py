@@ -11,6 +11,18 @@ from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL
 from offline_prog.export.formats import export
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.ur.urscript import ANALOG_RANGE_V, ANALOG_STEP_V
+from offline_prog.io_events import Signal
+from offline_prog.plan import plan_job
+from offline_prog.results.job_folder import write_job_outputs
+
+from conftest import CELLS, with_own_io
+
+IO_TOL_M = 1e-3  # an output switched within 1 mm of where the plan sets it
+IO = (
+    "tool:\n  process_io:\n    on:  {digital_output: 2, lead_mm: 3}\n"
+    "    off: {digital_output: 2, lead_mm: 4}\n"
+    "    flow: {analog_output: 1, per_mps: 30.0, offset: 1.0, min: 0.0, max: 10.0}\n"
+)
 
 POSE = r"p\[([^\]]*)\]"
 NUMBER = r"([\d.]+)"
@@ -46,6 +58,8 @@ def read_program(folder):
             steps.append(("movej", np.array(re.search(r"\[([^\]]*)\]", line)[1].split(","), float)))
         elif m := re.match(r"^\s*set_standard_analog_out\(1, ([\d.]+)\)", line):
             steps.append(("ao", float(m[1])))
+        elif m := re.match(r"^\s*set_standard_digital_out\((\d+), (True|False)\)", line):
+            steps.append(("do", int(m[1]), m[2] == "True"))
         elif m := re.match(r"^\s*set_tcp\((\w+)\)", line):
             steps.append(("tcp", m[1]))
     return frames, steps
@@ -83,6 +97,19 @@ def replay(waypoints: list[np.ndarray], radii: list[float]) -> np.ndarray:
     return np.array(out)
 
 
+def fractional_row(p_rows: np.ndarray, p: np.ndarray) -> float:
+    """The row position (a float index into p_rows (N, 3)) of the point p (3,) on the
+    polyline of the rows, nearest first."""
+    i = int(np.argmin(np.linalg.norm(p_rows - p, axis=1)))
+    best = (np.inf, float(i))
+    for a in (i - 1, i):
+        if 0 <= a < len(p_rows) - 1:
+            d = p_rows[a + 1] - p_rows[a]
+            u = float(np.clip(np.dot(p - p_rows[a], d) / max(np.dot(d, d), 1e-30), 0.0, 1.0))
+            best = min(best, (np.linalg.norm(p_rows[a] + u * d - p), a + u))
+    return best[1]
+
+
 def distances_to_polyline(points: np.ndarray, line: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(N,) distance of each point (N, 3) from the polyline (M, 3) and (N,) the index of
     the polyline's vertex nearest its closest point."""
@@ -95,6 +122,43 @@ def distances_to_polyline(points: np.ndarray, line: np.ndarray) -> tuple[np.ndar
 
 
 def test_movep_program_replayed_from_its_text_stays_within_the_path_tolerance(data, tmp_path):
+    check_movep_program(data, tmp_path)
+
+
+@pytest.mark.slow  # plans a job of its own
+def test_movep_program_switches_the_process_output_where_the_plan_sets_it(tmp_path):
+    """The tape cell with a digital output and a flow of its own: the replay as above,
+    and each ``set_standard_digital_out`` at the point where the plan sets it."""
+    cell = tmp_path / "tape_io.yaml"
+    text = (CELLS / "tape_cylinder_ur10e.yaml").read_text().replace(": data/", f": {CELLS}/data/")
+    cell.write_text(with_own_io(text, IO))
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, tmp_path / "plan")
+    data = JobProgramData.load(tmp_path / "plan")
+    waypoints, steps = check_movep_program(data, tmp_path / "out")
+    rows, switched = data.job, []
+    run = [s for s in data.segments if s.seam]
+    k = np.arange(run[0].start, min(run[-1].stop, len(rows.t) - 1) + 1)
+    p_plan = (rows.X_BE[k] @ rows.X_EP)[:, :3, 3]
+    first = next(n for n, s in enumerate(steps) if s[0] == "move")
+    at = 0  # the waypoint the robot is at (blending into the next move)
+    for step in steps[first - 1 :]:
+        if step[0] == "move":
+            at += 1
+        elif step[0] == "do":
+            i = int(np.argmin(np.linalg.norm(p_plan - waypoints[at][:3, 3], axis=1)))
+            switched.append((step[2], rows.path_m[k[i]]))
+    events = data.seam_events(data.seam_names[0])
+    assert [state for state, _ in switched] == [e.state for e in events] == [True, False]
+    for (_, path_m), event in zip(switched, events, strict=True):
+        assert path_m == pytest.approx(event.set_path_m, abs=IO_TOL_M)
+
+
+def check_movep_program(data: JobProgramData, tmp_path):
+    """Export the job's movep program, replay it from its text and compare it with the
+    plan's rows (see the module docstring); returns (the waypoints P in B, the
+    statements)."""
     files = export(data, "urscript", tmp_path, mode="movep")
     assert [f.name for f in files] == ["offline_prog.script", "offline_prog_frames.script"]
     frames, steps = read_program(tmp_path)
@@ -144,16 +208,18 @@ def test_movep_program_replayed_from_its_text_stays_within_the_path_tolerance(da
         elif step[0] == "move":
             at_point.append(written)
     p_plan = X_BP_plan[:, :3, 3]
-    checked = 0
+    edges = [e.t_s for e in data.events if e.signal is Signal.ANALOG]
+    skipped = 0
     for m, value in enumerate(at_point):  # value: set at waypoint m, held on move m+1
-        i = int(np.argmin(np.linalg.norm(p_plan - waypoints[m][:3, 3], axis=1)))
-        lo, hi = max(i - 1, 0), min(i + 1, len(k) - 1)
-        column = data.analog[k[lo : hi + 1]]
-        if np.ptp(column) > 0.1:  # the flow's edge between these rows
+        row = fractional_row(p_plan, waypoints[m][:3, 3])
+        a, b = int(np.floor(row)), int(np.ceil(row))
+        if any(rows.t[k[a]] - 1e-9 <= t <= rows.t[k[b]] + 1e-9 for t in edges):
+            skipped += 1  # the flow's edge between these rows
             continue
-        assert value == pytest.approx(data.analog[k[i]], abs=ANALOG_STEP_V + np.ptp(column) + 2e-3)
-        checked += 1
-    assert checked >= len(at_point) - 4
+        planned = np.interp(row, np.arange(len(k)), data.analog[k])
+        assert value == pytest.approx(planned, abs=ANALOG_STEP_V + 0.01), m
+    assert skipped <= len(edges)
+    return waypoints, steps[last_movej:]
 
 
 def test_servoj_takes_no_path_tolerance_and_an_unknown_mode_is_refused(data, tmp_path):
