@@ -227,4 +227,6 @@ def test_servoj_takes_no_path_tolerance_and_an_unknown_mode_is_refused(data, tmp
         export(data, "urscript", tmp_path, chord_tol_m=1e-4)
     with pytest.raises(ValueError, match="mode='movec': use one of servoj, movel, movep"):
         export(data, "urscript", tmp_path, mode="movec")
+    with pytest.raises(ValueError, match="need chord_tol_m > 0"):
+        export(data, "urscript", tmp_path, mode="movep", chord_tol_m=0.0)
     assert not list(tmp_path.glob("*.script"))

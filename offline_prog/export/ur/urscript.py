@@ -89,8 +89,11 @@ class UrScriptPost(ControllerPost):
                 "the planned joints)"
             )
         self.moves = options.mode != "servoj"
-        self.chord_tol_m = options.chord_tol_m or DEFAULT_CHORD_TOL_M
-        self.angle_tol_rad = options.angle_tol_rad or DEFAULT_ANGLE_TOL_RAD
+        given = options.chord_tol_m, options.angle_tol_rad
+        self.chord_tol_m = DEFAULT_CHORD_TOL_M if given[0] is None else given[0]
+        self.angle_tol_rad = DEFAULT_ANGLE_TOL_RAD if given[1] is None else given[1]
+        # the move forms' points: half the tolerance (checked > 0 here)
+        self.rule = PointRule("flange", "X_TP", 0.5 * self.chord_tol_m, 0.5 * self.angle_tol_rad)
         rows = self.job.job
         # The move forms' pose variables: the fixed tool T in B and the part P on E.
         self.feature = identifier_from("tool", rows.tool, max_chars=VARIABLE_MAX)
@@ -105,9 +108,7 @@ class UrScriptPost(ControllerPost):
         """The move forms: the controller interpolates the TCP P in B with the tool fixed
         (flange style), the seam's points at half the tolerance (the blends take the
         other half); servoj: every sample."""
-        if not self.moves:
-            return None
-        return PointRule("flange", "X_TP", 0.5 * self.chord_tol_m, 0.5 * self.angle_tol_rad)
+        return self.rule if self.moves else None
 
     def conventions(self, record: ProgramRecord) -> list[str]:
         if self.moves:
