@@ -181,7 +181,7 @@ class Plan:
                 load is used, as its header says); without it a cell without masses is
                 refused.
             options: the format's options (``chord_tol_m``, ``angle_tol_rad``,
-                ``tcp_pose_convention``, ``line_limit``; SI units).
+                ``tcp_pose_convention``, ``line_limit``, ``mode``; SI units).
 
         Returns:
             The files written.

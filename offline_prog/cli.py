@@ -49,6 +49,7 @@ EXPORT_FLAGS = {
     "angle_tol_rad": "--angle-tol-deg",
     "tcp_pose_convention": "--tcp-pose-convention",
     "line_limit": "--line-limit",
+    "mode": "--mode",
 }
 
 
@@ -67,6 +68,7 @@ def _export_options(args) -> dict:
         else float(np.deg2rad(args.angle_tol_deg)),
         "tcp_pose_convention": args.tcp_pose_convention,
         "line_limit": args.line_limit,
+        "mode": args.mode,
     }
     options = {key: value for key, value in given.items() if value is not None}
     takes = format_options(args.format)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from offline_prog import __version__
 from offline_prog.constants import MAX_PLACE_BUDGET, MAX_PLACE_SEED
+from offline_prog.export.split import MIN_LINE_LIMIT
 from offline_prog.viz.local_server import MAX_PORT, MIN_PORT
 
 EXIT_BAD_INPUT = 2
@@ -67,7 +68,6 @@ def _number(kind, *, low: float, inclusive: bool, high: float = math.inf):
 POSITIVE = _number(float, low=0.0, inclusive=False)
 PORT = _number(int, low=MIN_PORT, inclusive=True, high=MAX_PORT)  # MeshCat aborts below 1024
 HOST_HELP = "listen on this host (default localhost; 0.0.0.0: every interface; ::1: IPv6)"
-MIN_LINE_LIMIT = 20  # the smallest program part the writers can split into
 MAX_MATRIX_SAMPLES = 10_000_000  # self-collision samples (10⁴ take ~3 s)
 
 
@@ -162,20 +162,30 @@ def parser() -> argparse.ArgumentParser:
         "--chord-tol-mm",
         type=POSITIVE,
         default=None,
-        help="KRL, RAPID, FANUC point density: chordal tolerance [mm] (default 0.05)",
+        help="KRL, RAPID, FANUC, URScript movel/movep point density: chordal tolerance "
+        "[mm] (default 0.05)",
     )
     export.add_argument(
         "--angle-tol-deg",
         type=POSITIVE,
         default=None,
-        help="KRL, RAPID, FANUC point density: orientation tolerance [deg] (default 0.1)",
+        help="KRL, RAPID, FANUC, URScript movel/movep point density: orientation "
+        "tolerance [deg] (default 0.1)",
+    )
+    export.add_argument(
+        "--mode",
+        choices=["servoj", "movel", "movep"],
+        default=None,
+        help="URScript: servoj streams the planned joints (default); movel / movep: linear "
+        "moves with blend radii within the path tolerance, the flow set per point, in the "
+        "tool's feature (editable on the pendant)",
     )
     export.add_argument(
         "--line-limit",
         type=_number(int, low=MIN_LINE_LIMIT, inclusive=True),
         default=None,
-        help="FANUC: most lines of one program; a seam's longer program is split into "
-        "called parts (default 2000)",
+        help="KRL, RAPID, FANUC: most lines of one program part; a seam's longer program "
+        "is split into parts called in turn (default: no split; set your controller's limit)",
     )
     return parser
 

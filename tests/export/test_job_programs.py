@@ -304,8 +304,8 @@ def test_urscript_job_links_and_io(folders):
 
 def test_export_offers_only_what_a_plan_accepts_and_refuses_the_rest_in_one_line(folders, capsys):
     """``export --help`` lists no option that every plan refuses (the one-seam
-    writers' ``--style`` and ``--mode`` are gone); a flag of another format is one line,
-    exit 2, naming the flags the format takes."""
+    writers' ``--style`` is gone; ``--mode`` is URScript's servoj / movel / movep); a flag
+    of another format is one line, exit 2, naming the flags the format takes."""
     from offline_prog.cli import main
 
     _, _, plan_folder = folders["krl"]
@@ -315,10 +315,11 @@ def test_export_offers_only_what_a_plan_accepts_and_refuses_the_rest_in_one_line
     with pytest.raises(SystemExit):
         main(["export", "--help"])
     usage = capsys.readouterr().out
-    assert "--style" not in usage and "--mode" not in usage and "--tcp-pose-convention" in usage
+    assert "--style" not in usage and "--tcp-pose-convention" in usage
+    assert "--mode {servoj,movel,movep}" in usage
     for flags, words in [
         (["--style", "flange"], "unrecognized arguments: --style flange"),
-        (["--line-limit", "100"], "--line-limit: not an option of --format krl"),
+        (["--mode", "movep"], "--mode: not an option of --format krl"),
     ]:
         argv = ["export", str(plan_folder), "--format", "krl", *flags, "--out", str(out)]
         try:

@@ -368,7 +368,7 @@ def test_forced_export_says_so_in_every_file(data, tmp_path):
     ("options", "words"),
     [
         ({"style": "flange"}, "no option style"),
-        ({"line_limit": 100}, "no option line_limit"),
+        ({"line_limit": 5}, "line_limit=5: need a whole number"),
         ({"tcp_pose_convention": "X_PT"}, "tcp_pose_convention"),
         ({"name": "1abc"}, "name="),
         ({"name": "a_name_that_is_far_too_long"}, "name="),

@@ -268,7 +268,7 @@ def test_bad_arguments_are_named(data, tmp_path):
         ({"module": "1bad"}, "module"),
         ({"module": "x" * 40}, "module"),
         ({"zone_mm": -1.0}, "zone_mm"),
-        ({"line_limit": 80}, "line_limit"),
+        ({"line_limit": 5}, "line_limit=5: need a whole number"),
         ({"chord_tol_m": -1.0}, "chord_tol_m"),
     ]:
         with pytest.raises(ValueError, match=name):

@@ -149,11 +149,15 @@ def test_cli_export_refuses_a_plan_folder_of_one_seam_from_before_jobs(data, tmp
 
 
 def test_cli_export_refuses_flags_its_format_does_not_take(plan_dir, tmp_path):
-    """``--chord-tol-mm`` chooses Cartesian points; a URScript stream has none."""
-    flags = ["--format", "urscript", "--chord-tol-mm", "0.2", "--force", "--out", tmp_path]
-    done = run_export(plan_dir, *flags)
-    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
-    assert "--chord-tol-mm: not an option of --format urscript" in done.stderr
+    """``--chord-tol-mm`` chooses Cartesian points; a URScript stream has none (its
+    ``--mode movel`` / ``movep`` programs take it); ``--mode`` is URScript's alone."""
+    for flags, words in [
+        (["--format", "urscript", "--chord-tol-mm", "0.2"], "apply to mode movel or movep"),
+        (["--format", "csv", "--mode", "movep"], "--mode: not an option of --format csv"),
+    ]:
+        done = run_export(plan_dir, *flags, "--force", "--out", tmp_path)
+        assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+        assert words in done.stderr
     assert not list(tmp_path.iterdir())
 
 

@@ -208,6 +208,15 @@ def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
     files = export(data, "fanuc", tmp_path, line_limit=100)
     assert len(files) > 2 and all(len(read_ls(f)["mn"]) <= 100 for f in files)
     _check_job(data, tmp_path, robot, cell)
+    # ... and run the unsplit programs' statements and positions, in order (the
+    # position registers are numbered per program).
+
+    def statements(folder):
+        return [(re.sub(r"P\[\d+\]", "P[]", s), p) for s, p in _run(folder)]
+
+    assert max(len(read_ls(f)["mn"]) for f in folder.glob("*.ls")) > 100
+    assert len(files) > len(list(folder.glob("*.ls")))
+    assert statements(tmp_path) == statements(folder)
 
 
 def _check_job(data, folder, robot, cell):

@@ -21,7 +21,11 @@ at this edge: mm, degrees, quaternions ``[q1, q2, q3, q4] = [w, x, y, z]``.
 fine points: the planned, collision-checked joint moves), the approach (``TriggL`` to
 the seam's first point), the seam (``PROC seam_<k>``: ``MoveL`` / ``TriggL`` through its
 points at each segment's planned mean TCP speed, zone ``zPath``), the retract
-(``MoveL``/``TriggL``); home at the end.
+(``MoveL``/``TriggL``); home at the end. With a ``line_limit`` a seam's routine that would
+be longer (``PROC`` to ``ENDPROC``) runs as routines ``seam_<k>_p<j>`` called in turn
+(``export.split``): a move stays with its ``TriggIO`` / ``TriggSpeed``, each move
+names its own speeddata, the last move of a part keeps its zone, and the outputs (the
+``TriggSpeed`` flow with them) hold across the calls.
 
 Process I/O on the path from the plan's I/O events (RAPID Instructions, 3HAC050917:
 ``TriggIO``, ``TriggL``, ``TriggSpeed``): ``TriggIO t, d \\DOp:=do<n>, 1`` then
@@ -51,6 +55,7 @@ from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.program import ProgramData
 from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
+from offline_prog.export.split import check_line_limit, split_blocks
 from offline_prog.export.text import identifier_from, rapid_comment
 from offline_prog.io_events import Signal
 
@@ -80,10 +85,13 @@ TRIGGERS = {
 
 @dataclasses.dataclass(frozen=True)
 class RapidOptions(PointOptions):
-    """module: the module's name; zone_mm: the corner zone of the seams' moves [mm]."""
+    """module: the module's name; zone_mm: the corner zone of the seams' moves [mm];
+    line_limit: most lines (``PROC`` to ``ENDPROC``) of a seam's routine, or None (no
+    split)."""
 
     module: str = "OfflineProg"
     zone_mm: float = 0.3
+    line_limit: int | None = None
 
 
 class RapidPost(CartesianPost):
@@ -98,6 +106,7 @@ class RapidPost(CartesianPost):
         super().__init__(job, options, **flags)
         if not options.zone_mm >= 0:
             raise ValueError(f"zone_mm={options.zone_mm}: need a zone >= 0 mm")
+        check_line_limit(options.line_limit)
         rows = job.job
         tool = identifier_from("tool", rows.tool, max_chars=NAME_MAX)
         wobj = identifier_from("wobj", rows.part, max_chars=NAME_MAX)
@@ -196,20 +205,29 @@ class RapidPost(CartesianPost):
         return f"TriggSpeed {name}, {distance}, {_num(io.lag_s, 3)}, ao{event.output}, {k};"
 
     def call_part(self, process: Process) -> None:
-        """``PROC seam_<k>``: the seam's moves; its first point is the approach's end."""
+        """``PROC seam_<k>``: the seam's moves; its first point is the approach's end.
+        At the line limit: its parts ``seam_<k>_p<j>``, called in turn."""
         proc, data, idx = f"seam_{process.number}", process.data, process.indices
         conf, speeds = confdata(self.robot, data.q[idx]), segment_speeds_mms(data, idx)
-        lines = self.procs.setdefault(proc, [])
-        for m in range(1, len(idx)):
-            name = f"{proc}_{m}"
-            self.decls.append(_robtarget(name, data.X_PT[idx[m]], conf[m]))
-            zone = "fine" if m == len(idx) - 1 or self.options.zone_mm == 0 else "zPath"
-            triggers = self._triggers(process.switches_before(m), lines)
-            lines.append(_move(name, self._speed(speeds[m - 1]), triggers, zone, self.tail))
-        self.main.append(f"{proc};  ! seam {process.seam}")
+        moves = range(1, len(idx))
+        sizes = [len(process.switches_before(m)) + 1 for m in moves]
+        parts = split_blocks(sizes, self.options.line_limit, frame=2)
+        names = [proc] if len(parts) == 1 else [f"{proc}_p{j + 1}" for j in range(len(parts))]
+        for routine, part in zip(names, parts, strict=True):
+            lines = self.procs.setdefault(routine, [])
+            for m in (moves[k] for k in part):
+                name = f"{proc}_{m}"
+                self.decls.append(_robtarget(name, data.X_PT[idx[m]], conf[m]))
+                zone = "fine" if m == len(idx) - 1 or self.options.zone_mm == 0 else "zPath"
+                triggers = self._triggers(process.switches_before(m), lines)
+                lines.append(_move(name, self._speed(speeds[m - 1]), triggers, zone, self.tail))
+            self.main.append(f"{routine};  ! seam {process.seam}")
 
     def footer(self, out_dir: Path) -> list[Path]:
-        module = self.options.module
+        module, limit = self.options.module, self.options.line_limit
+        statements = 2 + sum(not line.startswith("!") for line in self.main)
+        if limit is not None and statements > limit:
+            raise ValueError(f"line_limit={limit}: the main routine alone needs {statements} lines")
         decls = self.decls + [f"VAR triggdata {name};" for name in sorted(self.triggdata)]
         text = _module_text(module, self.head + decls, {"main": self.main, **self.procs})
         files = [out_dir / f"{module}.mod", out_dir / f"{module}.pgf"]

@@ -18,8 +18,9 @@ the ends of each move.
 points, FINE: the planned, collision-checked joint moves) and ``CALL <name>_S<k>``: the
 approach (``L`` to the seam's first point), the seam's ``L`` moves and the retract
 (``L``), in its own program so that no program grows with the job; home at the end (the
-last link). Every ``L`` point is a planned sample. A seam's moves beyond ``line_limit``
-lines go to ``<name>_S<k>_<j>``, called in turn.
+last link). Every ``L`` point is a planned sample. With a ``line_limit``, a seam's moves
+beyond that many lines go to ``<name>_S<k>_<j>``, called in turn (no FANUC document we
+found states a limit, so there is no default: the user sets the controller's).
 
 Process I/O, translated from the plan's I/O events (``io_events``), placed by
 :mod:`offline_prog.export.fanuc.fanuc_io`:
@@ -70,19 +71,20 @@ from offline_prog.export.merge import PathCheck
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
+from offline_prog.export.split import check_line_limit
 
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
-DEFAULT_LINE_LIMIT = 2000  # /MN lines per program (splits into called sub-programs)
 JOINT_SPEED_PCT = 20  # J moves of the links
 MIN_SPEED_MMS, MAX_SPEED_MMS = 1, 2000  # FANUC L moves take 1 to 2000 mm/sec
 
 
 @dataclasses.dataclass(frozen=True)
 class FanucOptions(PointOptions):
-    """name: the main program; line_limit: most /MN lines of one program (≥ 8)."""
+    """name: the main program; line_limit: most /MN lines of one program, or None (no
+    split)."""
 
     name: str = "OFFLINE_PROG"
-    line_limit: int = DEFAULT_LINE_LIMIT
+    line_limit: int | None = None
 
 
 class _Program:
@@ -125,8 +127,7 @@ class FanucPost(ControllerPost):
 
     def __init__(self, job, options: FanucOptions, **flags):
         super().__init__(job, options, **flags)
-        if options.line_limit < 8:
-            raise ValueError(f"line_limit={options.line_limit}: need at least 8 lines per program")
+        check_line_limit(options.line_limit)
         self.numbers = controller_frames(job.job)
         self.main, self.seams = _Program(options.name, self.numbers), []
 
@@ -200,7 +201,7 @@ class FanucPost(ControllerPost):
 
     def footer(self, out_dir: Path) -> list[Path]:
         limit = self.options.line_limit
-        if len(self.main.lines) > limit:
+        if limit is not None and len(self.main.lines) > limit:
             raise ValueError(
                 f"line_limit={limit}: the main program alone needs {len(self.main.lines)} lines"
             )
@@ -235,9 +236,9 @@ class FanucPost(ControllerPost):
     def _parts(self, name: str, lines: list) -> list[_Program]:
         """The seam's statements in programs of at most line_limit lines (``name``, or
         ``name_1``, ``name_2`` ... called in turn)."""
-        parts = [_Program(name, self.numbers)]
+        parts, limit = [_Program(name, self.numbers)], self.options.line_limit
         for line in lines:
-            if len(parts[-1].lines) + 2 > self.options.line_limit:  # an AO and its move
+            if limit is not None and len(parts[-1].lines) + 2 > limit:  # an AO and its move
                 parts.append(_Program(f"{name}_{len(parts) + 1}", self.numbers))
             parts[-1].add([line])
         if len(parts) > 1:

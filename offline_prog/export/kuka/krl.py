@@ -18,7 +18,12 @@ URDF ``tool0`` (``kuka.X_KE``); B = ``base_link`` = ``$ROBROOT``, taken as ``$WO
 Main program: home (``PTP`` to an ``E6AXIS``), then per seam: the link (``PTP`` through
 its ``E6AXIS`` waypoints, fine points), the approach (``LIN`` to the seam's first
 point), the seam's module (its LIN points with ``C_DIS``, ``$VEL.CP`` the highest
-planned speed on each segment), the retract (``LIN``), and the last link home.
+planned speed on each segment), the retract (``LIN``), and the last link home. With a
+``line_limit`` a seam whose module would be longer (``DEF`` to ``END``) runs as modules
+``<name>_<k>_<j>`` called in turn (``export.split``): each opens with the ``$VEL.CP`` it
+runs at, a ``TRIGGER`` stays with its ``LIN``, the last ``LIN`` of a part keeps its
+``C_DIS`` (the advance run approximates across the call), and ``$OUT`` and the flow's
+factor are globals that the parts share.
 
 Process I/O on the path (KSS 8 System Software, "TRIGGER WHEN PATH"), from the plan's
 I/O events: ``TRIGGER WHEN PATH = −d DELAY = 0 DO $OUT[n] = TRUE`` before a LIN switches
@@ -61,6 +66,7 @@ from offline_prog.export.payload import Principal
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import CartesianPost, PointOptions
 from offline_prog.export.record import JointMove, LinearMove, Process, ProgramRecord, Switch
+from offline_prog.export.split import check_line_limit, split_blocks
 from offline_prog.export.text import krl_comment
 
 ANALOG_FULL_SCALE_V = 10.0  # $ANOUT = ±1 is ±10 V
@@ -70,17 +76,20 @@ PTP_ACC_PERCENT = 100
 ORI_SPEED_MARGIN, ORI_SPEED_MIN_DEG_S = 1.2, 100.0  # $VEL.ORI1/2 vs the planned peak
 FRAMES_SUFFIX = "_frm"  # <name>_frm: the nominal frames (KRL names: ≤ 24 characters)
 MAX_LINE_CHARS = 255  # no published KRL limit; our lines stay far below
+NAME_CHARS = 24  # KRL module names: at most 24 characters
 _ZEROS = ",E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0"
 
 
 @dataclasses.dataclass(frozen=True)
 class KrlOptions(PointOptions):
     """name: the main program (KRL names ≤ 24 characters, 4 kept for ``_<k>``);
-    blend_m: ``C_DIS`` blend distance [m]; tcp_pose_convention: "X_TP" or "X_PF"."""
+    blend_m: ``C_DIS`` blend distance [m]; tcp_pose_convention: "X_TP" or "X_PF";
+    line_limit: most lines (``DEF`` to ``END``) of a seam's module, or None (no split)."""
 
     name: str = "offline_prog"
     blend_m: float = 0.001
     tcp_pose_convention: str = "X_TP"
+    line_limit: int | None = None
 
 
 class KrlPost(CartesianPost):
@@ -93,12 +102,14 @@ class KrlPost(CartesianPost):
 
     def __init__(self, job, options: KrlOptions, **flags):
         super().__init__(job, options, **flags)
+        check_line_limit(options.line_limit)
         self.rule = PointRule(
             "external_tcp", options.tcp_pose_convention, options.chord_tol_m, options.angle_tol_rad
         )
         self.src: list[str] = []  # main program statements after the settings
         self.decl: list[str] = []  # main .dat declarations
-        self.modules: list[tuple[str, Process]] = []
+        # the seams' modules: name, process, its LIN moves m (1 .. n of the process)
+        self.modules: list[tuple[str, Process, range]] = []
         io = job.process_io
         self.flow = io is not None and io.analog_output is not None
         self.factor = f"{options.name.upper()}_FK"  # the flow's factor: live while $OUT is on
@@ -191,17 +202,33 @@ class KrlPost(CartesianPost):
         return f"TRIGGER WHEN PATH={_path(switch)} DELAY=0 DO {self.factor}={krl_num(f, 6)} PRIO=-1"
 
     def call_part(self, process: Process) -> None:
+        """The seam's module, or its parts at the line limit, called in turn."""
         module = f"{self.options.name}_{process.number}"
-        n = len(process.indices) - 1
-        self.src += [f"; Seam {process.seam}: {n} LIN points in {module}", f"{module}( )"]
-        self.modules.append((module, process))
+        speeds = self._lin_speeds(process)
+        n = len(speeds) - 1
+        sizes = [
+            len(process.switches_before(m)) + 1 + (speeds[m] != speeds[m - 1])
+            for m in range(1, n + 1)
+        ]
+        opening = [int(speeds[m] == speeds[m - 1]) for m in range(1, n + 1)]
+        parts = split_blocks(sizes, self.options.line_limit, frame=2, opening=opening)
+        moves = [range(part.start + 1, part.stop + 1) for part in parts]
+        names = [module] if len(parts) == 1 else [f"{module}_{j}" for j in range(1, len(parts) + 1)]
+        if len(names[-1]) > NAME_CHARS:
+            raise ValueError(
+                f"line_limit={self.options.line_limit}: part {names[-1]} is longer than KRL's "
+                f"{NAME_CHARS} characters (shorten name)"
+            )
+        self.src.append(f"; Seam {process.seam}: {n} LIN points in {', '.join(names)}")
+        self.src += [f"{name}( )" for name in names]
+        self.modules += [(name, process, m) for name, m in zip(names, moves, strict=True)]
 
     def footer(self, out_dir: Path) -> list[Path]:
         name, io, rows = self.options.name, self.job.process_io, self.job.job
         ori = _ori_speed(rows)
         main_src = [
             f"DEF {name}( )",
-            *(f"EXT {m}( )" for m, _ in self.modules),
+            *(f"EXT {m}( )" for m, _, _ in self.modules),
             ";FOLD INI",
             "BAS(#INITMOV,0)",
             ";ENDFOLD (INI)",
@@ -226,9 +253,13 @@ class KrlPost(CartesianPost):
             *self.decl,
             "ENDDAT",
         ]
+        limit = self.options.line_limit
+        statements = sum(not line.startswith(";") for line in main_src)
+        if limit is not None and statements > limit:
+            raise ValueError(f"line_limit={limit}: the main program alone needs {statements} lines")
         files = _write(out_dir, name, self.head + main_src, self.head + main_dat)
-        for module, process in self.modules:
-            files += self._seam_module(out_dir, module, process)
+        for module, process, moves in self.modules:
+            files += self._seam_module(out_dir, module, process, moves)
         return files + self._nominal_frames(out_dir)
 
     def _nominal_frames(self, folder: Path) -> list[Path]:
@@ -254,10 +285,20 @@ class KrlPost(CartesianPost):
         """(…, 4, 4) the E6POS of the tool frame T in P: P in T (X_TP) or T in P."""
         return X_PT if self.rule.convention == "X_PF" else np.linalg.inv(X_PT)
 
-    def _seam_module(self, folder: Path, module: str, process: Process) -> list[Path]:
-        """``module.src`` / ``.dat``: the seam's LIN points (the first is where the
-        approach ended: the main .dat's XA<k>), with the switches before the LIN whose
-        motion holds them."""
+    @staticmethod
+    def _lin_speeds(process: Process) -> list[float | None]:
+        """``$VEL.CP`` [m/s] of each LIN m = 1 .. n of the seam (the highest planned
+        speed on its segment, floored to 0.1 mm/s); entry 0 None (no LIN)."""
+        data, idx = process.data, process.indices
+        return [None] + [
+            vel_cp(data.tcp_speed[idx[m - 1] : idx[m] + 1].max()) for m in range(1, len(idx))
+        ]
+
+    def _seam_module(self, folder: Path, module: str, process: Process, moves: range) -> list[Path]:
+        """``module.src`` / ``.dat``: the seam's LIN moves ``moves`` to its points (the
+        seam's first point is where the approach ended: the main .dat's XA<k>), with the
+        switches before the LIN whose motion holds them; ``$VEL.CP`` where it changes
+        and at the module's start."""
         data, idx = process.data, process.indices
         names = [f"XP{k + 1}" for k in range(len(idx))]
         status, turn = status_turn(self.robot.params, data.q[idx])
@@ -265,21 +306,25 @@ class KrlPost(CartesianPost):
             f"DECL E6POS {n}={{{krl_frame(X)},S {s},T {t}{_ZEROS}}}"
             for n, X, s, t in zip(names, self._point(data.X_PT[idx]), status, turn, strict=True)
         ]
+        speeds = self._lin_speeds(process)
         body, v_now = [], None
-        for m in range(1, len(idx)):
-            # $VEL.CP: the highest planned speed on the segment, floored to 0.1 mm/s,
-            # written when it changes; the last LIN stops exactly.
-            v = vel_cp(data.tcp_speed[idx[m - 1] : idx[m] + 1].max())
-            body += [f"$VEL.CP={v:.4f}"] if v != v_now else []
+        for m in moves:
+            # the last LIN of the seam stops exactly
+            body += [f"$VEL.CP={speeds[m]:.4f}"] if speeds[m] != v_now else []
             body += [self.switch(s) for s in process.switches_before(m)]
             body.append(f"LIN {names[m]}" + (" C_DIS" if m < len(idx) - 1 else ""))
-            v_now = v
+            v_now = speeds[m]
         note = [
             f"; Seam {process.seam}: deviation <= {process.max_chord_m * 1e3:.4f} mm, "
             f"{np.rad2deg(process.max_angle_rad):.4f} deg from the plan"
         ]
         src = [f"DEF {module}( )", *body, "END"]
-        dat = [f"DEFDAT {module}", "EXT BAS (BAS_COMMAND :IN,REAL :IN )", *decls[1:], "ENDDAT"]
+        dat = [
+            f"DEFDAT {module}",
+            "EXT BAS (BAS_COMMAND :IN,REAL :IN )",
+            *(decls[m] for m in moves),
+            "ENDDAT",
+        ]
         return _write(folder, module, self.head + note + src, self.head + note + dat)
 
 
