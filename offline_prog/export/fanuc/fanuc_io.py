@@ -33,10 +33,12 @@ import dataclasses
 from collections.abc import Callable
 
 import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
 
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
+DB_STEP_M = 2e-5  # the tool's curve on a DB motion, sampled this finely
 FLOW_STEP_V = 0.05  # a live motion's AO value is within half this of the plan's flow on it
 FLOW_STEP_SHARE = 0.01  # ... and within half this share of it (a low flow on a ramp)
 
@@ -50,12 +52,14 @@ class Samples:
         t: (K,) job time [s].
         q: (K, 6) URDF joints [rad].
         X_BP: (K, 4, 4) the part P in the robot base B.
+        p_BT: (3,) the fixed tool's origin in B [m].
     """
 
     path_m: np.ndarray
     t: np.ndarray
     q: np.ndarray
     X_BP: np.ndarray
+    p_BT: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,12 +145,37 @@ def place_events(
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
         event = on_motion.get(i)
-        before = (
-            0.0 if event is None else float(min(sigma[b] - event.set_path_m, sigma[b] - sigma[a]))
-        )
+        before = 0.0 if event is None else tcp_before_end(samples, a, b, event.set_path_m)
         flow = _flow(samples, a, b, edges, io, flow_at)
-        motions.append(Motion(a, b, event, max(before, 0.0), flow, dict(split).get(a)))
+        motions.append(Motion(a, b, event, before, flow, dict(split).get(a)))
     return motions
+
+
+def tcp_before_end(samples: Samples, a: int, b: int, position: float) -> float:
+    """[m] How far the programmed TCP (P's origin: UTOOL) is from the motion's end b
+    when the tool is at ``position`` [m] on the seam's path: the distance FANUC's DB
+    measures (it sets the output when the TCP enters the sphere of that radius around
+    the motion's destination).
+
+    The controller moves the TCP on the straight chord from sample a to sample b with
+    the orientation slerped; the tool's point on the part then runs a curve whose
+    length from sample a gives the position's share λ of the chord. Where the part
+    turns, this differs from the path's own distance to b: the tool's point on the part
+    moves with the turn times the lever from P's origin.
+    """
+    X_a, X_b = samples.X_BP[a], samples.X_BP[b]
+    length = float(np.linalg.norm(X_b[:3, 3] - X_a[:3, 3]))
+    if length <= SAME_POINT_M:
+        return 0.0
+    turn = Rotation.from_matrix(X_a[:3, :3].T @ X_b[:3, :3]).magnitude()
+    lever = float(np.linalg.norm(samples.p_BT - X_a[:3, 3]))
+    share = np.linspace(0.0, 1.0, int(max(length, turn * lever) / DB_STEP_M) + 2)
+    R = Slerp([0.0, 1.0], Rotation.from_matrix([X_a[:3, :3], X_b[:3, :3]]))(share).as_matrix()
+    p_BP = X_a[:3, 3] + share[:, None] * (X_b[:3, 3] - X_a[:3, 3])
+    p_PT = np.einsum("gji,gj->gi", R, samples.p_BT - p_BP)  # the tool's point on the part
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p_PT, axis=0), axis=1))])
+    at = float(np.interp(position - samples.path_m[a], along, share))
+    return (1.0 - at) * length
 
 
 def _live(samples: Samples, a: int, edges) -> bool:
