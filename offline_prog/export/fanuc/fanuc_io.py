@@ -35,6 +35,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from offline_prog.export.merge import MIN_MOTION_M
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
@@ -112,7 +113,7 @@ def place_events(
     points = sorted(set(points))
     sigma = samples.path_m
     analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
-    split = [(_split(sigma, points, e.set_path_m), e) for e in analog]  # (L point, event)
+    split = [(_split(samples, points, e.set_path_m), e) for e in analog]  # (L point, event)
     edges = [(sigma[i], e.state) for i, e in split]
     digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.set_path_m)
     while (pair := _crowded(sigma, points, digital)) is not None:
@@ -134,9 +135,10 @@ def place_events(
         ends = {points[_motion_of(sigma, points, e.set_path_m)] for e in digital}
         pinned = ends | {i for i, _ in split}
 
-        def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow still flat
+        def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow as coarse
             live = io is not None and io.analog_output is not None and _live(samples, a, edges)
-            return not live or _flat(flow_at(samples.t[a : b + 1]))
+            travel = float(np.linalg.norm(samples.X_BP[b, :3, 3] - samples.X_BP[a, :3, 3]))
+            return not live or _flow_fits(flow_at(samples.t[a : b + 1]), travel)
 
         points = merge(points, pinned, flow_fits)
     on_motion = {_motion_of(sigma, points, e.set_path_m): e for e in digital}
@@ -199,19 +201,32 @@ def _flow(samples, a, b, edges, io, flow_at) -> float | None:
 
 def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
     """Points split so the plan's flow varies by at most FLOW_STEP_V, and by at most
-    FLOW_STEP_SHARE of its value, on a live motion."""
+    FLOW_STEP_SHARE of its value, on a live motion, except that no split makes a
+    motion whose TCP travels less than MIN_MOTION_M: where the tool speeds up from or
+    slows down to rest, the flow steps are as coarse as a 0.5 mm motion needs (a short
+    rest before the next point joins the motion before it)."""
+    p = samples.X_BP[:, :3, 3]
     out = [points[0]]
     for a, b in zip(points, points[1:], strict=False):
         if _live(samples, a, edges):
             values = flow_at(samples.t[a : b + 1])
             start = 0
             for k in range(1, len(values)):
-                moved = samples.path_m[a + k - 1] - samples.path_m[out[-1]] > SAME_POINT_M
-                if not _flat(values[start : k + 1]) and k - 1 > start and moved:
-                    start = k - 1  # no L motion of zero length: at rest the flow waits
+                long = np.linalg.norm(p[a + k - 1] - p[out[-1]]) >= MIN_MOTION_M
+                if not _flat(values[start : k + 1]) and k - 1 > start and long:
+                    start = k - 1
                     out.append(a + start)
+            if out[-1] != a and np.linalg.norm(p[b] - p[out[-1]]) < MIN_MOTION_M:
+                out.pop()  # the short rest to b joins the motion before it
         out.append(b)
     return out
+
+
+def _flow_fits(values: np.ndarray, travel_m: float) -> bool:
+    """Whether a motion whose TCP travels travel_m [m] may hold one flow value over
+    the plan's values (n,) [V]: flat, or no longer than two of the shortest motions
+    ``_flow_splits`` leaves where the flow steps coarsely."""
+    return _flat(values) or travel_m < 2 * MIN_MOTION_M
 
 
 def _flat(values: np.ndarray) -> bool:
@@ -220,12 +235,15 @@ def _flat(values: np.ndarray) -> bool:
     return values.max() - values.min() <= min(FLOW_STEP_V, FLOW_STEP_SHARE * values.max())
 
 
-def _split(sigma: np.ndarray, points: list[int], position: float) -> int:
-    """Make the planned sample nearest ``position`` an L point (in place); its index."""
+def _split(samples: Samples, points: list[int], position: float) -> int:
+    """Make the planned sample nearest ``position`` an L point (in place); its index.
+    An L point already there whose TCP is less than MIN_MOTION_M from that sample's is
+    taken instead (the nearest along the path), so that no motion that short starts."""
+    sigma, p = samples.path_m, samples.X_BP[:, :3, 3]
     i = int(np.argmin(np.abs(sigma - position)))
-    for p in points:
-        if abs(sigma[p] - sigma[i]) <= SAME_POINT_M:
-            return p
+    near = [k for k in points if np.linalg.norm(p[k] - p[i]) < MIN_MOTION_M]
+    if near:
+        return min(near, key=lambda k: abs(sigma[k] - sigma[i]))
     if sigma[points[0]] < sigma[i] < sigma[points[-1]]:
         points.append(i)
         points.sort()
