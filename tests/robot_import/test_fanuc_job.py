@@ -36,6 +36,7 @@ from conftest import with_own_io
 IO_TOL_M = 1e-3
 SWITCH_TOL_M = 0.5e-3  # a DB switch lands this close to the cell's position on the part
 JOINT_TOL_DEG = 1e-3
+REPLAY_STEPS = 16  # the bead replay's time steps per planned row
 FLOW_TOL_V = 0.05  # a motion's AO value against the plan's column on its rows
 IO = (
     "tool:\n  process_io:\n    on:  {digital_output: 2, lead_mm: 3}\n"
@@ -427,11 +428,20 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     ends = np.array([b for _, b, _ in seam["moves"]])
     values = np.array([v for _, _, v in seam["moves"]])
     idle = job.io.settings.idle
-    on_path = np.isfinite(s.path_m)
-    k = np.minimum(np.searchsorted(ends, np.nan_to_num(s.path_m), side="left"), len(ends) - 1)
+    # The controller holds each motion's AO from the motion's start (a step) and the
+    # model's lag takes a piecewise-linear command, so the replay runs on a grid
+    # REPLAY_STEPS times finer than the plan's rows: a step between two rows is then
+    # not smeared over a whole row interval (a motion here is two or three rows long).
+    at = np.arange((len(s.t) - 1) * REPLAY_STEPS + 1) / REPLAY_STEPS
+    t_fine = np.interp(at, np.arange(len(s.t)), s.t)
+    rows_near = np.round(at).astype(int)
+    on_path = np.isfinite(s.path_m)[np.floor(at).astype(int)] & np.isfinite(s.path_m)[rows_near]
+    path = np.interp(t_fine, s.t, np.nan_to_num(s.path_m))
+    k = np.minimum(np.searchsorted(ends, path, side="left"), len(ends) - 1)
     held = np.where(on_path, values[k], idle)
     model = process_model(job.cell.process)
-    bead = model.predict(s.t, job.tcp_speed, held) * model.unit_scale
+    speed = np.interp(t_fine, s.t, job.tcp_speed)
+    bead = (model.predict(t_fine, speed, held) * model.unit_scale)[::REPLAY_STEPS]
     process = next(g for g in s.segments if g.kind == "process")
     rows = np.arange(process.start, process.stop)
     plan = job.quality.column[rows]

@@ -30,11 +30,12 @@ beyond L on the retract), as the events'.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from offline_prog.export.fanuc.fanuc_flow import flow_values
 from offline_prog.export.merge import MIN_MOTION_M
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
@@ -87,6 +88,7 @@ def place_events(
     io: ProcessIo | None,
     flow_at: Callable[[np.ndarray], np.ndarray] | None = None,
     merge: Callable[[list[int], set[int], Callable[[int, int], bool]], list[int]] | None = None,
+    fixed: Collection[int] = (),
 ) -> list[Motion]:
     """The seam's ``L`` motions with its events on them, split at planned samples.
 
@@ -102,6 +104,8 @@ def place_events(
             the points it must keep (the digital events' motion ends, the flow's
             edges) and whether the plan's flow allows a motion from sample a to b (as
             flat as the splits make it) ↦ the points left (None: no merging).
+        fixed: points no merge may drop (the seam's FINE ends): a flow edge less than
+            MIN_MOTION_M from one of them (or from the chain's ends) starts there.
 
     Returns:
         The motions in run order (at most one digital event each).
@@ -113,7 +117,8 @@ def place_events(
     points = sorted(set(points))
     sigma = samples.path_m
     analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
-    split = [(_split(samples, points, e.set_path_m), e) for e in analog]  # (L point, event)
+    fixed = {points[0], points[-1], *fixed}
+    split = [(_split(samples, points, e.set_path_m, fixed), e) for e in analog]  # (L point, event)
     edges = [(sigma[i], e.state) for i, e in split]
     digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.set_path_m)
     while (pair := _crowded(sigma, points, digital)) is not None:
@@ -143,13 +148,16 @@ def place_events(
         points = merge(points, pinned, flow_fits)
     on_motion = {_motion_of(sigma, points, e.set_path_m): e for e in digital}
     assert len(on_motion) == len(digital), "one digital event per motion"
+    flows = [None] * (len(points) - 1)
+    if io is not None and io.analog_output is not None:
+        live = [_live(samples, a, edges) for a in points[:-1]]
+        flows = flow_values(samples, points, live, io, flow_at, windows=_windows(analog))
     motions = []
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
         event = on_motion.get(i)
         before = 0.0 if event is None else tcp_before_end(samples, a, b, event.set_path_m)
-        flow = _flow(samples, a, b, edges, io, flow_at)
-        motions.append(Motion(a, b, event, before, flow, dict(split).get(a)))
+        motions.append(Motion(a, b, event, before, flows[i - 1], dict(split).get(a)))
     return motions
 
 
@@ -180,6 +188,19 @@ def tcp_before_end(samples: Samples, a: int, b: int, position: float) -> float:
     return (1.0 - at) * length
 
 
+def _windows(analog: list[IoEvent]) -> list[tuple[float, float]]:
+    """The plan's live flow as [(t_on, t_off), ...] job times [s] (t_off inf: live to
+    the end) from its analog events."""
+    windows, start = [], None
+    for event in sorted(analog, key=lambda e: e.t_s):
+        if event.state and start is None:
+            start = event.t_s
+        elif not event.state and start is not None:
+            windows.append((start, event.t_s))
+            start = None
+    return windows if start is None else [*windows, (start, np.inf)]
+
+
 def _live(samples: Samples, a: int, edges) -> bool:
     """Whether the flow is live on the motion from sample a (the edges before it)."""
     live = False
@@ -187,16 +208,6 @@ def _live(samples: Samples, a: int, edges) -> bool:
         if position <= samples.path_m[a] + SAME_POINT_M:
             live = state
     return live
-
-
-def _flow(samples, a, b, edges, io, flow_at) -> float | None:
-    """The flow while the motion a → b runs: live between the edges, else idle."""
-    if io is None or io.analog_output is None:
-        return None
-    if not _live(samples, a, edges):
-        return io.idle
-    values = flow_at(samples.t[a : b + 1])
-    return float(values.max() + values.min()) / 2
 
 
 def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
@@ -235,13 +246,16 @@ def _flat(values: np.ndarray) -> bool:
     return values.max() - values.min() <= min(FLOW_STEP_V, FLOW_STEP_SHARE * values.max())
 
 
-def _split(samples: Samples, points: list[int], position: float) -> int:
+def _split(samples: Samples, points: list[int], position: float, fixed: Collection[int]) -> int:
     """Make the planned sample nearest ``position`` an L point (in place); its index.
-    An L point already there whose TCP is less than MIN_MOTION_M from that sample's is
-    taken instead (the nearest along the path), so that no motion that short starts."""
+    A fixed point (one no merge may drop) whose TCP is less than MIN_MOTION_M from that
+    sample's is taken instead (the nearest along the path), so that no motion that
+    short stays; from any other point the merge may take the short motion away."""
     sigma, p = samples.path_m, samples.X_BP[:, :3, 3]
     i = int(np.argmin(np.abs(sigma - position)))
-    near = [k for k in points if np.linalg.norm(p[k] - p[i]) < MIN_MOTION_M]
+    if any(abs(sigma[k] - sigma[i]) <= SAME_POINT_M for k in points):
+        return next(k for k in points if abs(sigma[k] - sigma[i]) <= SAME_POINT_M)
+    near = [k for k in fixed if np.linalg.norm(p[k] - p[i]) < MIN_MOTION_M]
     if near:
         return min(near, key=lambda k: abs(sigma[k] - sigma[i]))
     if sigma[points[0]] < sigma[i] < sigma[points[-1]]:

@@ -275,6 +275,7 @@ class _Chain:
                 io=io,
                 flow_at=_flow_at(job),
                 merge=merge,
+                fixed={n_a, n_p},
             )
         except ValueError as error:  # the cell's switch positions: one line, exit 2
             raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
