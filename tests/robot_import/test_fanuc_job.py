@@ -423,6 +423,8 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
 
     data, folder, robot, job = bead_stripe
     write_fanuc_job(data, tmp_path)
+    for _, motions in _seam_motions(tmp_path):  # coarser flow steps near rest, no short one
+        _assert_no_short_motion(motions)
     (seam,) = _walk(data, tmp_path, robot)
     s = job.samples
     ends = np.array([b for _, b, _ in seam["moves"]])
@@ -495,11 +497,9 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
     """Issue 42: the seam programs read back, the tool's curve on the part while the
     controller moves P linearly (slerp) between their points reconstructed, and the
     plan's continuous path (its dense grid) compared with it: within the chord
-    tolerance. A motion shorter than 0.5 mm is left only where the plan needs its
-    point: a flow step (an AO statement at either end), a switch (DB) or a FINE end;
-    none is written slower than the plan runs it."""
+    tolerance. No motion is shorter than 0.5 mm: not a flow step, a switch (DB) or a
+    FINE end either."""
     from offline_prog.export.density import DEFAULT_CHORD_TOL_M
-    from offline_prog.export.merge import MIN_MOTION_M
 
     data, _, _, _ = fanuc_job
     write_fanuc_job(data, tmp_path)
@@ -517,10 +517,15 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
         planned = data.seams[k].X_PT_dense[:, :3, 3]
         gap, _ = cKDTree(np.concatenate(curve)).query(planned)
         assert gap.max() <= DEFAULT_CHORD_TOL_M + 1e-5, gap.max()  # + the curve's spacing
-        for (statement, X, around), (_, X_prev, _) in zip(motions[1:], motions, strict=False):
-            if np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) < MIN_MOTION_M:
-                needed = "DB" in statement or "FINE" in statement
-                assert needed or any(line.startswith("AO[") for line in around), statement
+        _assert_no_short_motion(motions)
+
+
+def _assert_no_short_motion(motions) -> None:
+    """No L motion of a seam program (``_seam_motions``) moves the TCP less than 0.5 mm."""
+    from offline_prog.export.merge import MIN_MOTION_M
+
+    for (statement, X, _), (_, X_prev, _) in zip(motions[1:], motions, strict=False):
+        assert np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) >= MIN_MOTION_M, statement
 
 
 def test_fanuc_approach_and_retract_run_at_the_planned_speed(fanuc_job, tmp_path):

@@ -27,9 +27,11 @@ Process I/O, translated from the plan's I/O events (``io_events``), placed by
 
 - the digital output: FANUC's distance-before motion option on the motion whose end the
   event precedes, ``L P[i] ... DB d mm,DO[n]=ON`` (the output is set when the TCP comes
-  within d of the destination: on these straight ``L`` moves, d before the end along the
-  path). A motion takes one DB option: where two switches fall on one motion it is
-  split at a planned sample between them.
+  within d of the destination). The TCP is UTOOL's point, P's origin, not the tool's
+  point on the part, so d is the TCP's distance to the destination where the tool is at
+  the event's position on the seam (``fanuc_io.tcp_before_end``): where the part turns,
+  that differs from the distance along the seam. A motion takes one DB option: where two
+  switches fall on one motion it is split at a planned sample between them.
 - the flow: plain ``AO[n]=value`` statements before the motion they hold for; the value
   takes effect when the statement runs, as that motion starts (a motion starts at each
   flow edge: the planned sample nearest it is an ``L`` point). While the output is on
@@ -37,8 +39,10 @@ Process I/O, translated from the plan's I/O events (``io_events``), placed by
   output's switches, since FANUC does not lead by the dispenser's lag itself) each
   motion's value is the plan's flow (offset + per_mps · v, clipped, at the speed the
   tool has ``lag_s`` later) within ``fanuc_io.FLOW_STEP_V`` / 2 (a planned sample
-  starts a new motion where the speed changes more); otherwise ``AO[n]`` is the idle
-  value (``ProcessIo.idle``), set once at the program's start.
+  starts a new motion where the speed changes more, but no motion shorter than 0.5 mm:
+  near rest the steps are coarser and ``fanuc_flow`` picks values the dispenser's lag
+  smooths into the plan's flow); otherwise ``AO[n]`` is the idle value
+  (``ProcessIo.idle``), set once at the program's start.
 A time-before trigger (``TB t sec,...``) is not used: the events are distances.
 """
 
@@ -148,8 +152,9 @@ class FanucPost(ControllerPost):
             lines.append(
                 f"Process output DO[{io.digital_output}]: DB (distance before), on "
                 f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
-                f"{io.off_lead_m * 1e3:g} mm before its end; one DB per motion (split at "
-                "planned samples)."
+                f"{io.off_lead_m * 1e3:g} mm before its end; DB is the TCP's (P origin's) "
+                "distance to the motion's end there; one DB per motion (split at planned "
+                "samples)."
             )
         if io is not None and io.analog_output is not None:
             lines.append(
