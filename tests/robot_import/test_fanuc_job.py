@@ -34,7 +34,9 @@ from offline_prog.robot_import.run import import_robot
 from conftest import with_own_io
 
 IO_TOL_M = 1e-3
+SWITCH_TOL_M = 0.5e-3  # a DB switch lands this close to the cell's position on the part
 JOINT_TOL_DEG = 1e-3
+REPLAY_STEPS = 16  # the bead replay's time steps per planned row
 FLOW_TOL_V = 0.05  # a motion's AO value against the plan's column on its rows
 IO = (
     "tool:\n  process_io:\n    on:  {digital_output: 2, lead_mm: 3}\n"
@@ -148,14 +150,29 @@ def nominal_frames(folder, robot, name="OFFLINE_PROG"):
     return frames
 
 
+def _tool_curve(X_a: np.ndarray, X_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The controller's L motion from pose X_a to X_b (4, 4) of P in the user frame T:
+    (G,) shares λ of the TCP's (P's origin) straight chord and (G, 3) the tool's point
+    (T's origin) on the part there, the orientation slerped, 0.05 mm apart or closer."""
+    length = np.linalg.norm(X_b[:3, 3] - X_a[:3, 3])
+    turn = np.linalg.norm(Rotation.from_matrix(X_a[:3, :3].T @ X_b[:3, :3]).as_rotvec())
+    lam = np.linspace(0.0, 1.0, max(2, int(max(length, turn) / 5e-5) + 2))
+    R = Slerp([0, 1], Rotation.from_matrix([X_a[:3, :3], X_b[:3, :3]]))(lam).as_matrix()
+    p = X_a[:3, 3] + lam[:, None] * (X_b[:3, 3] - X_a[:3, 3])
+    return lam, np.einsum("gji,gj->gi", R, -p)
+
+
 def _walk(data, folder, robot):
     """Replays the program: per seam (in run order), the DB switches as (output, state,
     position [m]) and the L motions as (start, end [m], AO value), positions along the
     tool's path on the part from the seam's start, from the program's own poses in the
-    frames the frames program sets."""
+    frames the frames program sets. The controller moves P's origin (the TCP UTOOL
+    names) on a straight line with the orientation slerped, and sets a DB output when
+    that TCP comes within the DB distance of the motion's end: the switch lands where
+    the tool's point on the part is then."""
     frames = nominal_frames(folder, robot)
     (uf, X_BT), (ut, X_EP) = frames["UFRAME"], frames["UTOOL"]
-    X_PE, p_BT = np.linalg.inv(X_EP), X_BT[:3, 3]
+    X_PE, X_TB = np.linalg.inv(X_EP), np.linalg.inv(X_BT)
     here, cumulative, ao, seams = None, 0.0, None, []
     starts = [seam.X_PT[0, :3, 3] for seam in data.seams]  # the seams' planned starts
     for statement, entry in _run(folder):
@@ -171,8 +188,7 @@ def _walk(data, folder, robot):
             X_BE = X_BT @ pose(entry["xyzwpr"]) @ X_PE
             q = joints_from_config(robot, X_BE, entry["config"], entry["turns"])
             np.testing.assert_allclose(robot.forward(q[None])[0], X_BE, atol=1e-9)
-        X_BP = X_BE @ X_EP
-        p_PT = X_BP[:3, :3].T @ (p_BT - X_BP[:3, 3])  # the fixed tool's point on the part
+        X_TP = X_TB @ X_BE @ X_EP
         if statement.startswith("J "):
             if seams and "open" in seams[-1]:
                 del seams[-1]["open"]
@@ -180,17 +196,23 @@ def _walk(data, folder, robot):
         else:
             if not seams or "open" not in seams[-1]:
                 seams.append({"open": True, "db": [], "moves": []})
-            step = np.linalg.norm(p_PT - here)
-            seams[-1]["moves"].append((cumulative, cumulative + step, ao))
+            lam, curve = _tool_curve(here, X_TP)
+            along = np.concatenate(
+                [[0.0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))]
+            )
+            seams[-1]["moves"].append((cumulative, cumulative + along[-1], ao))
             assert len(re.findall(r"\bDB\b", statement)) <= 1, statement
             if m := re.search(r"DB ([\d.]+)mm,DO\[(\d+)\]=(ON|OFF)", statement):
-                d = float(m[1]) * 1e-3
-                seams[-1]["db"].append((int(m[2]), m[3] == "ON", cumulative + step - d))
-            cumulative += step
+                chord = np.linalg.norm(X_TP[:3, 3] - here[:3, 3])
+                at = 1.0 - min(float(m[1]) * 1e-3 / chord, 1.0) if chord > 0 else 1.0
+                seams[-1]["db"].append(
+                    (int(m[2]), m[3] == "ON", cumulative + np.interp(at, lam, along))
+                )
+            cumulative += along[-1]
             start = starts[len(seams) - 1]
-            if "zero" not in seams[-1] and np.linalg.norm(p_PT - start) < 1e-6:
+            if "zero" not in seams[-1] and np.linalg.norm(curve[-1] - start) < 1e-6:
                 seams[-1]["zero"] = cumulative  # the approach ends at the seam's start
-        here = p_PT
+        here = X_TP
     for seam in seams:
         zero = seam.pop("zero")
         seam["db"] = [(n, s, p - zero) for n, s, p in seam["db"]]
@@ -234,8 +256,8 @@ def _check_job(data, folder, robot, cell):
     for k, seam in enumerate(seams):
         on, off = -io.on.lead_mm * 1e-3, data.seam_lengths_m[k] - io.off.lead_mm * 1e-3
         assert [(n, s) for n, s, _ in seam["db"]] == [(2, True), (2, False)]
-        assert seam["db"][0][2] == pytest.approx(on, abs=IO_TOL_M)
-        assert seam["db"][1][2] == pytest.approx(off, abs=IO_TOL_M)
+        assert seam["db"][0][2] == pytest.approx(on, abs=SWITCH_TOL_M)
+        assert seam["db"][1][2] == pytest.approx(off, abs=SWITCH_TOL_M)
         # The flow (lag 0): live from the on switch to the off switch, idle outside.
         flow = io.flow
         for a, b, v in seam["moves"]:
@@ -256,8 +278,8 @@ def test_fanuc_keeps_both_switches_on_a_straight_seam(stripe, tmp_path):
     (seam,) = _walk(data, tmp_path, robot)
     on, off = -ON_LEAD_MM * 1e-3, LENGTH_M - OFF_LEAD_MM * 1e-3
     assert [(n, s) for n, s, _ in seam["db"]] == [(1, True), (1, False)]
-    assert seam["db"][0][2] == pytest.approx(on, abs=IO_TOL_M)
-    assert seam["db"][1][2] == pytest.approx(off, abs=IO_TOL_M)
+    assert seam["db"][0][2] == pytest.approx(on, abs=SWITCH_TOL_M)
+    assert seam["db"][1][2] == pytest.approx(off, abs=SWITCH_TOL_M)
     statements = [s for f in tmp_path.glob("*.ls") for s in read_ls(f)["mn"]]
     assert sum("DO[" in s for s in statements if not s.startswith("!")) == 2  # not the flow
     # The flow goes live lag_s ahead of the on switch (at the stripe's speed), and is
@@ -313,8 +335,41 @@ def test_fanuc_switches_where_the_events_say(stripe, positions_mm):
         (seam,) = _walk(data, Path(folder), robot)
     assert [s for _, s, _ in seam["db"]] == [k % 2 == 0 for k in range(len(positions_mm))]
     assert [p for _, _, p in seam["db"]] == [
-        pytest.approx(p * 1e-3, abs=IO_TOL_M) for p in positions_mm
+        pytest.approx(p * 1e-3, abs=SWITCH_TOL_M) for p in positions_mm
     ]
+
+
+def test_fanuc_switches_land_where_the_part_turns(fanuc_job):
+    """Issue 37: FANUC's DB measures the programmed TCP (P's origin, UTOOL), not the
+    tool's point on the part. On/off pairs every few millimetres around the plate's
+    seam, corners included: each switch, replayed from the program text (the TCP on its
+    chord, the orientation slerped, the output set where the TCP comes within the DB
+    distance of the motion's end), lands within ±0.5 mm of its position on the part."""
+    data, _, robot, _ = fanuc_job
+    name, length = data.seam_names[0], data.seam_lengths_m[0]
+    positions = np.linspace(0.002, length - 0.002, 60)
+    events = tuple(
+        IoEvent(name, Signal.DIGITAL, 2, k % 2 == 0, float(k % 2 == 0), p, 0.0, p)
+        for k, p in enumerate(positions)
+    )
+    analog = tuple(e for e in data.events if e.signal is Signal.ANALOG)
+    seam_data = data.seams[0]
+    dense = seam_data.X_PT_dense
+    # The part turns near the switches: the tool's heading on the part changes by more
+    # than 10° within 5 mm of several of them (the corners).
+    heading = np.gradient(dense[:, :3, 3], seam_data.path_dense_m, axis=0)
+    heading /= np.linalg.norm(heading, axis=1, keepdims=True)
+    turns = 0
+    for p in positions:
+        near = np.abs(seam_data.path_dense_m - p) < 5e-3
+        turns += np.degrees(np.arccos(np.clip(heading[near] @ heading[near][0], -1, 1))).max() > 10
+    assert turns >= 4
+    with tempfile.TemporaryDirectory() as folder:
+        write_fanuc_job(dataclasses.replace(data, events=events + analog), Path(folder))
+        seam = _walk(data, Path(folder), robot)[0]
+    assert [s for _, s, _ in seam["db"]] == [k % 2 == 0 for k in range(len(positions))]
+    landed = np.array([p for _, _, p in seam["db"]])
+    assert np.abs(landed - positions).max() <= SWITCH_TOL_M
 
 
 def test_fanuc_refuses_switches_no_sample_separates(stripe, tmp_path):
@@ -377,16 +432,27 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
 
     data, folder, robot, job = bead_stripe
     write_fanuc_job(data, tmp_path)
+    for _, motions in _seam_motions(tmp_path):  # coarser flow steps near rest, no short one
+        _assert_no_short_motion(motions)
     (seam,) = _walk(data, tmp_path, robot)
     s = job.samples
     ends = np.array([b for _, b, _ in seam["moves"]])
     values = np.array([v for _, _, v in seam["moves"]])
     idle = job.io.settings.idle
-    on_path = np.isfinite(s.path_m)
-    k = np.minimum(np.searchsorted(ends, np.nan_to_num(s.path_m), side="left"), len(ends) - 1)
+    # The controller holds each motion's AO from the motion's start (a step) and the
+    # model's lag takes a piecewise-linear command, so the replay runs on a grid
+    # REPLAY_STEPS times finer than the plan's rows: a step between two rows is then
+    # not smeared over a whole row interval (a motion here is two or three rows long).
+    at = np.arange((len(s.t) - 1) * REPLAY_STEPS + 1) / REPLAY_STEPS
+    t_fine = np.interp(at, np.arange(len(s.t)), s.t)
+    rows_near = np.round(at).astype(int)
+    on_path = np.isfinite(s.path_m)[np.floor(at).astype(int)] & np.isfinite(s.path_m)[rows_near]
+    path = np.interp(t_fine, s.t, np.nan_to_num(s.path_m))
+    k = np.minimum(np.searchsorted(ends, path, side="left"), len(ends) - 1)
     held = np.where(on_path, values[k], idle)
     model = process_model(job.cell.process)
-    bead = model.predict(s.t, job.tcp_speed, held) * model.unit_scale
+    speed = np.interp(t_fine, s.t, job.tcp_speed)
+    bead = (model.predict(t_fine, speed, held) * model.unit_scale)[::REPLAY_STEPS]
     process = next(g for g in s.segments if g.kind == "process")
     rows = np.arange(process.start, process.stop)
     plan = job.quality.column[rows]
@@ -440,11 +506,9 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
     """Issue 42: the seam programs read back, the tool's curve on the part while the
     controller moves P linearly (slerp) between their points reconstructed, and the
     plan's continuous path (its dense grid) compared with it: within the chord
-    tolerance. A motion shorter than 0.5 mm is left only where the plan needs its
-    point: a flow step (an AO statement at either end), a switch (DB) or a FINE end;
-    none is written slower than the plan runs it."""
+    tolerance. No motion is shorter than 0.5 mm: not a flow step, a switch (DB) or a
+    FINE end either."""
     from offline_prog.export.density import DEFAULT_CHORD_TOL_M
-    from offline_prog.export.merge import MIN_MOTION_M
 
     data, _, _, _ = fanuc_job
     write_fanuc_job(data, tmp_path)
@@ -462,10 +526,51 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
         planned = data.seams[k].X_PT_dense[:, :3, 3]
         gap, _ = cKDTree(np.concatenate(curve)).query(planned)
         assert gap.max() <= DEFAULT_CHORD_TOL_M + 1e-5, gap.max()  # + the curve's spacing
-        for (statement, X, around), (_, X_prev, _) in zip(motions[1:], motions, strict=False):
-            if np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) < MIN_MOTION_M:
-                needed = "DB" in statement or "FINE" in statement
-                assert needed or any(line.startswith("AO[") for line in around), statement
+        _assert_no_short_motion(motions)
+
+
+def _assert_no_short_motion(motions) -> None:
+    """No L motion of a seam program (``_seam_motions``) moves the TCP less than 0.5 mm."""
+    from offline_prog.export.merge import MIN_MOTION_M
+
+    for (statement, X, _), (_, X_prev, _) in zip(motions[1:], motions, strict=False):
+        assert np.linalg.norm(X[:3, 3] - X_prev[:3, 3]) >= MIN_MOTION_M, statement
+
+
+def test_fanuc_approach_and_retract_run_at_the_planned_speed(fanuc_job, tmp_path):
+    """Issue 37: each approach and retract ``L`` motion, read back, is written at the
+    plan's mean speed of P's origin between its two points (the planned rows its
+    positions are), whole mm/sec in FANUC's [1, 2000]: at most the approach speed,
+    slower on its ramps from and to rest; never the cruise speed on a ramp."""
+    data, _, robot, _ = fanuc_job
+    write_fanuc_job(data, tmp_path)
+    rows, segments = data.job, {g.kind: g for g in data.segments}
+    p_BP = (rows.X_BE @ rows.X_EP)[:, :3, 3]
+    frames = nominal_frames(tmp_path, robot)
+    X_BT = frames["UFRAME"][1]
+    checked = []
+    for kind in ("approach", "retract"):
+        g = segments[kind]
+        own = np.arange(g.start - 1, g.stop + 1)  # the link's last row, the next's first
+        written = []
+        for statement, entry in _run(tmp_path):
+            if not statement.startswith("L "):
+                continue
+            p = (X_BT @ pose(entry["xyzwpr"]))[:3, 3]
+            gap = np.linalg.norm(p_BP[own] - p, axis=1)
+            if gap.min() < 2e-6:
+                speed = int(re.search(r"(\d+)mm/sec", statement)[1])
+                written.append((int(own[np.argmin(gap)]), speed))
+        assert len(written) >= 2, kind
+        for (a, _), (b, speed) in zip(written, written[1:], strict=False):
+            if b <= a:
+                continue  # a seam sample that is also a retract row
+            planned = np.linalg.norm(p_BP[b] - p_BP[a]) / (rows.t[b] - rows.t[a]) * 1e3
+            assert speed == np.clip(round(planned), 1, 2000), (kind, a, b, planned)
+            checked.append(speed)
+    cruise = round(data.job.off_seam_speed_m_s * 1e3)
+    assert max(checked) <= cruise + 1  # the approach speed, where a motion cruises
+    assert min(checked) < 0.5 * cruise  # the ramps are written as planned
 
 
 def test_fanuc_ao_in_counts_is_the_volts_times_the_cells_counts_per_volt(stripe, tmp_path):

@@ -30,13 +30,17 @@ beyond L on the retract), as the events'.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 
 import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
 
+from offline_prog.export.fanuc.fanuc_flow import flow_values
+from offline_prog.export.merge import MIN_MOTION_M
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 
 SAME_POINT_M = 1e-6  # a sample this close to an L point is that point
+DB_STEP_M = 2e-5  # the tool's curve on a DB motion, sampled this finely
 FLOW_STEP_V = 0.05  # a live motion's AO value is within half this of the plan's flow on it
 FLOW_STEP_SHARE = 0.01  # ... and within half this share of it (a low flow on a ramp)
 
@@ -50,12 +54,14 @@ class Samples:
         t: (K,) job time [s].
         q: (K, 6) URDF joints [rad].
         X_BP: (K, 4, 4) the part P in the robot base B.
+        p_BT: (3,) the fixed tool's origin in B [m].
     """
 
     path_m: np.ndarray
     t: np.ndarray
     q: np.ndarray
     X_BP: np.ndarray
+    p_BT: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -82,6 +88,7 @@ def place_events(
     io: ProcessIo | None,
     flow_at: Callable[[np.ndarray], np.ndarray] | None = None,
     merge: Callable[[list[int], set[int], Callable[[int, int], bool]], list[int]] | None = None,
+    fixed: Collection[int] = (),
 ) -> list[Motion]:
     """The seam's ``L`` motions with its events on them, split at planned samples.
 
@@ -97,6 +104,8 @@ def place_events(
             the points it must keep (the digital events' motion ends, the flow's
             edges) and whether the plan's flow allows a motion from sample a to b (as
             flat as the splits make it) ↦ the points left (None: no merging).
+        fixed: points no merge may drop (the seam's FINE ends): a flow edge less than
+            MIN_MOTION_M from one of them (or from the chain's ends) starts there.
 
     Returns:
         The motions in run order (at most one digital event each).
@@ -108,7 +117,8 @@ def place_events(
     points = sorted(set(points))
     sigma = samples.path_m
     analog = sorted((e for e in events if e.signal is Signal.ANALOG), key=lambda e: e.set_path_m)
-    split = [(_split(sigma, points, e.set_path_m), e) for e in analog]  # (L point, event)
+    fixed = {points[0], points[-1], *fixed}
+    split = [(_split(samples, points, e.set_path_m, fixed), e) for e in analog]  # (L point, event)
     edges = [(sigma[i], e.state) for i, e in split]
     digital = sorted((e for e in events if e.signal is Signal.DIGITAL), key=lambda e: e.set_path_m)
     while (pair := _crowded(sigma, points, digital)) is not None:
@@ -130,23 +140,65 @@ def place_events(
         ends = {points[_motion_of(sigma, points, e.set_path_m)] for e in digital}
         pinned = ends | {i for i, _ in split}
 
-        def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow still flat
+        def flow_fits(a: int, b: int) -> bool:  # a merged live motion's flow as coarse
             live = io is not None and io.analog_output is not None and _live(samples, a, edges)
-            return not live or _flat(flow_at(samples.t[a : b + 1]))
+            travel = float(np.linalg.norm(samples.X_BP[b, :3, 3] - samples.X_BP[a, :3, 3]))
+            return not live or _flow_fits(flow_at(samples.t[a : b + 1]), travel)
 
         points = merge(points, pinned, flow_fits)
     on_motion = {_motion_of(sigma, points, e.set_path_m): e for e in digital}
     assert len(on_motion) == len(digital), "one digital event per motion"
+    flows = [None] * (len(points) - 1)
+    if io is not None and io.analog_output is not None:
+        live = [_live(samples, a, edges) for a in points[:-1]]
+        flows = flow_values(samples, points, live, io, flow_at, windows=_windows(analog))
     motions = []
     for i in range(1, len(points)):
         a, b = points[i - 1], points[i]
         event = on_motion.get(i)
-        before = (
-            0.0 if event is None else float(min(sigma[b] - event.set_path_m, sigma[b] - sigma[a]))
-        )
-        flow = _flow(samples, a, b, edges, io, flow_at)
-        motions.append(Motion(a, b, event, max(before, 0.0), flow, dict(split).get(a)))
+        before = 0.0 if event is None else tcp_before_end(samples, a, b, event.set_path_m)
+        motions.append(Motion(a, b, event, before, flows[i - 1], dict(split).get(a)))
     return motions
+
+
+def tcp_before_end(samples: Samples, a: int, b: int, position: float) -> float:
+    """[m] How far the programmed TCP (P's origin: UTOOL) is from the motion's end b
+    when the tool is at ``position`` [m] on the seam's path: the distance FANUC's DB
+    measures (it sets the output when the TCP enters the sphere of that radius around
+    the motion's destination).
+
+    The controller moves the TCP on the straight chord from sample a to sample b with
+    the orientation slerped; the tool's point on the part then runs a curve whose
+    length from sample a gives the position's share λ of the chord. Where the part
+    turns, this differs from the path's own distance to b: the tool's point on the part
+    moves with the turn times the lever from P's origin.
+    """
+    X_a, X_b = samples.X_BP[a], samples.X_BP[b]
+    length = float(np.linalg.norm(X_b[:3, 3] - X_a[:3, 3]))
+    if length <= SAME_POINT_M:
+        return 0.0
+    turn = Rotation.from_matrix(X_a[:3, :3].T @ X_b[:3, :3]).magnitude()
+    lever = float(np.linalg.norm(samples.p_BT - X_a[:3, 3]))
+    share = np.linspace(0.0, 1.0, int(max(length, turn * lever) / DB_STEP_M) + 2)
+    R = Slerp([0.0, 1.0], Rotation.from_matrix([X_a[:3, :3], X_b[:3, :3]]))(share).as_matrix()
+    p_BP = X_a[:3, 3] + share[:, None] * (X_b[:3, 3] - X_a[:3, 3])
+    p_PT = np.einsum("gji,gj->gi", R, samples.p_BT - p_BP)  # the tool's point on the part
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p_PT, axis=0), axis=1))])
+    at = float(np.interp(position - samples.path_m[a], along, share))
+    return (1.0 - at) * length
+
+
+def _windows(analog: list[IoEvent]) -> list[tuple[float, float]]:
+    """The plan's live flow as [(t_on, t_off), ...] job times [s] (t_off inf: live to
+    the end) from its analog events."""
+    windows, start = [], None
+    for event in sorted(analog, key=lambda e: e.t_s):
+        if event.state and start is None:
+            start = event.t_s
+        elif not event.state and start is not None:
+            windows.append((start, event.t_s))
+            start = None
+    return windows if start is None else [*windows, (start, np.inf)]
 
 
 def _live(samples: Samples, a: int, edges) -> bool:
@@ -158,31 +210,34 @@ def _live(samples: Samples, a: int, edges) -> bool:
     return live
 
 
-def _flow(samples, a, b, edges, io, flow_at) -> float | None:
-    """The flow while the motion a → b runs: live between the edges, else idle."""
-    if io is None or io.analog_output is None:
-        return None
-    if not _live(samples, a, edges):
-        return io.idle
-    values = flow_at(samples.t[a : b + 1])
-    return float(values.max() + values.min()) / 2
-
-
 def _flow_splits(samples: Samples, points: list[int], edges, flow_at) -> list[int]:
     """Points split so the plan's flow varies by at most FLOW_STEP_V, and by at most
-    FLOW_STEP_SHARE of its value, on a live motion."""
+    FLOW_STEP_SHARE of its value, on a live motion, except that no split makes a
+    motion whose TCP travels less than MIN_MOTION_M: where the tool speeds up from or
+    slows down to rest, the flow steps are as coarse as a 0.5 mm motion needs (a short
+    rest before the next point joins the motion before it)."""
+    p = samples.X_BP[:, :3, 3]
     out = [points[0]]
     for a, b in zip(points, points[1:], strict=False):
         if _live(samples, a, edges):
             values = flow_at(samples.t[a : b + 1])
             start = 0
             for k in range(1, len(values)):
-                moved = samples.path_m[a + k - 1] - samples.path_m[out[-1]] > SAME_POINT_M
-                if not _flat(values[start : k + 1]) and k - 1 > start and moved:
-                    start = k - 1  # no L motion of zero length: at rest the flow waits
+                long = np.linalg.norm(p[a + k - 1] - p[out[-1]]) >= MIN_MOTION_M
+                if not _flat(values[start : k + 1]) and k - 1 > start and long:
+                    start = k - 1
                     out.append(a + start)
+            if out[-1] != a and np.linalg.norm(p[b] - p[out[-1]]) < MIN_MOTION_M:
+                out.pop()  # the short rest to b joins the motion before it
         out.append(b)
     return out
+
+
+def _flow_fits(values: np.ndarray, travel_m: float) -> bool:
+    """Whether a motion whose TCP travels travel_m [m] may hold one flow value over
+    the plan's values (n,) [V]: flat, or no longer than two of the shortest motions
+    ``_flow_splits`` leaves where the flow steps coarsely."""
+    return _flat(values) or travel_m < 2 * MIN_MOTION_M
 
 
 def _flat(values: np.ndarray) -> bool:
@@ -191,12 +246,18 @@ def _flat(values: np.ndarray) -> bool:
     return values.max() - values.min() <= min(FLOW_STEP_V, FLOW_STEP_SHARE * values.max())
 
 
-def _split(sigma: np.ndarray, points: list[int], position: float) -> int:
-    """Make the planned sample nearest ``position`` an L point (in place); its index."""
+def _split(samples: Samples, points: list[int], position: float, fixed: Collection[int]) -> int:
+    """Make the planned sample nearest ``position`` an L point (in place); its index.
+    A fixed point (one no merge may drop) whose TCP is less than MIN_MOTION_M from that
+    sample's is taken instead (the nearest along the path), so that no motion that
+    short stays; from any other point the merge may take the short motion away."""
+    sigma, p = samples.path_m, samples.X_BP[:, :3, 3]
     i = int(np.argmin(np.abs(sigma - position)))
-    for p in points:
-        if abs(sigma[p] - sigma[i]) <= SAME_POINT_M:
-            return p
+    if any(abs(sigma[k] - sigma[i]) <= SAME_POINT_M for k in points):
+        return next(k for k in points if abs(sigma[k] - sigma[i]) <= SAME_POINT_M)
+    near = [k for k in fixed if np.linalg.norm(p[k] - p[i]) < MIN_MOTION_M]
+    if near:
+        return min(near, key=lambda k: abs(sigma[k] - sigma[i]))
     if sigma[points[0]] < sigma[i] < sigma[points[-1]]:
         points.append(i)
         points.sort()

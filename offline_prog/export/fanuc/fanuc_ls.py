@@ -11,7 +11,8 @@ frame, X_TP = X_BT⁻¹ · X_BE · X_EP; the nominal values of the two frames ar
 ``<name>_FRAMES.ls`` only. The controller interpolates P linearly between the points
 while the tool stays fixed, so the points are split until the tool's curve on the part
 also stays within the chord and angle tolerances (``PointRule("flange")``). Speeds are
-each segment's planned mean speed of P's origin [mm/sec]; CNT100 between points, FINE at
+each segment's planned mean speed of P's origin [mm/sec] (approach and retract too);
+CNT100 between points, FINE at
 the ends of each move.
 
 ``<name>.ls``: ``J`` home; per seam the link (``J`` through its joint-represented
@@ -27,9 +28,11 @@ Process I/O, translated from the plan's I/O events (``io_events``), placed by
 
 - the digital output: FANUC's distance-before motion option on the motion whose end the
   event precedes, ``L P[i] ... DB d mm,DO[n]=ON`` (the output is set when the TCP comes
-  within d of the destination: on these straight ``L`` moves, d before the end along the
-  path). A motion takes one DB option: where two switches fall on one motion it is
-  split at a planned sample between them.
+  within d of the destination). The TCP is UTOOL's point, P's origin, not the tool's
+  point on the part, so d is the TCP's distance to the destination where the tool is at
+  the event's position on the seam (``fanuc_io.tcp_before_end``): where the part turns,
+  that differs from the distance along the seam. A motion takes one DB option: where two
+  switches fall on one motion it is split at a planned sample between them.
 - the flow: plain ``AO[n]=value`` statements before the motion they hold for; the value
   takes effect when the statement runs, as that motion starts (a motion starts at each
   flow edge: the planned sample nearest it is an ``L`` point). While the output is on
@@ -37,8 +40,10 @@ Process I/O, translated from the plan's I/O events (``io_events``), placed by
   output's switches, since FANUC does not lead by the dispenser's lag itself) each
   motion's value is the plan's flow (offset + per_mps · v, clipped, at the speed the
   tool has ``lag_s`` later) within ``fanuc_io.FLOW_STEP_V`` / 2 (a planned sample
-  starts a new motion where the speed changes more); otherwise ``AO[n]`` is the idle
-  value (``ProcessIo.idle``), set once at the program's start.
+  starts a new motion where the speed changes more, but no motion shorter than 0.5 mm:
+  near rest the steps are coarser and ``fanuc_flow`` picks values the dispenser's lag
+  smooths into the plan's flow); otherwise ``AO[n]`` is the idle value
+  (``ProcessIo.idle``), set once at the program's start.
 A time-before trigger (``TB t sec,...``) is not used: the events are distances.
 """
 
@@ -148,8 +153,9 @@ class FanucPost(ControllerPost):
             lines.append(
                 f"Process output DO[{io.digital_output}]: DB (distance before), on "
                 f"{io.on_lead_m * 1e3:g} mm before each seam's start, off "
-                f"{io.off_lead_m * 1e3:g} mm before its end; one DB per motion (split at "
-                "planned samples)."
+                f"{io.off_lead_m * 1e3:g} mm before its end; DB is the TCP's (P origin's) "
+                "distance to the motion's end there; one DB per motion (split at planned "
+                "samples)."
             )
         if io is not None and io.analog_output is not None:
             lines.append(
@@ -275,24 +281,20 @@ class _Chain:
                 io=io,
                 flow_at=_flow_at(job),
                 merge=merge,
+                fixed={n_a, n_p},
             )
         except ValueError as error:  # the cell's switch positions: one line, exit 2
             raise InputError(job.job.cell_file, "tool.process_io", str(error)) from None
         configs = config_strings(post.robot, samples.q)
-        speed = job.seams[job.seam_names.index(seam)].off_seam_speed_m_s  # approach, retract
-        process = [m.end for m in motions if n_a < m.end <= n_p]
-        speeds = dict(
-            zip(
-                process,
-                segment_speeds_mms(samples.t, samples.X_BP, np.array([n_a, *process])),
-                strict=True,
-            )
-        )
+        # Every motion at its planned mean speed: the seam's, and the approach's and
+        # retract's (motion.approach_speed where they cruise, slower on their ramps).
+        ends = np.array([motions[0].start, *(m.end for m in motions)]) if motions else []
+        speeds = segment_speeds_mms(samples.t, samples.X_BP, ends) if motions else []
         # The seam program's first lines: its deviation from the plan, re-checked.
         self.lines: list = _deviation_remarks(check, motions, (n_a, n_p), run.process.residual)
         X_TB = np.linalg.inv(job.job.X_BT)
         current = None if io is None else io.idle
-        for m in motions:
+        for m, mms in zip(motions, speeds, strict=True):
             if m.flow is not None and post.ao_statement(m.flow) != post.ao_statement(current):
                 if m.flow_event is None:
                     self.lines.append(post.ao_statement(m.flow))
@@ -301,7 +303,6 @@ class _Chain:
                     self.lines.append(post.follow_speed(Switch(0, 0.0, event)))
                 current = m.flow
             last = m.end in (n_a, n_p, len(samples.path_m) - 1)
-            mms = speeds.get(m.end, max(1, int(round(speed * 1e3))))
             switch = "" if m.event is None else post.set_output(Switch(0, m.before_end_m, m.event))
             entry = (X_TB @ samples.X_BP[m.end], configs[m.end])  # P in the user frame T
             self.lines.append((entry, f"{mms}mm/sec {'FINE' if last else 'CNT100'}{switch}"))
@@ -349,6 +350,7 @@ def _samples(rows, run: SeamRun):
         t=np.concatenate([rows.t[a_rows], dense.t + t0, rows.t[r_rows]]),
         q=np.concatenate([rows.q[a_rows], dense.q, rows.q[r_rows]]),
         X_BP=np.concatenate([rows.X_BE[a_rows], dense.X_BE, rows.X_BE[r_rows]]) @ rows.X_EP,
+        p_BT=rows.X_BT[:3, 3],
     )
     n_a, n_p = len(a_rows) + int(idx[0]), len(a_rows) + int(idx[-1])
     points = [0, *(len(a_rows) + idx), len(samples.path_m) - 1]
