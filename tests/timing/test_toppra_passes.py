@@ -5,11 +5,10 @@ return code and failure point; seeded random paths."""
 
 import numpy as np
 import pytest
+from test_time_optimal import QD_MAX, QDD_MAX, bump_rates
 
 import offline_prog.timing.time_optimal as time_optimal
 from offline_prog.timing.time_optimal import topp_profile
-
-from test_time_optimal import QD_MAX, QDD_MAX, bump_rates
 
 
 def both(rates, monkeypatch, **kwargs):
