@@ -14,7 +14,9 @@ cell (both intents), and TOPP-RA's own duration without the jerk stage. Prints
   differences of its qd columns (≤ 1.01);
 - the solve time of the whole time-optimal law (``timing.path_timing``: TOPP-RA, the
   jerk stage, the averaged profile where it may win) on a 5,000-sample path, per
-  intent (< 100 ms), and of TOPP-RA alone.
+  intent (< 100 ms), and of TOPP-RA alone;
+- the CPU time of that cycle_time law with TOPP-RA's lean passes
+  (``timing.toppra_passes``) against toppra's own, and whether both laws are the same.
 """
 
 from __future__ import annotations
@@ -142,6 +144,39 @@ def solve_time_5000(plan) -> tuple[float, float, float]:
     return best["topp"], best["constant_speed"], best["cycle_time"]
 
 
+def lean_passes_ratio(plan) -> tuple[float, float, bool]:
+    """(CPU time [s] of the cycle_time law on the 5,000-sample path with TOPP-RA's lean
+    passes, with toppra's own passes, whether both laws have the same duration); best
+    of 5 each, in turn."""
+    from offline_prog.timing import time_optimal
+    from offline_prog.timing.path_timing import PathLimits, time_path
+
+    robot, motion = plan.robot, plan.cell.motion
+    rates = path_rates(plan, 5000)
+    limits = PathLimits.of(
+        robot,
+        rates.sigma[-1],
+        v_process=plan.process_speed.v_m_s,
+        a_max=motion.max_acceleration,
+        j_max=motion.max_jerk,
+    )
+    lean = time_optimal.lean_toppra
+    toppras = {"lean": lean, "toppra": lambda: time_optimal._toppra_algorithm().TOPPRA}
+    best, durations = {}, {}
+    try:
+        for _ in range(5):
+            for name, solver in toppras.items():
+                time_optimal.lean_toppra = solver
+                start = time.process_time()
+                durations[name] = time_path(
+                    rates, limits, "time_optimal", "cycle_time"
+                ).law.duration
+                best[name] = min(best.get(name, np.inf), time.process_time() - start)
+    finally:
+        time_optimal.lean_toppra = lean
+    return best["lean"], best["toppra"], durations["lean"] == durations["toppra"]
+
+
 def _X_IB(plan):
     from offline_prog.config.cell import transform
 
@@ -206,6 +241,12 @@ def bench_timing(cells: list[str] = ONE_SEAM_CELLS) -> None:
             f"  solve on a 5,000-sample path (best of 5; acceptance < 100 ms): the whole "
             f"time-optimal law {held_s * 1e3:.0f} ms (constant_speed), {fast_s * 1e3:.0f} ms "
             f"(cycle_time); TOPP-RA alone {alone * 1e3:.1f} ms"
+        )
+        lean_s, toppra_s, same = lean_passes_ratio(held)
+        print(
+            f"  cycle_time law, CPU (best of 5): TOPP-RA's lean passes {lean_s * 1e3:.0f} ms, "
+            f"toppra's own {toppra_s * 1e3:.0f} ms, ratio {lean_s / toppra_s:.2f}; "
+            f"same law: {'yes' if same else 'NO'}"
         )
 
 

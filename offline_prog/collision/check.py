@@ -30,7 +30,7 @@ from heapq import heappop, heappush
 import numpy as np
 
 from offline_prog.arrays import at_index, true_runs
-from offline_prog.collision.pairs import Pairs
+from offline_prog.collision.pairs import cell_pairs
 from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     CollisionResult,
     CollisionStretch,
@@ -88,7 +88,7 @@ def check_trajectory(
         if not (np.isfinite(value) and value >= 0):
             raise ValueError(f"{name}: expected a distance >= 0 m, got {value!r}")
     start = time.perf_counter()
-    pairs, rho = Pairs(cell, fixed_layout=True), cell.motion_radii()
+    pairs, rho = cell_pairs(cell, fixed_layout=True), cell.motion_radii()
     clear_s = np.where(pairs.is_self, self_clearance, clearance)  # (S,) per shape pair [m]
     clear_s = np.where(pairs.is_fixed, 0.0, clear_s)  # a base on its floor touches it
     clear_g = clear_s[pairs.shape_of]  # (G,) per geometry pair [m]

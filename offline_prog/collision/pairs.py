@@ -20,6 +20,8 @@ advanced by a few millimetres of motion bound.
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from offline_prog.scene.drake_cell import DrakeCell
@@ -177,3 +179,16 @@ class Pairs:
         a, b = (self._components(name) for name in self.names[s])
         pose = self.query.GetPoseInWorld
         return min(exact_distance(sa, pose(ga), sb, pose(gb)) for sa, ga in a for sb, gb in b)
+
+
+def cell_pairs(cell: DrakeCell, *, fixed_layout: bool = False) -> Pairs:
+    """The cell's :class:`Pairs`, built once per cell, layout and thread (its context,
+    filters, pairs and exact shapes; ~8 ms a build, a sixth of a seam's collision check)
+    and kept in ``cell.kept``, its counters set to zero. Every measurement sets the
+    joint positions it is made at, so one check leaves nothing the next one reads."""
+    key = (Pairs, fixed_layout, threading.get_ident())
+    pairs = cell.kept.get(key)
+    if pairs is None:
+        pairs = cell.kept[key] = Pairs(cell, fixed_layout=fixed_layout)
+    pairs.exact_checks = pairs.evaluations = 0
+    return pairs

@@ -89,6 +89,8 @@ class DrakeCell:
     held_contacts: list[tuple[str, str, str]] = dataclasses.field(default_factory=list)
     _motion_radii: np.ndarray | None = dataclasses.field(default=None, repr=False, compare=False)
     _exact: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
+    # What other packages build once per cell and reuse (``collision.pairs.cell_pairs``).
+    kept: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def frame_E(self):

@@ -27,6 +27,7 @@ import types
 import numpy as np
 
 from offline_prog.timing.joint_timing import JointRates
+from offline_prog.timing.toppra_passes import lean_toppra
 
 # TOPP-RA's grid: the joint rates' grid thinned to about this spacing [m], within
 # these many points. The solve time grows linearly with them (~18 µs a point here);
@@ -225,8 +226,6 @@ def topp_profile(
             returned ``sigma``), from σ̇ = ends[0] at i to σ̇ = ends[1] at j [m/s]; the
             whole path, rest to rest, if None (``resolve_locally``).
     """
-    algorithm = _toppra_algorithm()
-
     keep = topp_grid(rates.sigma, v_cap**2 / (2.0 * a_path), grid_points)
     if span is not None:
         keep = keep[span[0] : span[1] + 1]
@@ -246,7 +245,7 @@ def topp_profile(
         a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)
         constraints.append(_speed_curve(np.minimum(v_curve, v_cap), path.dof, a_step))
     start = time.perf_counter()
-    solver = algorithm.TOPPRA(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
+    solver = lean_toppra()(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
     _, sd, _, K = solver.compute_parameterization(*ends, return_data=True)
     solve_s = time.perf_counter() - start
     code = solver.problem_data.return_code

@@ -349,3 +349,28 @@ def test_a_mesh_in_mm_declared_as_metres_is_refused_at_once(tmp_path):
     assert message.startswith("part.mesh: ") and "set part.mesh_units: mm" in message
     assert "\n" not in message
     assert mesh_shape("shell", DATA / "data" / "cylinder_shell.stl", 1e-3).kind == "mesh"
+
+
+def test_a_cells_kept_pairs_check_as_a_fresh_cells_do(kr16):
+    """The collision check keeps its geometry pairs in the cell (``pairs.cell_pairs``):
+    checks one after the other on one cell (another trajectory between them) report the
+    same verdict, distances and counts of queries as each check on a cell of its own."""
+    q, t = sweep(kr16, 401)
+    poses = part_poses(plate_cell(kr16, []), q)
+    sigma = arc_length(poses)
+    near = poses[200].translation() - [0.0, 0.0, BALL_R_M + 0.004]  # 4 mm below the plate
+    kept = plate_cell(kr16, [ball("ball", near)])
+    runs = [(q, t, sigma), (q[::-1][:150], t[:150], sigma[:150]), (q, t, sigma)]
+    for run in runs:
+        ours = check_trajectory(kept, *run, clearance=CLEARANCE_M)
+        fresh = check_trajectory(
+            plate_cell(kr16, [ball("ball", near)]), *run, clearance=CLEARANCE_M
+        )
+        assert ours.collision_free == fresh.collision_free
+        assert ours.samples_in_collision == fresh.samples_in_collision
+        assert [(p.a, p.b, p.distance_m, p.sample) for p in ours.pairs] == [
+            (p.a, p.b, p.distance_m, p.sample) for p in fresh.pairs
+        ]
+        for key in ("checked_samples", "distance_queries", "exact_checks"):
+            assert ours.stats[key] == fresh.stats[key]
+    assert not ours.collision_free  # the ball is within the clearance
