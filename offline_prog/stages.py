@@ -23,13 +23,14 @@ from offline_prog.config.job_checks import check_process_io
 from offline_prog.config.process_speed import ProcessSpeed, process_speed
 from offline_prog.config.robot_search import find_robot, search_path
 from offline_prog.constants import LIMIT_CHECK_RATE_HZ, MAX_SAMPLES
-from offline_prog.errors import InputError
+from offline_prog.errors import InputError, PlanFailedError
 from offline_prog.joints.joint_plan import plan_joint_trajectory, tool_rotations
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline, fit_bspline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath, find_cusps
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit, check_normal_fit, load_points, normal_field
+from offline_prog.path.lead import LeadPath, unwrapped
 from offline_prog.path.process_frames import NormalField, NormalTangentError
 from offline_prog.path.sources import PathPoints
 from offline_prog.path.tool_turn import SmoothTurn, smooth_turn_of
@@ -38,6 +39,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
+from offline_prog.timing.lead_length import at_rest, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -240,8 +242,20 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
     run = motion_setup(inputs, flange)
+    try:
+        joints = _joint_trajectory(inputs, run, branch)
+    except PlanFailedError as error:
+        if not run.flange.flying:
+            raise
+        reason = f"the lead-in or lead-out: {error.failure.reason}"
+        run = motion_setup(inputs, at_rest(run.flange, reason))
+        joints = _joint_trajectory(inputs, run, branch)
+    return Attempt(rotation, run.flange, run.limits, joints, None)
+
+
+def _joint_trajectory(inputs: Inputs, run, branch: int | None):
     motion = inputs.cell.motion
-    joints = plan_joint_trajectory(
+    return plan_joint_trajectory(
         inputs.robot,
         inputs.X_IB,
         run.flange,
@@ -253,7 +267,6 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
         process=motion.process,
         process_caps=run.caps,
     )
-    return Attempt(rotation, run.flange, run.limits, joints, None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -263,7 +276,7 @@ class MotionSetup:
     path's limits (the seam's process speed, the caps, the robot's joint limits; their
     nominal law is built once, ``PathLimits.nominal``)."""
 
-    flange: FlangePath | SmoothedFlangePath
+    flange: LeadPath  # over a FlangePath or SmoothedFlangePath
     parameter: TimeLawParameter
     caps: ProcessCaps
     limits: PathLimits
@@ -277,12 +290,13 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
             more than MAX_SAMPLES samples.
     """
     motion = inputs.cell.motion
+    leads = flange if isinstance(flange, LeadPath) else None  # its entry decided
+    flange = unwrapped(flange)
     if motion.cusp_smoothing_mm is not None:
         try:
             flange = SmoothedFlangePath(flange, motion.cusp_smoothing_mm * 1e-3)
         except ValueError as error:
             raise InputError(inputs.file, "motion.cusp_smoothing_mm", str(error)) from None
-    parameter = TimeLawParameter(flange, motion.speed_reference)
     speed = inputs.speed.v_m_s
     caps = process_caps(
         process_model(inputs.cell.process) if inputs.process_bound else None,
@@ -290,6 +304,8 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
         a_max=motion.max_acceleration,
         j_max=motion.max_jerk,
     )
+    flange = with_leads(inputs, flange, caps, leads)
+    parameter = TimeLawParameter(flange, motion.speed_reference)
     limits = PathLimits.of(
         inputs.robot, parameter.length, v_process=speed, a_max=caps.a_max, j_max=caps.j_max
     )
@@ -308,7 +324,25 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
 
 def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:
     """Stage ``check``: the attempt with the collision check of every sample and step at
-    the cell's clearances."""
+    the cell's clearances. A flying seam that collides is planned at rest again: where
+    that one is free, the leads collided and it is the attempt."""
+    checked = _checked(inputs, scene, attempt)
+    if checked.collisions.collision_free or not getattr(attempt.flange, "flying", False):
+        return checked
+    try:
+        rest = plan_motion(
+            inputs,
+            attempt.rotation,
+            at_rest(attempt.flange, "the lead-in or lead-out collides"),
+            attempt.joints.branch,
+        )
+    except PlanFailedError:
+        return checked
+    rest = _checked(inputs, scene, rest)
+    return rest if rest.collisions.collision_free else checked
+
+
+def _checked(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:
     motion, joints = inputs.cell.motion, attempt.joints
     collisions = check_trajectory(
         scene,

@@ -5,8 +5,9 @@ Plans the sealing demo (KR 16, a closed border, bead 12 mm² ± 5 %, lag 0.08 s)
 ``on``/``off`` switches carrying ``delay_s`` and ``overlap_mm: 5``, and prints:
 
 - the share of the gun-on (valve-open) length within ±5 % of the target area and the
-  worst gun-on row, with and without the first/last ``RAMP_MM`` of the seam (the rest
-  start and stop are the flying-start work of another change);
+  worst gun-on row, with and without the first/last ``RAMP_MM`` of the seam (the seam
+  runs flying, ``path.entry``; ``scripts/flying_entry_figures.py`` compares it with
+  ``entry: rest`` on every demo cell);
 - the overlap: how far past the seam's start the valve closes, and whether the valve is
   open over the whole closed contour (no gap);
 - the last 5 mm before the valve closes: the bead there (the cut-off is no longer led).

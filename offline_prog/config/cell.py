@@ -187,6 +187,12 @@ class PathConfig:
     # A closed seam's bead runs past its start by this much before the gun closes [mm]
     # (the path runs on over its first overlap_mm); refused on an open seam.
     overlap_mm: float = 0.0
+    # rest | flying. rest: the seam starts and ends at rest. flying: the tool reaches
+    # the seam's start already at the process speed and leaves its end at it (a lead-in
+    # and lead-out along the seam's tangent, lifting off the part, timed with the seam:
+    # path.lead). A lead that cannot be run (out of reach, a joint limit, a collision,
+    # speed_reference flange) falls back to rest; report.json names the entry and why.
+    entry: str = "rest"
 
 
 @dataclasses.dataclass
@@ -244,6 +250,11 @@ class MotionConfig:
     # speed; config.process_speed.approach_speed decides)
     approach_speed: float | None = None
     link_speed_percent: float = 100.0  # % of the joints' speed limits on links (PTP)
+    # mm of a flying seam's lead-in and lead-out (path.entry: flying). None: what the
+    # process speed needs under the seam's caps (its ramp from rest, half as much again,
+    # plus the I/O switches' leads and the dispenser's lag run at that speed); 0: every
+    # seam starts and ends at rest.
+    lead_mm: float | None = None
 
 
 @dataclasses.dataclass

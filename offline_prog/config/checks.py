@@ -30,6 +30,9 @@ from offline_prog.constants import (
 )
 from offline_prog.errors import InputError
 
+ENTRIES = ("rest", "flying")  # path.entry / seams[].entry
+MAX_LEAD_MM = 500.0  # motion.lead_mm: a lead is tens of millimetres
+
 
 def _error(file, key, reason) -> InputError:
     return InputError(file, key, reason)
@@ -173,6 +176,10 @@ def _check_path(file: Path, key: str, path: PathConfig, cell: Cell) -> None:
         raise _error(file, f"{key}.normal", "is the zero vector")
     if path.degree < 5:
         raise _error(file, f"{key}.degree", f"{path.degree} < 5 (the paper needs degree ≥ 5)")
+    if path.entry not in ENTRIES:
+        raise _error(
+            file, f"{key}.entry", f"{path.entry!r} is not an entry (use {' or '.join(ENTRIES)})"
+        )
     for name in ("fit_tolerance_mm", "normal_tolerance_deg"):
         if getattr(path, name) is not None and not getattr(path, name) > 0:  # None: cad:'s
             raise _error(file, f"{key}.{name}", f"must be > 0, got {getattr(path, name)}")
@@ -239,8 +246,8 @@ def _check_shapes(file: Path, cell: Cell) -> None:
 
 def check_off_seam_speeds(file: Path, motion) -> None:
     """``motion.approach_speed`` within (0, MAX_SPEED_M_S] m/s (the controllers' path
-    speed limit: KUKA $VEL.CP, FANUC 2000 mm/sec) and ``motion.link_speed_percent``
-    within (0, 100] %."""
+    speed limit: KUKA $VEL.CP, FANUC 2000 mm/sec), ``motion.link_speed_percent``
+    within (0, 100] % and ``motion.lead_mm`` within [0, MAX_LEAD_MM]."""
     speed = motion.approach_speed
     if speed is not None and not (np.isfinite(speed) and 0.0 < speed <= MAX_SPEED_M_S):
         raise _error(
@@ -253,4 +260,9 @@ def check_off_seam_speeds(file: Path, motion) -> None:
     if not (np.isfinite(percent) and 0.0 < percent <= 100.0):
         raise _error(
             file, "motion.link_speed_percent", f"must be within (0, 100] %, got {percent:g}"
+        )
+    lead = motion.lead_mm
+    if lead is not None and not (np.isfinite(lead) and 0.0 <= lead <= MAX_LEAD_MM):
+        raise _error(
+            file, "motion.lead_mm", f"must be within [0, {MAX_LEAD_MM:g}] mm, got {lead:g}"
         )

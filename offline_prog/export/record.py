@@ -171,10 +171,18 @@ def _seam_run(job, number, segments, points, flow_where_set) -> SeamRun:
 
 
 def _linear_move(job: JobProgramData, segment: JobSegment, number: int, k: int) -> LinearMove:
+    """The straight part of an approach or retract: a flying seam's approach ends where
+    its lead-in starts, its retract starts where its lead-out ends (the leads are the
+    seam's samples, ``results.program_data.seam_rows``)."""
     rows = job.job
-    end = min(segment.stop, len(rows.t) - 1)  # the row where the segment ends
+    start, end = segment.start, min(segment.stop, len(rows.t) - 1)  # the segment's rows
+    path_m = job.seams[k].path_m  # the seam's samples, from its lead-in's start
+    if segment.kind == "approach" and path_m[0] < 0.0:
+        end = start + int(np.flatnonzero(rows.path_m[start : end + 1] <= path_m[0] + 1e-12)[-1])
+    if segment.kind == "retract" and path_m[-1] > job.seam_lengths_m[k]:
+        start += int(np.flatnonzero(rows.path_m[start : end + 1] >= path_m[-1] - 1e-12)[0])
     X_PT = rows.X_PT
-    length = float(np.linalg.norm(X_PT[end, :3, 3] - X_PT[segment.start, :3, 3]))
+    length = float(np.linalg.norm(X_PT[end, :3, 3] - X_PT[start, :3, 3]))
     speed = float(job.seams[k].off_seam_speed_m_s)
     return LinearMove(segment.kind, segment.seam, number, X_PT[end], rows.q[end], length, speed)
 
@@ -212,13 +220,13 @@ def _with_switches(run: SeamRun, length: float, flow_where_set: bool) -> SeamRun
         return run
     # (part, move, path position at the move's start and end [m]) in path order.
     moves = []
+    sigma = run.process.data.path_m[run.process.indices]  # from a lead-in's start
+    first, last = min(sigma[0], 0.0), max(sigma[-1], length)
     if run.approach is not None:
-        a = -run.approach.length_m
-        moves.append(("approach", 0, a, a + run.approach.length_m))
-    sigma = run.process.data.path_m[run.process.indices]
+        moves.append(("approach", 0, first - run.approach.length_m, first))
     moves += [("process", m, sigma[m - 1], sigma[m]) for m in range(1, len(sigma))]
     if run.retract is not None:
-        moves.append(("retract", 0, length, length + run.retract.length_m))
+        moves.append(("retract", 0, last, last + run.retract.length_m))
     moves.sort(key=lambda move: (move[2], move[3]))
     placed: dict[str, list[Switch]] = {}
     for event in events:

@@ -25,6 +25,7 @@ from offline_prog.config.cell import ApproachConfig
 from offline_prog.config.process_speed import approach_speed
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.path_ik import base_poses, branch_results
+from offline_prog.path.lead import path_ends
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.time_law import sin2_time_law
 from offline_prog.timing.trajectory import sample_times
@@ -157,21 +158,29 @@ def _fail(kind: str, seam: str, t: np.ndarray, i: int, reason: str, failure: Fai
 def seam_ends(
     inputs, flange, length_m: float, q_ends: np.ndarray, branch: int, seam
 ) -> tuple[CartesianMove | None, CartesianMove | None]:
-    """The approach to a seam's first sample and the retract from its last.
+    """The approach to a seam's first sample and the retract from its last (a flying
+    seam's: its lead-in's first and its lead-out's last, ``path.lead``).
 
     Args:
         inputs: the seam's ``stages.Inputs``; seam: its ``SeamConfig``.
         flange: the seam's flange path as run; length_m: its path length [m].
-        q_ends: (2, 6) joints at σ = 0 and at the end [rad]; branch: their IK branch.
+        q_ends: (2, 6) joints at the path's first and last σ [rad]; branch: their IK
+            branch.
 
     Raises:
         PlanFailedError: a move the robot cannot make (kind, seam and why).
     """
     motion = inputs.cell.motion
     R_PE = inputs.X_PE.rotation().matrix()
-    ends = flange(np.array([0.0, length_m]))
+    ends = flange(np.array(path_ends(flange)))  # a flying seam's: its leads' far ends
+    lifts = getattr(flange, "lifts_m", (0.0, 0.0))
     moves = []
-    for kind, i, spec in (("approach", 0, seam.approach), ("retract", -1, seam.retract)):
+    for kind, i, spec, lift in (
+        ("approach", 0, seam.approach, lifts[0]),
+        ("retract", -1, seam.retract, lifts[1]),
+    ):
+        if spec.kind == "normal" and lift > 0.0:  # the lead lifted the tool that much
+            spec = dataclasses.replace(spec, distance_mm=max(0.0, spec.distance_mm - lift * 1e3))
         moves.append(
             cartesian_move(
                 inputs.robot,
@@ -197,7 +206,7 @@ def seam_ends(
 
 def plan_ends(inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:
     """:func:`seam_ends` of a timed seam plan (``job.records.Plan``)."""
-    q_ends = plan.joints.q[[0, -1]]
+    q_ends = np.array([(plan.lead_in or plan.joints).q[0], (plan.lead_out or plan.joints).q[-1]])
     return seam_ends(inputs, plan.flange, plan.path.length, q_ends, plan.joints.branch, seam)
 
 

@@ -7,8 +7,10 @@ negative on the approach, beyond L on the retract; a closed seam's L includes it
 ``overlap_mm``); the digital output is set the valve's response time (``on.delay_s``,
 ``off.delay_s``) before. The flow output follows the TCP speed (value = offset +
 per_mps · v_TCP, clipped to [min, max]) while the valve is open, and rests at its idle
-value (``ProcessIo.idle``) otherwise; it goes live ``flow.lag_s`` before the valve opens
-and its command leads the speed by that lag, but it is cut when the valve closes. The events
+value (``ProcessIo.idle``) otherwise; it goes live ``flow.lag_s`` before the valve
+opens (on a flying seam FLOW_PRIME_LAGS lags before: the tool is at speed there and the
+lagging flow has risen to its command by the opening) and its command leads the speed
+by that lag, but it is cut when the valve closes. The events
 (:class:`~offline_prog.io_events.IoEvent`) are what every program writer translates.
 """
 
@@ -19,6 +21,7 @@ import dataclasses
 import numpy as np
 
 from offline_prog.config.cell import ProcessIoConfig
+from offline_prog.constants import FLOW_PRIME_LAGS
 from offline_prog.errors import TravellingError
 from offline_prog.io_events import IoEvent, ProcessIo, Signal
 from offline_prog.job.assemble import JobSamples
@@ -92,6 +95,8 @@ def io_columns(
     lengths_m: dict[str, float],
     tcp_speed,
     model: ProcessModel | None = None,
+    *,
+    flying: frozenset[str] = frozenset(),
 ) -> IoColumns:
     """The process output's state and the flow command on every row, and the events.
 
@@ -99,6 +104,7 @@ def io_columns(
         samples: the job's samples.
         io: ``tool.process_io`` (None: no I/O).
         lengths_m: each seam's path length L [m] by name.
+        flying: the names of the seams run flying (``path.lead``).
         tcp_speed: (N,) speed of the tool along the part [m/s].
         model: the cell's process model (it may set the speed-following output).
 
@@ -148,19 +154,21 @@ def io_columns(
                 for state, position, time in zip((True, False), gate, set_times, strict=True)
             ]
         if flowing:
-            if times[0] - lag < t_seam[0] - 1e-9:  # a program sets it on the approach
+            prime = (FLOW_PRIME_LAGS if seam in flying else 1.0) * lag
+            if times[0] - prime < t_seam[0] - 1e-9:  # a program sets it on the approach
                 raise IoPlacementError(
                     _lag_key(model),
-                    f"{lag:g} s before seam {seam}'s output goes on is before its approach "
+                    f"{prime:g} s before seam {seam}'s output goes on is before its approach "
                     f"starts ({times[0] - t_seam[0]:.3f} s earlier): a longer approach or "
                     "on.lead_mm leaves the flow room to lead",
                 )
-            # Live lag_s before the valve opens, until it closes (the cut-off not led).
-            flow_times = (times[0] - lag, times[1])
+            # Live FLOW_PRIME_LAGS lags before the valve opens, until it closes (the
+            # cut-off not led).
+            flow_times = (times[0] - prime, times[1])
             live |= (t >= flow_times[0]) & (t < flow_times[1])
             # Where each takes effect, lag_s after it is set (a controller that leads by
-            # the lag itself places it there): the gate, and past the valve's closing.
-            flow_at = (gate[0], float(np.interp(times[1] + lag, t_seam, path)))
+            # the lag itself places it there): the gate's side, and past the valve's closing.
+            flow_at = tuple(float(np.interp(x + lag, t_seam, path)) for x in flow_times)
             v_on = float(np.interp(times[0], t, tcp_speed))
             values = (float(settings.flow(v_on)), settings.idle)
             events += [

@@ -19,6 +19,7 @@ from offline_prog.config.process_speed import ProcessSpeed
 from offline_prog.errors import Failure
 from offline_prog.job.approach import CartesianMove
 from offline_prog.job.assemble import JobSamples
+from offline_prog.job.lead_rows import LeadRows, split_leads
 from offline_prog.job.links import LinkMotion
 from offline_prog.job.order import JobOrder
 from offline_prog.job.process_io import IoColumns
@@ -28,6 +29,7 @@ from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
 from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.inputs import NormalFit
+from offline_prog.path.lead import LeadPath
 from offline_prog.path.sources import PathPoints
 from offline_prog.process.quality import ProcessQuality
 from offline_prog.robot.model import RobotModel
@@ -61,6 +63,33 @@ class Plan:
     # The seam's process speed, as its time law ran it (the seam's cell keeps the
     # cell's motion.speed: a seam's own speed is here alone).
     process_speed: ProcessSpeed | None = None
+    # A flying seam's lead-in and lead-out rows (job.lead_rows; None: that end at
+    # rest). The seam's own rows (joints, trajectory) run from σ = 0 to L.
+    lead_in: LeadRows | None = None
+    lead_out: LeadRows | None = None
+
+    def __post_init__(self):
+        """Joints timed with the leads (path.lead) are cut at the seam's ends here, so
+        every way a plan is made or replaced with new joints holds the seam's rows."""
+        s, length = self.trajectory.s, self.path.length
+        if isinstance(self.flange, LeadPath) and (s[0] < 0.0 or s[-1] > length):
+            self.joints, self.lead_in, self.lead_out = split_leads(self.joints, length)
+            self.trajectory = self.joints.trajectory
+
+    @property
+    def entry(self) -> dict:
+        """How the seam is entered and left: ``{"entry": "flying" | "rest", "reason":
+        why at rest ("" when flying), "lead_in_mm", "lead_out_mm"}`` (report.json)."""
+        lead_in = 0.0 if self.lead_in is None else self.lead_in.length_m
+        lead_out = 0.0 if self.lead_out is None else self.lead_out.length_m
+        flying = lead_in > 0.0 or lead_out > 0.0
+        reason = "" if flying else getattr(self.flange, "reason", "") or "entry: rest"
+        return {
+            "entry": "flying" if flying else "rest",
+            "reason": reason,
+            "lead_in_mm": lead_in * 1e3,
+            "lead_out_mm": lead_out * 1e3,
+        }
 
     @classmethod
     def of_attempt(
@@ -161,13 +190,17 @@ class SeamOption:
     def q_in(self) -> np.ndarray:
         if self.approach:
             return self.approach.q[0]
-        return self.untimed.q_ends[0] if self.plan is None else self.plan.joints.q[0]
+        if self.plan is None:
+            return self.untimed.q_ends[0]
+        return (self.plan.lead_in or self.plan.joints).q[0]
 
     @property
     def q_out(self) -> np.ndarray:
         if self.retract:
             return self.retract.q[-1]
-        return self.untimed.q_ends[1] if self.plan is None else self.plan.joints.q[-1]
+        if self.plan is None:
+            return self.untimed.q_ends[1]
+        return (self.plan.lead_out or self.plan.joints).q[-1]
 
     @property
     def label(self) -> str:

@@ -219,19 +219,47 @@ def job_pieces(
 
 
 def _seam_pieces(option: SeamOption) -> list[Piece]:
-    joints, traj, name = option.plan.joints, option.plan.joints.trajectory, option.name
+    """approach (its straight move, then a flying seam's lead-in), process, retract (the
+    lead-out, then the straight move); path_m: σ on the seam and its leads, −(lead-in +
+    δ) and L + lead-out + δ on the straight moves."""
+    plan, name = option.plan, option.name
+    joints, traj = plan.joints, plan.joints.trajectory
+    lead_in, lead_out, length = plan.lead_in, plan.lead_out, plan.path.length
     out = []
-    if option.approach:
-        a = option.approach
-        out.append(Piece("approach", name, a.t, a.q, np.gradient(a.q, a.t, axis=0), -a.delta))
+    a, r = option.approach, option.retract
+    before = lead_in.length_m if lead_in else 0.0
+    after = lead_out.length_m if lead_out else 0.0
+    moves = []
+    if a:
+        moves.append((a.t, a.q, np.gradient(a.q, a.t, axis=0), -before - a.delta))
+    if lead_in:
+        moves.append((lead_in.t, lead_in.q, lead_in.qd, lead_in.s))
+    if moves:
+        out.append(Piece("approach", name, *_joined(moves)))
     out.append(Piece("process", name, traj.t, joints.q, joints.qd, traj.s))
-    if option.retract:
-        r = option.retract
-        length = option.plan.path.length
-        out.append(
-            Piece("retract", name, r.t, r.q, np.gradient(r.q, r.t, axis=0), length + r.delta)
-        )
+    moves = []
+    if lead_out:
+        moves.append((lead_out.t, lead_out.q, lead_out.qd, lead_out.s))
+    if r:
+        moves.append((r.t, r.q, np.gradient(r.q, r.t, axis=0), length + after + r.delta))
+    if moves:
+        out.append(Piece("retract", name, *_joined(moves)))
     return out
+
+
+def _joined(moves: list[tuple]) -> tuple[np.ndarray, ...]:
+    """(t, q, qd, path_m) of motions run one after the other, each starting where the
+    one before ends (that shared row once, the later motion's)."""
+    t, q, qd, path = [], [], [], []
+    clock = 0.0
+    for k, (t_k, q_k, qd_k, path_k) in enumerate(moves):
+        keep = slice(0, None) if k == len(moves) - 1 else slice(0, -1)
+        t.append(clock + t_k[keep])
+        q.append(q_k[keep])
+        qd.append(qd_k[keep])
+        path.append(path_k[keep])
+        clock += float(t_k[-1])
+    return tuple(np.concatenate(x) for x in (t, q, qd, path))
 
 
 @dataclasses.dataclass
@@ -282,6 +310,7 @@ def job_io(inputs: Inputs, linked: LinkedJob) -> IoColumns:
             lengths,
             linked.tcp_speed,
             process_model(inputs.cell.process),
+            flying=frozenset(o.name for o in linked.chosen if o.plan.lead_in is not None),
         )
     except IoPlacementError as error:
         raise InputError(inputs.file, error.key, error.reason) from None
@@ -331,15 +360,21 @@ def tool_speed(
 ) -> np.ndarray:
     """(N,) speed of the tool point along the part [m/s] on every row: |d p_PT / dt|
     with X_PT = X_PE · X_EB · X_BI · X_IT (X_BE (N, 4, 4): the flange on every row);
-    the seams' own exact TCP speed on their process rows."""
+    the seams' own exact TCP speed on their process rows and their leads' rows."""
     X_BT = (inputs.X_IB.inverse() @ inputs.X_IT).GetAsMatrix4()
     X_PE = inputs.X_PE.GetAsMatrix4()
     p_PT = (X_PE @ np.linalg.inv(X_BE) @ X_BT)[:, :3, 3]
     speed = np.linalg.norm(np.gradient(p_PT, samples.t, axis=0), axis=1)
-    by_seam = {option.name: option.plan.trajectory.tcp_speed for option in chosen}
+    by_seam = {option.name: option.plan for option in chosen}
     for segment in samples.segments:
+        plan = by_seam.get(segment.seam)
+        rows = slice(segment.start, segment.stop)
         if segment.kind == "process":
-            speed[segment.start : segment.stop] = by_seam[segment.seam][
-                : segment.stop - segment.start
-            ]
+            speed[rows] = plan.trajectory.tcp_speed[: segment.stop - segment.start]
+        elif segment.kind == "approach" and plan.lead_in is not None:  # its last rows
+            lead = plan.lead_in.tcp_speed[:-1]  # the last: the seam's first row
+            speed[segment.stop - len(lead) : segment.stop] = lead
+        elif segment.kind == "retract" and plan.lead_out is not None:  # its first rows
+            lead = plan.lead_out.tcp_speed[: segment.stop - segment.start]
+            speed[segment.start : segment.start + len(lead)] = lead
     return speed

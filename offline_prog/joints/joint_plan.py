@@ -5,10 +5,9 @@ Stages: pick one configuration branch and 2π start for the whole path
 σ-derivatives through the robot's Jacobian (``robot.jacobian``), time the path
 under the joint limits (``time_optimal`` + ``jerk_stage``, or the paper's sin²
 law with ``joint_timing``; the time-optimal law's joint jerk checked once more on the
-output samples with the exact path, ``jerk_check``), and
-sample the final trajectory with its joint positions, speeds, accelerations,
-singularity distances and joint steps. Failures are results that say where
-(σ, t) and why.
+output samples with the exact path, ``jerk_check``), and sample the final trajectory
+with its joint positions, speeds, accelerations, singularity distances and joint steps
+(σ: the seam's). Failures are results that say where (σ, t) and why.
 """
 
 from __future__ import annotations
@@ -367,6 +366,7 @@ def plan_joint_trajectory(
     steps = np.abs(np.diff(q, axis=0))
     i, j = np.unravel_index(np.argmax(steps), steps.shape)
     distances = path.singularity_distances(q, sigma)
+    sigma = sigma + parameter.start  # on the seam's σ (a lead-in's negative)
     singular = {}
     for kind, d in distances.items():
         k = int(np.argmin(d))

@@ -119,27 +119,48 @@ def _poses(p: np.ndarray, R: np.ndarray) -> np.ndarray:
     return X
 
 
+def seam_rows(plan: Plan) -> tuple[np.ndarray, ...]:
+    """(t (N,) [s] from the first row, σ (N,) [m], q, qd (N, 6), tcp_speed (N,) [m/s]) of
+    a seam as the programs run it between its straight approach and retract: a flying
+    seam's lead-in, its own rows and its lead-out (``job.lead_rows``: σ from −lead-in to
+    L + lead-out; the shared rows once)."""
+    joints, traj = plan.joints, plan.trajectory
+    rows = (traj.s, joints.q, joints.qd, traj.tcp_speed)
+    start = 0.0 if plan.lead_in is None else float(plan.lead_in.t[-1])  # the seam's σ = 0
+    times, parts = [traj.t + start], [rows]
+    if plan.lead_in is not None:
+        lead = plan.lead_in
+        times.insert(0, lead.t[:-1])
+        parts.insert(0, tuple(x[:-1] for x in (lead.s, lead.q, lead.qd, lead.tcp_speed)))
+    if plan.lead_out is not None:
+        lead = plan.lead_out
+        times.append(lead.t[1:] + start + traj.t[-1])
+        parts.append(tuple(x[1:] for x in (lead.s, lead.q, lead.qd, lead.tcp_speed)))
+    return (np.concatenate(times), *(np.concatenate([p[k] for p in parts]) for k in range(4)))
+
+
 def seam_program_data(plan: Plan, summary: dict) -> ProgramData:
-    """A seam as the writers read it: its samples, and its continuous path on the
-    dense grid (``export.densify``) with the joints planned there (no writer runs IK)."""
-    cell, joints, traj = plan.cell, plan.joints, plan.trajectory
+    """A seam as the writers read it: its samples (:func:`seam_rows`: a flying seam's
+    leads included), and its continuous path on the dense grid (``export.densify``) with
+    the joints planned there (no writer runs IK)."""
+    cell = plan.cell
+    t, s, q, qd, tcp_speed = seam_rows(plan)
     X_BI, X_BT, _ = _tool_and_part(cell)
-    X_BE = X_BI @ _poses(traj.flange.p_IE, traj.flange.R_IE)
+    rows = plan.flange(s)  # the samples' own flange poses (a lead's too)
+    X_BE = X_BI @ _poses(rows.p_IE, rows.R_IE)
     X_EP = plan.flange.X_PE.inverse().GetAsMatrix4()
-    path_dense_m = dense_grid(plan.path.length)
+    path_dense_m = s[0] + dense_grid(s[-1] - s[0])
     dense = plan.flange(path_dense_m)
     X_BE_dense = X_BI @ _poses(dense.p_IE, dense.R_IE)
     X_PT_dense = _tool_in_part(X_BT, X_BE_dense, X_EP)
     # The writers' inserted points: X_BE as export.densify computes it from X_PT_dense.
     X_BE_grid = X_BT @ np.linalg.inv(X_PT_dense) @ np.linalg.inv(X_EP)
-    q_dense = dense_joints(
-        plan.robot, traj.s, traj.t, joints.q, joints.qd, X_BE, path_dense_m, X_BE_grid
-    )
+    q_dense = dense_joints(plan.robot, s, t, q, qd, X_BE, path_dense_m, X_BE_grid)
     return ProgramData(
         **_header(plan, plan.cell_file, plan.robot, summary),
-        speed_reference=traj.reference,
-        cycle_time_s=traj.duration,
-        **_samples(traj.t, traj.s, joints.q, joints.qd, traj.tcp_speed),
+        speed_reference=plan.trajectory.reference,
+        cycle_time_s=float(t[-1]),
+        **_samples(t, s, q, qd, tcp_speed),
         **_frames(X_BT, X_BE, X_EP),
         path_dense_m=path_dense_m,
         X_PT_dense=X_PT_dense,

@@ -309,6 +309,8 @@ def report(plan: Plan) -> dict:
             # The path is too short to reach the speed (with no joint limit).
             "top_speed_reduced": not without_joint_limits(law, cell.motion.time_law)[1],
             "sample_rate_hz": cell.motion.sample_rate_hz,
+            # flying (lead-in and lead-out at the process speed) or rest, and why rest
+            "entry": plan.entry,
         },
         "trajectory": {
             "duration_s": tr.duration,

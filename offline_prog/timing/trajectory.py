@@ -102,6 +102,10 @@ class WorkspaceTrajectory:
         )
 
 
+# A grid time closer than this share of a step to a seam end's own sample is dropped.
+JOIN_MERGE_SHARE = 0.25
+
+
 def sample_times(duration: float, rate_hz: float) -> np.ndarray:
     """(N,) times 0, 1/rate, … with the end time appended exactly."""
     t = np.arange(0.0, duration, 1.0 / rate_hz)
@@ -114,7 +118,9 @@ class TimeLawParameter:
     """The time law's path parameter σ and its map to the TCP arc length s.
 
     "tcp": σ = s (the process speed is held at the tool). "flange": σ = λ, the
-    arc length along the flange path, with s(λ) from the true arc-length map.
+    arc length along the flange path, with s(λ) from the true arc-length map. On a
+    path with a lead-in (``path.lead.LeadPath``) the law's σ counts from the lead's
+    start: s = σ + ``flange.start`` (tcp only).
 
     Args:
         flange: the flange path X_IE(s).
@@ -126,6 +132,9 @@ class TimeLawParameter:
             raise ValueError(f"speed_reference must be 'tcp' or 'flange', got {reference!r}")
         self.reference = reference
         self._map = None
+        self.start = float(getattr(flange, "start", 0.0))  # s at σ = 0 [m]
+        if reference == "flange" and self.start != 0.0:
+            raise ValueError("a lead-in needs speed_reference tcp")
         if reference == "flange":
             s_knots = flange.path.map.s_of_u(flange.path.fitted.breakpoints)
             self._map = flange_arc_length(flange, s_knots)
@@ -135,8 +144,40 @@ class TimeLawParameter:
         """[s, ds/dσ, d²s/dσ²] at σ (N,), each (N,)."""
         sigma = np.asarray(sigma, dtype=float)
         if self._map is None:
-            return [sigma, np.ones_like(sigma), np.zeros_like(sigma)]
+            s = sigma + self.start if self.start else sigma
+            return [s, np.ones_like(sigma), np.zeros_like(sigma)]
         return self._map.u_of_s(sigma, order=2)
+
+
+def sample_times_through(law, sigmas: list[float], rate_hz: float) -> np.ndarray:
+    """:func:`sample_times` of ``law`` with the times it passes each of ``sigmas`` (the
+    law's σ [m], strictly inside its path) added as samples, a grid time closer than
+    JOIN_MERGE_SHARE of a step to one of them dropped: a seam's ends on a path with
+    leads are samples of their own, so the seam's rows run from σ = 0 to L exactly."""
+    t = sample_times(law.duration, rate_hz)
+    if not sigmas:
+        return t
+    dense = np.linspace(0.0, law.duration, max(20001, 4 * len(t)))
+    sigma_dense = law(dense)[0]
+    joins = []
+    for target in sigmas:
+        k = int(np.searchsorted(sigma_dense, target))
+        a, b = dense[max(k - 1, 0)], dense[min(k, len(dense) - 1)]
+        for _ in range(60):  # bisection on the monotone σ(t), to ~1e-18 of a step
+            mid = 0.5 * (a + b)
+            a, b = (mid, b) if law(np.array([mid]))[0][0] < target else (a, mid)
+        joins.append(0.5 * (a + b))
+    joins = np.array(joins)
+    near = (np.abs(t[:, None] - joins[None, :]) < JOIN_MERGE_SHARE / rate_hz).any(axis=1)
+    near[[0, -1]] = False
+    return np.sort(np.concatenate([t[~near], joins]))
+
+
+def seam_sample_times(law, parameter: TimeLawParameter, flange, rate_hz: float) -> np.ndarray:
+    """The law's sample times, with a path with leads' (``path.lead.LeadPath``) seam
+    ends σ = 0 and L as samples of their own (:func:`sample_times_through`)."""
+    ends = [-parameter.start, -parameter.start + getattr(flange, "seam_length", 0.0)]
+    return sample_times_through(law, [x for x in ends if 0.0 < x < parameter.length], rate_hz)
 
 
 def sample_workspace_trajectory(
@@ -145,9 +186,12 @@ def sample_workspace_trajectory(
     law: Sin2TimeLaw,
     *,
     rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
+    t: np.ndarray | None = None,
 ) -> WorkspaceTrajectory:
-    """Sample the flange path timed by ``law`` over σ (paper §4, eq. 9)."""
-    t = sample_times(law.duration, rate_hz)
+    """Sample the flange path timed by ``law`` over σ (paper §4, eq. 9), at ``t`` (N,)
+    [s] if given, else at ``rate_hz`` (:func:`seam_sample_times`: a lead's seam ends
+    too)."""
+    t = seam_sample_times(law, parameter, flange, rate_hz) if t is None else t
     sigma, sigma_dot, sigma_ddot, _ = law(t)
     s, ds, dds = parameter.s(sigma)
     s_dot = ds * sigma_dot

@@ -86,11 +86,12 @@ def asked() -> tuple[float, float]:
     return -ON_LEAD_MM * 1e-3, LENGTH_M - OFF_LEAD_MM * 1e-3
 
 
-def along(p_PT: np.ndarray) -> float:
+def along(p_PT: np.ndarray, off_line_m: float = 1e-4) -> float:
     """Position of a tool point on the part along the stripe from its start [m] (the
-    approach and retract are tangent: on the stripe's line)."""
+    approach and retract are tangent: on the stripe's line; a flying seam's leads lift
+    off it by up to ``off_line_m``)."""
     u = (END_P - START_P) / LENGTH_M
-    assert np.linalg.norm(np.cross(p_PT - START_P, u)) < 1e-4  # on the line
+    assert np.linalg.norm(np.cross(p_PT - START_P, u)) < off_line_m  # on the line
     return float((p_PT - START_P) @ u)
 
 
@@ -119,8 +120,9 @@ def krl_p_PT(decl: str) -> np.ndarray:
     return np.linalg.inv(X)[:3, 3]
 
 
-def krl_events(data, folder):
-    """[(what, value, position [m], DELAY [ms])] of every TRIGGER, in run order."""
+def krl_events(data, folder, off_line_m: float = 1e-4):
+    """[(what, value, position [m], DELAY [ms])] of every TRIGGER, in run order (the
+    position: the switch point's, projected on the stripe's line, ``along``)."""
     decls, run = {}, []
     for module in sorted(p.stem for p in folder.glob("*.src")):
         for line in (folder / f"{module}.dat").read_text().splitlines():
@@ -146,7 +148,8 @@ def krl_events(data, folder):
         elif line.startswith("LIN "):
             target = krl_p_PT(decls[line.split()[1]][1])
             for what, value, d, delay in pending:
-                events.append((what, value, along(point_before(here, target, d)), delay))
+                point = point_before(here, target, d)
+                events.append((what, value, along(point, off_line_m), delay))
             here, pending = target, []
     return run, events
 

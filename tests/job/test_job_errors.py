@@ -77,6 +77,12 @@ def run(tmp_path, text, capsys):
             "use 1..32",
         ),
         (("order: auto", "order: auto\n  link_time_s: 0"), "job.link_time_s", "must be within"),
+        (("motion:\n", "motion:\n  lead_mm: -5\n"), "motion.lead_mm", "must be within [0, 500]"),
+        (
+            ("direction: auto\n    speed", "direction: auto\n    entry: glide\n    speed"),
+            "seams[3].entry",
+            "'glide' is not an entry (use rest or flying)",
+        ),
     ],
 )
 def test_bad_job_input_is_one_line_exit_2_nothing_written(tmp_path, capsys, change, key, reason):

@@ -177,6 +177,59 @@ def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
     assert report < 1.0  # the bead starts 100 mm in at speed: the lag's thin start
 
 
+@pytest.mark.slow
+def test_a_flying_stripe_in_krl_lays_the_bead_from_its_first_millimetre(tmp_path):
+    """Issue 37: the stripe run flying (``entry: flying``) with the gun on at its start,
+    the bead's lag 0.08 s: the KRL's flow law and TRIGGERs replayed at the plan's speed
+    give the plan's bead within 1 %, ≥ 99 % of the gun-on length within ±5 %, no row
+    beyond ±20 % and no gun-on row at a standstill."""
+    from export.test_job_io import krl_events, stripe_cell
+
+    from offline_prog.export.formats import controller_post
+    from offline_prog.export.job_program import JobProgramData
+    from offline_prog.export.post import write_program
+    from offline_prog.plan import plan_job
+    from offline_prog.results.job_folder import write_job_outputs
+
+    cell = stripe_cell(tmp_path, on_lead_mm=0.0, off_lead_mm=0.0, lag_s=0.0)
+    text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
+    text = text.replace("direction: forward", "direction: forward\n    entry: flying")
+    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    assert job.chosen[0].plan.entry["entry"] == "flying"
+    folder = tmp_path / "plan"
+    write_job_outputs(job, folder)
+    data = JobProgramData.load(folder)
+    write_program(controller_post(data, "krl"), tmp_path / "krl")
+    src = (tmp_path / "krl" / "offline_prog.src").read_text()
+    m = re.search(
+        r"ANOUT ON \$ANOUT\[1\]=(\w+)\*\$VEL_ACT\+([-\d.]+) DELAY=([-\d.]+) "
+        r"MINIMUM=([-\d.]+) MAXIMUM=([-\d.]+)",
+        src,
+    )
+    offset, delay, low, high = (float(x) for x in m.groups()[1:])
+    _, events = krl_events(data, tmp_path / "krl", off_line_m=0.05)  # the leads lift
+    flow = [(float(value), position) for what, value, position, _ in events if what == m[1]]
+    (fk, p_on), (_, p_off) = flow
+    s = job.samples
+    rows = np.flatnonzero(np.isfinite(s.path_m))
+    t_on, t_off = np.interp([p_on, p_off], s.path_m[rows], s.t[rows])
+    t = s.t
+    live = np.where((t >= t_on) & (t < t_off), fk, 0.0)
+    v_ahead = np.interp(t - delay, t, job.tcp_speed)
+    value = 10.0 * np.clip(live * v_ahead + offset, low, high)
+    replay = replayed(job, t, value)
+    compare(job, folder, t, replay)
+    on = job.io.valve.astype(bool)
+    model = process_model(job.cell.process)
+    ratio = replay / (model.target * model.unit_scale) - 1.0
+    w = job.tcp_speed * np.gradient(t)
+    assert (w * (on & (np.abs(ratio) <= 0.05))).sum() / (w * on).sum() >= 0.99
+    assert np.abs(ratio[on]).max() <= 0.20
+    assert np.all(job.tcp_speed[on] > 1e-3 * job.cell.motion.speed)
+
+
 def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
     """The issue's figure: on the sealing demo, the share of process length within ±5 %
     of the bead's target with compensation on is at least that with it off, on the job

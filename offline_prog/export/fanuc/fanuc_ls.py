@@ -340,7 +340,10 @@ def _samples(rows, run: SeamRun):
     r_rows = np.arange(0)
     if retract:
         r_rows = np.arange(retract.start + 1, min(retract.stop, len(rows.t) - 1) + 1)
-    t0 = rows.t[segments["process"].start] - dense.t[0]
+    # A flying seam's leads are the seam's samples (dense): the job's rows on them left out.
+    a_rows = a_rows[rows.path_m[a_rows] < dense.path_m[0] - 1e-12]
+    r_rows = r_rows[~(rows.path_m[r_rows] <= dense.path_m[-1] + 1e-12)]  # NaN: kept
+    t0 = rows.t[segments["process"].start] - np.interp(0.0, dense.path_m, dense.t)
     path_r = rows.path_m[r_rows].copy()
     if len(path_r) > 1 and np.isnan(path_r[-1]):  # the retract's end: the next link's row
         gap = np.linalg.norm(rows.X_PT[r_rows[-1], :3, 3] - rows.X_PT[r_rows[-2], :3, 3])

@@ -1,0 +1,88 @@
+"""A flying seam's leads (path.lead): the flange path run on past both seam ends is as
+smooth there as the seam (position, velocity, acceleration; angular velocity and its
+rate), starts on the seam's tangent and lifts off the part, and changes nothing on the
+seam itself."""
+
+import numpy as np
+import pytest
+
+from offline_prog.path.lead import LIFT_RATIO, LeadPath, path_ends
+
+from conftest import random_flange_path, rotation_log
+
+LEAD_M = 0.03
+
+
+def _jumps(lead: LeadPath, end: float, h: float = 1e-7) -> dict[str, float]:
+    """Each field's change across the seam end over ±h, per metre of path."""
+    f = lead(np.array([end - h, end + h]))
+    return {
+        k: float(np.abs(np.diff(getattr(f, k), axis=0)).max())
+        for k in ("p_IE", "dp_IE", "ddp_IE", "w_s", "dw_s")
+    }
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_the_leads_join_the_seam_smoothly(rng, closed):
+    """Across σ = 0 and σ = L the flange's position, its first two σ-derivatives, its
+    angular velocity and its rate change no more than a smooth path's do over 2e-7 m
+    (the joints' q, q̇ and q̈ are continuous where the plan crosses them at speed)."""
+    for _ in range(3):
+        flange = random_flange_path(rng, closed=closed)
+        lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M)
+        for end in (0.0, flange.length):
+            f = flange(np.array([end]))
+            scale = {
+                "p_IE": np.abs(f.dp_IE).max(),
+                "dp_IE": np.abs(f.ddp_IE).max() + 1.0,
+                "ddp_IE": 1e3,  # the third derivative is not matched (a jerk step)
+                "w_s": np.abs(f.dw_s).max() + 1.0,
+                "dw_s": 1e3,
+            }
+            for key, jump in _jumps(lead, end).items():
+                assert jump <= 2e-7 * scale[key] * 10, (key, end, jump)
+
+
+def test_lead_derivatives_match_finite_differences(rng):
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M)
+    h = 1e-6
+    for s in (
+        rng.uniform(-LEAD_M + 2 * h, -2 * h, 50),
+        rng.uniform(2 * h, LEAD_M - 2 * h, 50) + flange.length,
+    ):
+        f, lo, hi = lead(s), lead(s - h), lead(s + h)
+        np.testing.assert_allclose((hi.p_IE - lo.p_IE) / (2 * h), f.dp_IE, atol=1e-7)
+        np.testing.assert_allclose((hi.dp_IE - lo.dp_IE) / (2 * h), f.ddp_IE, atol=1e-5)
+        w_fd = rotation_log(hi.R_IE @ np.swapaxes(lo.R_IE, 1, 2)) / (2 * h)
+        np.testing.assert_allclose(w_fd, f.w_s, atol=1e-6)
+        np.testing.assert_allclose((hi.w_s - lo.w_s) / (2 * h), f.dw_s, atol=1e-4)
+
+
+def test_the_lead_in_starts_on_the_tangent_and_lifts_off_the_part(rng):
+    """The tool point T in P: within the lead's first tenth it is off the seam's tangent
+    line by at most a thousandth of the lift; at the lead's far end it has backed off
+    the surface (against n) by the lift, LIFT_RATIO of the lead."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=0.0)
+    start = flange(np.array([0.0]))
+    p0, t0, n0 = start.p_PF[0], start.R_PF[0][:, 0], start.R_PF[0][:, 1]
+    near = lead(np.linspace(-0.1 * LEAD_M, 0.0, 20)).p_PF - p0
+    off_line = near - np.outer(near @ t0, t0)
+    lift = LIFT_RATIO * LEAD_M
+    assert np.linalg.norm(off_line, axis=1).max() <= 2e-3 * lift + 0.5 * (0.1 * LEAD_M) ** 2 * 50
+    far = lead(np.array([-LEAD_M])).p_PF[0] - p0
+    assert far @ t0 < 0.0  # before the start
+    assert -(far @ n0) == pytest.approx(lift, rel=0.2)  # backed off against n
+
+
+def test_leads_of_zero_change_nothing_on_the_seam(rng):
+    flange = random_flange_path(rng, closed=True)
+    lead = LeadPath(flange, lead_in_m=0.0, lead_out_m=0.0, reason="entry: rest")
+    s = np.linspace(0.0, flange.length, 101)
+    ours, theirs = lead(s), flange(s)
+    for key in ("p_IE", "dp_IE", "ddp_IE", "R_IE", "w_s", "dw_s", "p_PF", "R_PF"):
+        np.testing.assert_array_equal(getattr(ours, key), getattr(theirs, key))
+    assert path_ends(lead) == (0.0, flange.length) and not lead.flying
+    with pytest.raises(ValueError, match="no lead"):
+        lead(np.array([-1e-3]))
