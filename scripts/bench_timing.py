@@ -161,7 +161,7 @@ def lean_passes_ratio(plan) -> tuple[float, float, bool]:
         j_max=motion.max_jerk,
     )
     lean = time_optimal.lean_toppra
-    toppras = {"lean": lean, "toppra": lambda: time_optimal._toppra_algorithm().TOPPRA}
+    toppras = {"lean": lean, "toppra": lambda algorithm: algorithm.TOPPRA}
     best, durations = {}, {}
     try:
         for _ in range(5):

@@ -245,7 +245,8 @@ def topp_profile(
         a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)
         constraints.append(_speed_curve(np.minimum(v_curve, v_cap), path.dof, a_step))
     start = time.perf_counter()
-    solver = lean_toppra()(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
+    toppra = lean_toppra(_toppra_algorithm())
+    solver = toppra(constraints, path, gridpoints=sigma, solver_wrapper="seidel")
     _, sd, _, K = solver.compute_parameterization(*ends, return_data=True)
     solve_s = time.perf_counter() - start
     code = solver.problem_data.return_code

@@ -23,11 +23,9 @@ import numpy as np
 
 
 @functools.cache
-def lean_toppra():
-    """toppra.algorithm.TOPPRA with lean backward and forward passes (module doc)."""
-    from offline_prog.timing.time_optimal import _toppra_algorithm
-
-    algorithm = _toppra_algorithm()  # toppra without matplotlib
+def lean_toppra(algorithm):
+    """``algorithm.TOPPRA`` (``algorithm``: the module toppra.algorithm, as
+    ``time_optimal`` loads it) with lean backward and forward passes (module doc)."""
     from toppra.algorithm.algorithm import ParameterizationReturnCode
     from toppra.constants import MAX_TRIES, SMALL, TINY
     from toppra.exceptions import BadInputVelocities

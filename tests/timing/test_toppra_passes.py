@@ -15,7 +15,7 @@ def both(rates, monkeypatch, **kwargs):
     """(toppra's profile, the lean passes' profile) of one problem."""
     lean = topp_profile(rates, **kwargs)
     with monkeypatch.context() as patch:
-        patch.setattr(time_optimal, "lean_toppra", lambda: time_optimal._toppra_algorithm().TOPPRA)
+        patch.setattr(time_optimal, "lean_toppra", lambda algorithm: algorithm.TOPPRA)
         reference = topp_profile(rates, **kwargs)
     return reference, lean
 
