@@ -172,19 +172,20 @@ def _seam_run(job, number, segments, points, flow_where_set) -> SeamRun:
 
 def _linear_move(job: JobProgramData, segment: JobSegment, number: int, k: int) -> LinearMove:
     """The straight part of an approach or retract: a flying seam's approach ends where
-    its lead-in starts, its retract starts where its lead-out ends (the leads are the
-    seam's samples, ``results.program_data.seam_rows``)."""
-    rows = job.job
+    its lead-in starts (the seam's first sample), its retract starts where its lead-out
+    ends (the seam's last sample): the leads are the seam's samples
+    (``results.program_data.seam_rows``), and the job's rows, at the cell's sample
+    rate, need not hold the lead's end."""
+    rows, seam = job.job, job.seams[k]
     start, end = segment.start, min(segment.stop, len(rows.t) - 1)  # the segment's rows
-    path_m = job.seams[k].path_m  # the seam's samples, from its lead-in's start
-    if segment.kind == "approach" and path_m[0] < 0.0:
-        end = start + int(np.flatnonzero(rows.path_m[start : end + 1] <= path_m[0] + 1e-12)[-1])
-    if segment.kind == "retract" and path_m[-1] > job.seam_lengths_m[k]:
-        start += int(np.flatnonzero(rows.path_m[start : end + 1] >= path_m[-1] - 1e-12)[0])
-    X_PT = rows.X_PT
-    length = float(np.linalg.norm(X_PT[end, :3, 3] - X_PT[start, :3, 3]))
-    speed = float(job.seams[k].off_seam_speed_m_s)
-    return LinearMove(segment.kind, segment.seam, number, X_PT[end], rows.q[end], length, speed)
+    X_from, X_to, q_to = rows.X_PT[start], rows.X_PT[end], rows.q[end]
+    if segment.kind == "approach" and seam.path_m[0] < 0.0:
+        X_to, q_to = seam.X_PT[0], seam.q[0]
+    if segment.kind == "retract" and seam.path_m[-1] > job.seam_lengths_m[k]:
+        X_from = seam.X_PT[-1]
+    length = float(np.linalg.norm(X_to[:3, 3] - X_from[:3, 3]))
+    speed = float(seam.off_seam_speed_m_s)
+    return LinearMove(segment.kind, segment.seam, number, X_to, q_to, length, speed)
 
 
 def _process(seam: ProgramData, name: str, number: int, points: PointRule | None) -> Process:

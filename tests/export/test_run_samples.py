@@ -1,5 +1,6 @@
-"""A seam run's samples as the UR move and FANUC writers take them: on a flying seam
-each planned pose once, in time order, the leads included."""
+"""A flying seam's run as the writers take it: its samples (the UR move and FANUC
+writers) each planned pose once, in time order, the leads included; its straight
+approach and retract meeting the leads at any sample rate."""
 
 import numpy as np
 import pytest
@@ -9,6 +10,10 @@ from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.points import PointRule
 from offline_prog.export.record import program_record
 from offline_prog.export.run_samples import run_samples
+from offline_prog.plan import plan_job
+from offline_prog.results.job_folder import write_job_outputs
+
+from conftest import CELLS
 
 
 @pytest.fixture(scope="module")
@@ -37,3 +42,30 @@ def test_a_flying_seams_samples_run_once_in_time_order_through_its_leads(flying)
     assert lead_in.sum() > 2 and (samples.path_m > length).sum() > 2
     assert samples.t[0] == pytest.approx(flying.job.t[run.rows.start], abs=1e-9)
     assert samples.t[-1] == pytest.approx(flying.job.t[run.rows.stop - 1], abs=1e-9)
+
+
+@pytest.mark.slow  # plans a job of its own
+def test_a_flying_seams_straight_moves_end_at_its_leads_at_any_sample_rate(flying, tmp_path):
+    """The approach's straight move ends where the lead-in starts (on the seal demo the
+    lead's lift takes the whole approach: it is the approach's start) and the retract's
+    starts where the lead-out ends, at 2 samples per second (the job's rows then hold
+    neither the leads' ends) as at the demo's rate: the same targets and lengths."""
+    text = (CELLS / "seal_plate_kr16.yaml").read_text(encoding="utf-8")
+    text = text.replace(": data/", f": {CELLS}/data/").replace(
+        "  closed: true\n", "  closed: true\n  entry: flying\n"
+    )
+    cell = tmp_path / "slow_rate.yaml"
+    cell.write_text(text.replace("  max_jerk:", "  sample_rate_hz: 2\n  max_jerk:", 1))
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, tmp_path / "plan")
+    rule = PointRule("flange", "X_TP", 5e-5, 1e-3)
+    runs = [
+        program_record(d, rule).runs()[0] for d in (flying, JobProgramData.load(tmp_path / "plan"))
+    ]
+    for run in runs:
+        dense = run.process.data
+        np.testing.assert_allclose(run.approach.X_PT, dense.X_PT[0], atol=1e-9)
+    np.testing.assert_allclose(runs[1].approach.X_PT, runs[0].approach.X_PT, atol=1e-6)
+    np.testing.assert_allclose(runs[1].retract.X_PT, runs[0].retract.X_PT, atol=1e-6)
+    assert runs[1].retract.length_m == pytest.approx(runs[0].retract.length_m, abs=1e-6)
