@@ -16,7 +16,15 @@ against the plan's set positions [m].
 from __future__ import annotations
 
 import numpy as np
-from program_readers import KRL_FLOW_LAW, Point, Switch, krl_items, rapid_items, urscript_stream
+from program_readers import (
+    KRL_FLOW_LAW,
+    Point,
+    Switch,
+    krl_items,
+    rapid_items,
+    urscript_digital,
+    urscript_stream,
+)
 
 from offline_prog.process.registry import process_model
 
@@ -134,12 +142,16 @@ def at_rows(values: np.ndarray, fractional: float) -> float:
     return float(np.interp(fractional, np.arange(len(values)), values))
 
 
+def _digital_events(data) -> list:
+    from offline_prog.io_events import Signal
+
+    return [e for e in data.events if e.signal is Signal.DIGITAL]
+
+
 def switch_errors(data, placed, what: str) -> np.ndarray:
     """(K,) per switch of output ``what`` (the program's name of the plan's digital
     output), its position along the path against the plan's ``set_path_m`` [m]."""
-    from offline_prog.io_events import Signal
-
-    events = [e for e in data.events if e.signal is Signal.DIGITAL]
+    events = _digital_events(data)
     mine = [row for switch, row in placed if switch.what == what]
     assert len(mine) == len(events), (len(mine), len(events))
     path = data.job.path_m
@@ -191,6 +203,16 @@ def urscript_flow(job, script: str, output: int) -> tuple[np.ndarray, np.ndarray
     return stream_times(job, q, period), value, period
 
 
+def urscript_switch_errors(data, script: str, t: np.ndarray) -> np.ndarray:
+    """(K,) per ``set_standard_digital_out`` of the servoj stream (commands at plan
+    times ``t``), the path position at the command that runs next against the plan's
+    ``set_path_m`` [m] (set as the one before it ends: at most its travel late)."""
+    switches, events = urscript_digital(script), _digital_events(data)
+    assert [(n, s) for n, s, _ in switches] == [(e.output, e.state) for e in events]
+    path = np.interp(t, data.job.t, data.job.path_m)
+    return np.array([path[k] - e.set_path_m for (_, _, k), e in zip(switches, events, strict=True)])
+
+
 def stream_times(job, q_stream: np.ndarray, period: float) -> np.ndarray:
     """(K,) the plan's time of each servoj target: the block runs the approach to the
     retract every ``period``; its start is where the joints agree with the plan's."""
@@ -230,6 +252,19 @@ def fanuc_flow(job, data, folder, robot, *, steps: int = 16) -> tuple[np.ndarray
         k = np.minimum(np.searchsorted(ends, path, side="left"), len(ends) - 1)
         held[mine] = values[k]
     return t_fine, held
+
+
+def fanuc_switch_errors(data, folder, robot) -> np.ndarray:
+    """(K,) per DB switch of the LS program, where it lands along the part
+    (``fanuc_reader.walk``) against the plan's ``set_path_m`` [m]."""
+    from fanuc_reader import walk
+
+    errors = []
+    for seam, name in zip(walk(data, folder, robot), data.seam_names, strict=True):
+        events = [e for e in _digital_events(data) if e.seam == name]
+        assert [(n, s) for n, s, _ in seam["db"]] == [(e.output, e.state) for e in events]
+        errors += [p - e.set_path_m for (_, _, p), e in zip(seam["db"], events, strict=True)]
+    return np.array(errors)
 
 
 def _runs(data) -> list[tuple[int, int]]:

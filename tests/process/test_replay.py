@@ -15,7 +15,6 @@ import re
 
 import numpy as np
 import pytest
-from program_readers import urscript_digital
 from program_replay import (
     WORST_ALLOWED,
     acceptance,
@@ -25,7 +24,9 @@ from program_replay import (
     replayed,
     switch_errors,
     urscript_flow,
+    urscript_switch_errors,
 )
+from replay_jobs import BEAD, UR_LEAD_MM, exported, one_seam_flying, seal_job_flying
 
 from offline_prog.process.registry import process_model
 
@@ -33,10 +34,6 @@ from conftest import CELLS, with_own_io
 
 REPLAY_TOL = 0.01  # the issue: within 1 %
 SWITCH_TOL_M = 0.12e-3  # a switch read from the program against the plan's position
-BEAD_ON_UR = (  # the bead of the sealing demo, on another demo's robot
-    "process:\n  model: bead\n"
-    "  bead: {area_mm2: 12.0, tolerance_pct: 5, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
-)
 
 
 def plan_folder(capsys, tmp_path, text: str):
@@ -112,31 +109,10 @@ def test_bead_flow_set_by_urscript_gives_the_reported_bead(capsys, tmp_path):
     and the dispenser's lag on the streamed values gives the report's cross-section."""
     text = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
     text = with_own_io(text, "tool:\n  process_io:\n    flow: {analog_output: 1}\n")
-    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD_ON_UR + "motion:"))
+    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD + "motion:"))
     script = (folder / "programs" / "offline_prog.script").read_text()
     t, value, _ = urscript_flow(job, script, 1)
     compare(job, folder, t, replayed(job, t, value))
-
-
-def exported(cell, fmt: str, *, flying: bool = False):
-    """The cell planned, its outputs written beside it and its program in ``fmt``:
-    (job, plan folder, JobProgramData, the program's folder). ``flying``: every seam
-    runs flying (no fallback to rest)."""
-    from offline_prog.export.formats import controller_post
-    from offline_prog.export.job_program import JobProgramData
-    from offline_prog.export.post import write_program
-    from offline_prog.plan import plan_job
-    from offline_prog.results.job_folder import write_job_outputs
-
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    if flying:
-        assert [o.plan.entry["entry"] for o in job.chosen] == ["flying"] * len(job.chosen)
-    folder = cell.parent / "plan"
-    write_job_outputs(job, folder)
-    data = JobProgramData.load(folder)
-    write_program(controller_post(data, fmt), cell.parent / fmt)
-    return job, folder, data, cell.parent / fmt
 
 
 def bead_stripe(tmp_path, *, on_lead_mm: float, off_lead_mm: float, entry: str = "rest"):
@@ -147,7 +123,7 @@ def bead_stripe(tmp_path, *, on_lead_mm: float, off_lead_mm: float, entry: str =
     cell = stripe_cell(tmp_path, on_lead_mm=on_lead_mm, off_lead_mm=off_lead_mm, lag_s=0.0)
     text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
     text = text.replace("direction: forward", f"direction: forward\n    entry: {entry}")
-    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
+    cell.write_text(text.replace("motion:", BEAD + "motion:", 1))
     return cell
 
 
@@ -186,10 +162,8 @@ def test_the_seal_job_all_flying_in_krl_lays_every_seams_bead(tmp_path):
     ``seams[].motion.entry``); the KRL's TRIGGERs switch the gun within 0.12 mm of the
     plan's positions, and its flow replayed at the plan's speed holds the job to issue
     37's acceptance and every seam's run to the plan's own figures."""
-    text = (CELLS / "seal_job_kr16.yaml").read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
-    text = text.replace("    normal: [0, 0, 1]\n", "    normal: [0, 0, 1]\n    entry: flying\n")
     cell = tmp_path / "seal_job_flying.yaml"
-    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
+    cell.write_text(seal_job_flying(CELLS))
     job, folder, data, krl = exported(cell, "krl", flying=True)
     seams = json.loads((folder / "report.json").read_text())["seams"]
     assert [s["motion"]["entry"]["entry"] for s in seams] == ["flying"] * 4
@@ -205,22 +179,10 @@ def test_the_seal_job_all_flying_in_krl_lays_every_seams_bead(tmp_path):
         assert program["standstill"] == 0, name
 
 
-FLYING_IO = (  # the gun at the seam's ends, the flow following the speed
-    "tool:\n  process_io:\n    on:  {digital_output: 2}\n    off: {digital_output: 2}\n"
-    "    flow: {analog_output: 1}\n"
-)
-
-
 def flying_bead_cell(tmp_path, name: str, *, lead_mm: float | None = None):
-    """cells/<name>.yaml (a one-seam demo, ``path:``) laying the sealing demo's bead
-    (lag 0.08 s) with the gun and flow of FLYING_IO, its seam ``entry: flying`` with
-    ``motion.lead_mm`` (None: the default)."""
-    text = with_own_io((CELLS / f"{name}.yaml").read_text(), FLYING_IO)
-    text = text.replace("  closed: false\n", "  closed: false\n  entry: flying\n", 1)
-    motion = "motion:\n" + (f"  lead_mm: {lead_mm}\n" if lead_mm is not None else "")
-    text = text.replace("motion:\n", BEAD_ON_UR + motion, 1)
+    """The one-seam demo ``name`` laying the bead, its seam flying (``replay_jobs``)."""
     cell = tmp_path / f"{name}.yaml"
-    cell.write_text(text.replace(": data/", f": {CELLS}/data/"))
+    cell.write_text(one_seam_flying(CELLS, name, lead_mm=lead_mm))
     return cell
 
 
@@ -239,27 +201,20 @@ def test_a_flying_seam_in_rapid_lays_the_bead_from_its_first_millimetre(tmp_path
 
 @pytest.mark.slow
 def test_a_flying_seam_in_urscript_lays_the_bead_from_its_first_millimetre(tmp_path):
-    """The tape demo's UR10e laying the bead on its seam run flying, with 5 mm leads:
-    the default leads (54 mm) collide (link_3 with link_6) and fall back to rest, and
-    8 to 20 mm leave the approach's start closer to the part than the clearance. The
+    """The tape demo's UR10e laying the bead on its seam run flying, with 5 mm leads
+    (``replay_jobs``: the default leads collide and fall back to rest). The
     servoj stream's flow replayed at the plan's speed (issue 37's acceptance), its
     gun switched by the command the tool is at where the plan sets it; the movep
     program replayed from its text (path, speed, flow at its points)."""
     from export.test_ur_moves import check_movep_program
 
-    cell = flying_bead_cell(tmp_path, "tape_cylinder_ur10e", lead_mm=5.0)
+    cell = flying_bead_cell(tmp_path, "tape_cylinder_ur10e", lead_mm=UR_LEAD_MM)
     job, folder, data, ur = exported(cell, "urscript", flying=True)
     script = (ur / "offline_prog.script").read_text()
     t, value, period = urscript_flow(job, script, 1)
     assert_holds_the_bead(job, folder, t, replayed(job, t, value))
-    switches = urscript_digital(script)
-    events = [e for e in data.events if e.signal.value == "digital"]
-    assert [(n, state) for n, state, _ in switches] == [(2, e.state) for e in events]
-    path = np.interp(t, data.job.t, data.job.path_m)
-    for (_, _, k), event in zip(switches, events, strict=True):
-        # set as the command before k ends: at most one command's travel late
-        late = path[k] - event.set_path_m
-        assert 0.0 <= late <= job.cell.motion.speed * period + 1e-6, late
+    late = urscript_switch_errors(data, script, t)  # set as the command before ends
+    assert np.all(late >= 0.0) and late.max() <= job.cell.motion.speed * period + 1e-6, late
     check_movep_program(data, tmp_path / "movep")
 
 
@@ -301,7 +256,7 @@ def test_bead_flow_law_written_in_rapid_gives_the_reported_bead(capsys, tmp_path
     ScaleValue`` (V per mm/s) read from the module, replayed at the plan's speed."""
     text = (CELLS / "weld_seam_irb2400.yaml").read_text()
     text = with_own_io(text, "tool:\n  process_io:\n    flow: {analog_output: 1}\n")
-    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD_ON_UR + "motion:"))
+    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD + "motion:"))
     module = (folder / "programs" / "OfflineProg.mod").read_text()
     speeds = re.findall(r"TriggSpeed \w+, [\d.]+, ([\d.]+), ao1, ([\d.]+);", module)
     assert speeds and float(speeds[-1][1]) == 0.0

@@ -18,7 +18,8 @@ from calibrated import moved
 from fanuc_reader import nominal_frames, pose, read_ls, run_statements, walk
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from program_replay import fanuc_flow, replayed
+from program_replay import fanuc_flow, fanuc_switch_errors, replayed
+from replay_jobs import exported, import_m20ia, on_m20ia, stripe_flying, stripe_job
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation, Slerp
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
@@ -30,7 +31,6 @@ from offline_prog.export.post import write_program
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
-from offline_prog.robot_import.run import import_robot
 
 from conftest import with_own_io
 
@@ -57,25 +57,14 @@ def write_fanuc_job(data: JobProgramData, folder: Path) -> list[Path]:
 
 
 def _m20ia(work: Path) -> None:
-    import_robot(
-        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
-        name="fanuc_m20ia",
-        out=work / "robots",
-        package_paths=[FANUC],
-        vendor="fanuc",
-        samples=500,
-    )
-
-
-def _on_m20ia(text: str) -> str:
-    return text.replace("model: kuka_kr16_2\n", "model: fanuc_m20ia\n  robots_dir: robots\n")
+    import_m20ia(work, FANUC)
 
 
 @pytest.fixture(scope="module")
 def fanuc_job(tmp_path_factory):
     work = tmp_path_factory.mktemp("fanuc_job")
     _m20ia(work)
-    text = _on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
+    text = on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
     text = text.replace("motion:", "job: {order: given}\nmotion:", 1)
     text = with_own_io(text, IO)
     cell = work / "seal_job_m20ia.yaml"
@@ -89,11 +78,7 @@ def fanuc_job(tmp_path_factory):
 def _stripe_job() -> tuple[str, str]:
     """The seal job on the M-20iA cut to its stripe, run forward in the given order:
     (the text before ``seams:``, to edit; the rest from ``seams:`` on)."""
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
-    head, rest = text.split("seams:", 1)
-    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
-    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
-    return head, "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
+    return stripe_job(on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text()))
 
 
 @pytest.fixture(scope="module")
@@ -283,7 +268,7 @@ def test_plan_refuses_switches_no_sample_separates_in_one_line(tmp_path, capsys)
     from offline_prog.cli import main
 
     _m20ia(tmp_path)
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    text = on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
     head, rest = text.split("seams:", 1)
     seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
     head = head.replace("lead_mm: 5}", "lead_mm: -100}").replace("lead_mm: 2}", "lead_mm: 139.99}")
@@ -377,23 +362,16 @@ def test_a_flying_stripe_in_fanuc_lays_the_bead_from_its_first_millimetre(tmp_pa
     program holds along the part (its own poses), replayed at the plan's speed, give
     the plan's bead within 1 %, ≥ 99 % of the gun-on length within ±5 %, no row beyond
     ±20 %, no gun-on standstill; the DB switches within ±0.5 mm of the plan's."""
-    from process.test_replay import BEAD_ON_UR, assert_holds_the_bead, exported
+    from process.test_replay import assert_holds_the_bead
 
     _m20ia(tmp_path)
-    head, seams = _stripe_job()
-    head = head.replace("per_mps: 40.0, offset: 0.5, ", "")
-    head = head.replace("lead_mm: 5}", "lead_mm: 0}").replace("lead_mm: 2}", "lead_mm: 0}")
-    seams = seams.replace("direction: forward", "direction: forward\n    entry: flying")
     cell = tmp_path / "flying.yaml"
-    cell.write_text(BEAD_ON_UR + head + seams)
+    cell.write_text(stripe_flying(on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())))
     job, folder, data, ls = exported(cell, "fanuc", flying=True)
     t, held = fanuc_flow(job, data, ls, job.robot, steps=REPLAY_STEPS)
     assert_holds_the_bead(job, folder, t, replayed(job, t, held))
-    (seam,) = walk(data, ls, job.robot)
-    events = data.seam_events("stripe")
-    assert [s for _, s, _ in seam["db"]] == [e.state for e in events] == [True, False]
-    for (_, _, position), event in zip(seam["db"], events, strict=True):
-        assert position == pytest.approx(event.set_path_m, abs=SWITCH_TOL_M)
+    errors = fanuc_switch_errors(data, ls, job.robot)
+    assert len(errors) == 2 and np.abs(errors).max() <= SWITCH_TOL_M
 
 
 def _seam_motions(folder, name="OFFLINE_PROG"):
