@@ -20,10 +20,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 from pathlib import Path
 
-import numpy as np
 from off_seam_speeds import process_cells  # scripts/: the script's own folder
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "support"))  # the figures' rules
+from program_replay import BAND, WORST_ALLOWED, acceptance  # noqa: E402
 
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
@@ -31,8 +34,6 @@ from offline_prog.stages import load_inputs
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = REPO / "cells"
-BAND = 0.05  # ±5 % of the target
-WORST_ALLOWED = 0.20  # no gun-on row beyond ±20 %
 
 
 def with_keys(inputs, *, entry: str | None = None, **motion):
@@ -48,32 +49,12 @@ def with_keys(inputs, *, entry: str | None = None, **motion):
     return dataclasses.replace(inputs, cell=cell)
 
 
-def gun_on_rows(job) -> np.ndarray:
-    """(N,) where the output is on: the valve open, else the digital output, else the
-    seams' own rows (a process without a switched output)."""
-    io = job.io
-    if io.valve is not None:
-        return io.valve.astype(bool)
-    if io.digital is not None:
-        return io.digital.astype(bool)
-    on = np.zeros(len(job.samples.t), dtype=bool)
-    for segment in job.samples.segments:
-        if segment.kind == "process":
-            on[segment.start : segment.stop] = True
-    return on
-
-
 def figures(job) -> dict:
     """The acceptance figures of a planned job (module docstring)."""
     s, quality = job.samples, job.quality
-    on = gun_on_rows(job)
-    target = quality.model.target
-    ratio = quality.values / target - 1.0
-    w = job.tcp_speed * np.gradient(s.t)  # the path length each row stands for
-    finite = on & np.isfinite(ratio)
-    ok = finite & (np.abs(ratio) <= BAND)
-    worst = int(np.argmax(np.where(finite, np.abs(ratio), -1.0)))
-    standstill = on & (job.tcp_speed < 1e-3 * max(job.tcp_speed[on].max(), 1e-9))
+    ratio = quality.values / quality.model.target - 1.0
+    accepted = acceptance(job, ratio)
+    worst = accepted["worst_row"]
     moves = sum(g.t_stop - g.t_start for g in s.segments if g.kind in ("approach", "retract"))
     return {
         "entries": [
@@ -81,10 +62,10 @@ def figures(job) -> dict:
             + (f" ({o.plan.entry['reason']})" if o.plan.entry["reason"] else "")
             for o in job.chosen
         ],
-        "share": float((w * ok).sum() / (w * on).sum()),
+        "share": accepted["share"],
         "worst": float(ratio[worst]),
         "worst_at": (s.labels()[worst], float(s.path_m[worst])),
-        "standstill": int(standstill.sum()),
+        "standstill": accepted["standstill"],
         "cycle_s": float(s.t[-1]),
         "moves_s": float(moves),
     }

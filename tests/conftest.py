@@ -1,6 +1,5 @@
 """Shared fixtures: seeded random paths, frames and cell files."""
 
-import re
 import signal
 from pathlib import Path
 
@@ -8,6 +7,7 @@ import numpy as np
 import pytest
 from pydrake.common.eigen_geometry import Quaternion
 from pydrake.math import RigidTransform, RotationMatrix
+from replay_jobs import with_own_io  # noqa: F401  (the tests' shared cell edit)
 
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import fit_bspline
@@ -24,15 +24,6 @@ CELLS = REPO / "cells"
 # handler is reset to the default on exec, so the commands get Ctrl-C again.
 if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
-
-
-def with_own_io(text: str, io: str) -> str:
-    """A demo cell's text with its process model and its process I/O replaced by ``io``
-    (``"tool:\\n  process_io: ..."``): tests of the I/O writers bring their own outputs."""
-    text = re.sub(r"(?ms)^process:.*?(?=^\S)", "", text)
-    text = re.sub(r"(?m)^  # The dispenser's flow output.*\n", "", text)
-    text = re.sub(r"(?m)^  process_io:\n(    .*\n)*", "", text)
-    return text.replace("tool:\n", io, 1)
 
 
 # Pose comparison tolerances.

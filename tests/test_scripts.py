@@ -142,6 +142,7 @@ SMOKE = [
     ("figures.py", ["--cells", "seal_plate_kr16", "--runs", "1", "--out", "figures.md"], "wrote"),
     ("off_seam_speeds.py", ["--cells", "weld_seam_irb2400"], "cycle / default"),
     ("flying_entry_figures.py", ["--cells", "seal_plate_kr16"], "cycle flying / rest"),
+    ("program_bead_figures.py", ["--controllers", "abb"], "acceptance: within"),
 ]
 
 

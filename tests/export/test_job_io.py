@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from program_readers import Switch, krl_items, rapid_items, tool_in_part
 
 from offline_prog.config.cell import load_cell
 from offline_prog.export.formats import controller_post
@@ -26,10 +27,8 @@ from offline_prog.export.post import write_program
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
-from offline_prog.robot.model import load_robot
 
 from conftest import CELLS
-from rapid_reader import rapid_procs
 
 IO_TOL_M = 1e-3  # the issue: within ±1 mm
 START_P = np.array([-0.120, 0.080, 0.0])  # the stripe in P [m] (cells/seal_job_kr16.yaml)
@@ -95,63 +94,16 @@ def along(p_PT: np.ndarray, off_line_m: float = 1e-4) -> float:
     return float((p_PT - START_P) @ u)
 
 
-def tool_in_part(data: JobProgramData, q: np.ndarray) -> np.ndarray:
-    """p_PT [m] at joints q: X_PT = X_EP⁻¹ · X_BE(q)⁻¹ · X_BT (forward kinematics)."""
-    X_BE = load_robot(data.robot).forward(q[None])[0]
-    return (np.linalg.inv(data.job.X_EP) @ np.linalg.inv(X_BE) @ data.job.X_BT)[:3, 3]
-
-
-def point_before(p_from, p_to, d) -> np.ndarray:
-    """The point d [m] before p_to on the straight move from p_from."""
-    return p_to - d * (p_to - p_from) / np.linalg.norm(p_to - p_from)
-
-
 # --- KRL ------------------------------------------------------------------------------
 
 
-def krl_p_PT(decl: str) -> np.ndarray:
-    """p_PT [m] of an E6POS (P in T: X, Y, Z [mm], A, B, C [deg] Z-Y'-X'')."""
-    from scipy.spatial.transform import Rotation
-
-    f = {k: float(v) for k, v in (i.split() for i in decl.split(",")) if k not in "ST"}
-    X = np.eye(4)
-    X[:3, :3] = Rotation.from_euler("ZYX", [f["A"], f["B"], f["C"]], degrees=True).as_matrix()
-    X[:3, 3] = np.array([f["X"], f["Y"], f["Z"]]) * 1e-3
-    return np.linalg.inv(X)[:3, 3]
-
-
 def krl_events(data, folder, off_line_m: float = 1e-4):
-    """[(what, value, position [m], DELAY [ms])] of every TRIGGER, in run order (the
-    position: the switch point's, projected on the stripe's line, ``along``)."""
-    decls, run = {}, []
-    for module in sorted(p.stem for p in folder.glob("*.src")):
-        for line in (folder / f"{module}.dat").read_text().splitlines():
-            if m := re.match(r"DECL (E6POS|E6AXIS) (\w+)=\{(.*)\}$", line):
-                decls[m[2]] = (m[1], m[3])
-
-    def read(module):
-        for line in (folder / f"{module}.src").read_text().splitlines():
-            if re.fullmatch(r"offline_prog_\d+\( \)", line):
-                read(line.split("(")[0])
-            elif line and not line.startswith(";"):
-                run.append(line)
-
-    read("offline_prog")
-    here, pending, events = None, [], []
-    for line in run:
-        if line.startswith("PTP "):
-            axes = [float(v.split()[1]) for v in decls[line.split()[1]][1].split(",")[:6]]
-            here = tool_in_part(data, np.deg2rad(axes))
-        elif line.startswith("TRIGGER"):
-            m = re.match(r"TRIGGER WHEN PATH=(-?[\d.]+) DELAY=(-?\d+) DO (.+)=(.+) PRIO", line)
-            pending.append((m[3], m[4], -float(m[1]) * 1e-3, float(m[2])))
-        elif line.startswith("LIN "):
-            target = krl_p_PT(decls[line.split()[1]][1])
-            for what, value, d, delay in pending:
-                point = point_before(here, target, d)
-                events.append((what, value, along(point, off_line_m), delay))
-            here, pending = target, []
-    return run, events
+    """(the run's statements, [(what, value, position [m], DELAY [ms])] of every
+    TRIGGER in run order): the switch point's position projected on the stripe's line
+    (``along``)."""
+    run, items = krl_items(data, folder)
+    switches = [s for s in items if isinstance(s, Switch)]
+    return run, [(s.what, s.value, along(s.p_PT, off_line_m), s.delay_s * 1e3) for s in switches]
 
 
 def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
@@ -188,31 +140,8 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
 
 def rapid_events(data, text):
     """[(trigger kind, value, position [m], ScaleLag or None)] in run order."""
-    points = {
-        m[1]: np.array(m[2].split(","), float) * 1e-3
-        for m in re.finditer(r"robtarget (\w+) := \[\[([^\]]*)\]", text)
-    }
-    joints = {
-        m[1]: np.deg2rad(np.array(m[2].split(","), float))
-        for m in re.finditer(r"jointtarget (\w+) := \[\[([^\]]*)\]", text)
-    }
-    procs = rapid_procs(text)
-    run = [s for line in procs["main"] for s in procs.get(line.split(";")[0], [line])]
-    defined, here, events = {}, None, []
-    for line in run:
-        if m := re.match(r"TriggIO (\w+), ([\d.]+)\\DOp:=(\w+), (\d);", line):
-            defined[m[1]] = (m[3], m[4], float(m[2]) * 1e-3, None)
-        elif m := re.match(r"TriggSpeed (\w+), ([\d.]+), ([\d.]+), (\w+), ([\d.]+);", line):
-            defined[m[1]] = (m[4], m[5], float(m[2]) * 1e-3, float(m[3]))
-        elif m := re.match(r"MoveAbsJ (\w+)", line):
-            here = tool_in_part(data, joints[m[1]])
-        elif m := re.match(r"(MoveL|TriggL) (\w+)", line):
-            target = points[m[2]]
-            for name in re.findall(r"\b(t(?:Flow)?O(?:n|ff)\d*)\b", line):
-                what, value, d, lag = defined[name]
-                events.append((what, value, along(point_before(here, target, d)), lag))
-            here = target
-    return events
+    switches = [s for s in rapid_items(data, text) if isinstance(s, Switch)]
+    return [(s.what, s.value, along(s.p_PT), s.lag_s) for s in switches]
 
 
 def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):

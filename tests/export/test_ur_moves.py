@@ -5,6 +5,7 @@ import re
 
 import numpy as np
 import pytest
+from program_replay import fractional_row
 from scipy.spatial.transform import Rotation, Slerp
 
 from offline_prog.export.density import DEFAULT_ANGLE_TOL_RAD, DEFAULT_CHORD_TOL_M
@@ -95,19 +96,6 @@ def replay(waypoints: list[np.ndarray], radii: list[float]) -> np.ndarray:
                 X[:3, :3] = rot(u).as_matrix()
                 out.append(X)
     return np.array(out)
-
-
-def fractional_row(p_rows: np.ndarray, p: np.ndarray) -> float:
-    """The row position (a float index into p_rows (N, 3)) of the point p (3,) on the
-    polyline of the rows, nearest first."""
-    i = int(np.argmin(np.linalg.norm(p_rows - p, axis=1)))
-    best = (np.inf, float(i))
-    for a in (i - 1, i):
-        if 0 <= a < len(p_rows) - 1:
-            d = p_rows[a + 1] - p_rows[a]
-            u = float(np.clip(np.dot(p - p_rows[a], d) / max(np.dot(d, d), 1e-30), 0.0, 1.0))
-            best = min(best, (np.linalg.norm(p_rows[a] + u * d - p), a + u))
-    return best[1]
 
 
 def distances_to_polyline(points: np.ndarray, line: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -15,54 +15,25 @@ import re
 
 import numpy as np
 import pytest
+from program_replay import (
+    WORST_ALLOWED,
+    acceptance,
+    krl_flow,
+    rapid_flow,
+    ratio_to_target,
+    replayed,
+    switch_errors,
+    urscript_flow,
+    urscript_switch_errors,
+)
+from replay_jobs import BEAD, UR_LEAD_MM, exported, one_seam_flying, seal_job_flying
 
 from offline_prog.process.registry import process_model
 
 from conftest import CELLS, with_own_io
 
 REPLAY_TOL = 0.01  # the issue: within 1 %
-BEAD_ON_UR = (  # the bead of the sealing demo, on another demo's robot
-    "process:\n  model: bead\n"
-    "  bead: {area_mm2: 12.0, tolerance_pct: 5, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
-)
-
-
-def urscript_stream(script: str, output: int) -> tuple[np.ndarray, np.ndarray, float]:
-    """(K, 6) the servoj joint targets [rad], (K,) the output's value [V] while each
-    runs, and the period [s] of the first servoj block (one-seam job: one block)."""
-    period = float(re.search(r"servoj\(.*t=([\d.]+)", script)[1])
-    q, value, current = [], [], 0.0
-    for line in script.splitlines():
-        line = line.strip()
-        if m := re.match(rf"set_standard_analog_out\({output}, ([-\d.]+)\)", line):
-            current = float(m[1]) * 10.0  # URScript's 0..1 of the 10 V range
-        elif line.startswith("servoj("):
-            q.append(np.array(re.search(r"\(\[([^\]]*)\]", line)[1].split(","), float))
-            value.append(current)
-    return np.array(q), np.array(value), period
-
-
-def stream_times(job, q_stream: np.ndarray, period: float) -> np.ndarray:
-    """(K,) the plan's time of each servoj target: the block runs the approach to the
-    retract every ``period``; its start is where the joints agree with the plan's."""
-    s = job.samples
-    start = next(g.t_start for g in s.segments if g.kind == "approach")
-    best = None
-    for shift in np.arange(-2, 3) * period:
-        t = start + shift + period * np.arange(len(q_stream))
-        q_plan = np.stack([np.interp(t, s.t, s.q[:, j]) for j in range(6)], axis=1)
-        error = np.abs(job.robot.controller_joints(q_plan) - q_stream).max()
-        if best is None or error < best[0]:
-            best = (error, t)
-    assert best[0] < 1e-3, f"the servoj stream is not the plan's motion ({best[0]:.2g} rad)"
-    return best[1]
-
-
-def replayed(job, t: np.ndarray, value: np.ndarray) -> np.ndarray:
-    """The model on the program's values at its times, at the plan's speed there."""
-    model = process_model(job.cell.process)
-    v = np.interp(t, job.samples.t, job.tcp_speed)
-    return model.predict(t, v, value) * model.unit_scale
+SWITCH_TOL_M = 0.12e-3  # a switch read from the program against the plan's position
 
 
 def plan_folder(capsys, tmp_path, text: str):
@@ -83,13 +54,15 @@ def compare(job, folder, t, quality_prog):
     the standstills): the replay within 1 %; and the share."""
     report = json.loads((folder / "report.json").read_text())["quality"]
     column = job.quality.column
-    moves = [g for g in job.samples.segments if g.kind != "link"]
-    rows = slice(moves[0].start, moves[-1].stop)
+    rows = np.zeros(len(column), bool)  # the seams' runs (not the links between them)
+    for g in job.samples.segments:
+        rows[g.start : g.stop] |= g.kind != "link"
     plan_t, plan_q = job.samples.t[rows], column[rows]
     keep = np.isfinite(plan_q)
-    inside = (t > plan_t[keep][0]) & (t < plan_t[keep][-1])
+    defined = np.interp(t, job.samples.t, (rows & np.isfinite(column)).astype(float)) == 1.0
+    inside = (t > plan_t[keep][0]) & (t < plan_t[keep][-1]) & defined
     expected = np.interp(t[inside], plan_t[keep], plan_q[keep])
-    top = job.tcp_speed[rows].max()  # the seam's (links move the part faster)
+    top = job.tcp_speed[rows].max()  # the seams' (links move the part faster)
     moving = np.interp(t[inside], job.samples.t, job.tcp_speed) > 0.05 * top
     assert moving.sum() > 0.8 * inside.sum()  # the approach and retract start and stop
     # Within 1 % of the value, or of the target where the gun's lag fills or drains the
@@ -110,12 +83,24 @@ def compare(job, folder, t, quality_prog):
     return share
 
 
+def assert_holds_the_bead(job, folder, t: np.ndarray, quality: np.ndarray) -> dict:
+    """Issue 37's acceptance of a program's ``quality`` (K,) replayed at times ``t``
+    (K,) [s]: within 1 % of the plan (``compare``), ≥ 99 % of the gun-on length within
+    ±5 % of the target, no gun-on row beyond ±20 %, no gun-on row at a standstill.
+    Returns the figures (``program_replay.acceptance``)."""
+    compare(job, folder, t, quality)
+    figures = acceptance(job, ratio_to_target(job, np.interp(job.samples.t, t, quality)))
+    assert figures["share"] >= 0.99, figures
+    assert figures["worst"] <= WORST_ALLOWED, figures
+    assert figures["standstill"] == 0, figures
+    return figures
+
+
 def test_tape_heater_power_set_by_urscript_gives_the_reported_temperature(planned_job):
     job, folder = planned_job("tape_cylinder_ur10e")
     output = job.cell.process.tape_heating.power_output.analog_output
     script = (folder / "programs" / "offline_prog.script").read_text()
-    q, value, period = urscript_stream(script, output)
-    t = stream_times(job, q, period)
+    t, value, _ = urscript_flow(job, script, output)
     compare(job, folder, t, replayed(job, t, value))
 
 
@@ -124,11 +109,22 @@ def test_bead_flow_set_by_urscript_gives_the_reported_bead(capsys, tmp_path):
     and the dispenser's lag on the streamed values gives the report's cross-section."""
     text = (CELLS / "tape_cylinder_ur10e.yaml").read_text()
     text = with_own_io(text, "tool:\n  process_io:\n    flow: {analog_output: 1}\n")
-    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD_ON_UR + "motion:"))
+    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD + "motion:"))
     script = (folder / "programs" / "offline_prog.script").read_text()
-    q, value, period = urscript_stream(script, 1)
-    t = stream_times(job, q, period)
+    t, value, _ = urscript_flow(job, script, 1)
     compare(job, folder, t, replayed(job, t, value))
+
+
+def bead_stripe(tmp_path, *, on_lead_mm: float, off_lead_mm: float, entry: str = "rest"):
+    """Issue 24's stripe (cells/seal_job_kr16.yaml's, alone) laying the sealing demo's
+    bead, run with ``entry``."""
+    from export.test_job_io import stripe_cell
+
+    cell = stripe_cell(tmp_path, on_lead_mm=on_lead_mm, off_lead_mm=off_lead_mm, lag_s=0.0)
+    text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
+    text = text.replace("direction: forward", f"direction: forward\n    entry: {entry}")
+    cell.write_text(text.replace("motion:", BEAD + "motion:", 1))
+    return cell
 
 
 def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
@@ -136,43 +132,11 @@ def test_bead_flow_written_in_krl_gives_the_reported_bead(tmp_path):
     laying the sealing demo's bead, the gun on 100 mm into it: the KRL's ``ANOUT ON
     $ANOUT[1]=FK*$VEL_ACT+offset DELAY=−τ MINIMUM MAXIMUM`` and its TRIGGERs' FK values
     and positions (from the program's own poses), replayed at the plan's speed."""
-    from export.test_job_io import krl_events, stripe_cell
-
-    from offline_prog.export.formats import controller_post
-    from offline_prog.export.job_program import JobProgramData
-    from offline_prog.export.post import write_program
-    from offline_prog.plan import plan_job
-    from offline_prog.results.job_folder import write_job_outputs
-
-    cell = stripe_cell(tmp_path, on_lead_mm=-100.0, off_lead_mm=2.0, lag_s=0.0)
-    text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
-    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    folder = tmp_path / "plan"
-    write_job_outputs(job, folder)
-    data = JobProgramData.load(folder)
-    write_program(controller_post(data, "krl"), tmp_path / "krl")
-    src = (tmp_path / "krl" / "offline_prog.src").read_text()
-    m = re.search(
-        r"ANOUT ON \$ANOUT\[1\]=(\w+)\*\$VEL_ACT\+([-\d.]+) DELAY=([-\d.]+) "
-        r"MINIMUM=([-\d.]+) MAXIMUM=([-\d.]+)",
-        src,
-    )
-    assert m, "no speed-following ANOUT in the KRL"
-    offset, delay, low, high = (float(x) for x in m.groups()[1:])
-    _, events = krl_events(data, tmp_path / "krl")
-    flow = [(float(value), position) for what, value, position, _ in events if what == m[1]]
-    (fk, p_on), (idle, p_off) = flow
-    assert fk > 0 and idle == 0.0
-    # The tool's time at each TRIGGER's position (the seam's rows: path_m rises).
-    s = job.samples
-    rows = np.flatnonzero(np.isfinite(s.path_m))
-    t_on, t_off = np.interp([p_on, p_off], s.path_m[rows], s.t[rows])
-    t = s.t
-    live = np.where((t >= t_on) & (t < t_off), fk, 0.0)
-    v_ahead = np.interp(t - delay, t, job.tcp_speed)  # DELAY < 0: the output leads
-    value = 10.0 * np.clip(live * v_ahead + offset, low, high)
+    cell = bead_stripe(tmp_path, on_lead_mm=-100.0, off_lead_mm=2.0)
+    job, folder, data, krl = exported(cell, "krl")
+    t, value, placed = krl_flow(job, data, krl)
+    flow = [float(switch.value) for switch, _ in placed if "_FK" in switch.what]
+    assert len(flow) == 2 and flow[0] > 0 and flow[1] == 0.0
     report = compare(job, folder, t, replayed(job, t, value))
     assert report < 1.0  # the bead starts 100 mm in at speed: the lag's thin start
 
@@ -182,52 +146,76 @@ def test_a_flying_stripe_in_krl_lays_the_bead_from_its_first_millimetre(tmp_path
     """Issue 37: the stripe run flying (``entry: flying``) with the gun on at its start,
     the bead's lag 0.08 s: the KRL's flow law and TRIGGERs replayed at the plan's speed
     give the plan's bead within 1 %, ≥ 99 % of the gun-on length within ±5 %, no row
-    beyond ±20 % and no gun-on row at a standstill."""
-    from export.test_job_io import krl_events, stripe_cell
+    beyond ±20 % and no gun-on row at a standstill; the gun's TRIGGERs switch where
+    the plan sets it."""
+    cell = bead_stripe(tmp_path, on_lead_mm=0.0, off_lead_mm=0.0, entry="flying")
+    job, folder, data, krl = exported(cell, "krl", flying=True)
+    t, value, placed = krl_flow(job, data, krl)
+    assert_holds_the_bead(job, folder, t, replayed(job, t, value))
+    assert np.abs(switch_errors(data, placed, "$OUT[1]")).max() <= SWITCH_TOL_M
 
-    from offline_prog.export.formats import controller_post
-    from offline_prog.export.job_program import JobProgramData
-    from offline_prog.export.post import write_program
-    from offline_prog.plan import plan_job
-    from offline_prog.results.job_folder import write_job_outputs
 
-    cell = stripe_cell(tmp_path, on_lead_mm=0.0, off_lead_mm=0.0, lag_s=0.0)
-    text = cell.read_text().replace("per_mps: 40.0, offset: 0.5, ", "")
-    text = text.replace("direction: forward", "direction: forward\n    entry: flying")
-    cell.write_text(text.replace("motion:", BEAD_ON_UR + "motion:", 1))
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    assert job.chosen[0].plan.entry["entry"] == "flying"
-    folder = tmp_path / "plan"
-    write_job_outputs(job, folder)
-    data = JobProgramData.load(folder)
-    write_program(controller_post(data, "krl"), tmp_path / "krl")
-    src = (tmp_path / "krl" / "offline_prog.src").read_text()
-    m = re.search(
-        r"ANOUT ON \$ANOUT\[1\]=(\w+)\*\$VEL_ACT\+([-\d.]+) DELAY=([-\d.]+) "
-        r"MINIMUM=([-\d.]+) MAXIMUM=([-\d.]+)",
-        src,
-    )
-    offset, delay, low, high = (float(x) for x in m.groups()[1:])
-    _, events = krl_events(data, tmp_path / "krl", off_line_m=0.05)  # the leads lift
-    flow = [(float(value), position) for what, value, position, _ in events if what == m[1]]
-    (fk, p_on), (_, p_off) = flow
-    s = job.samples
-    rows = np.flatnonzero(np.isfinite(s.path_m))
-    t_on, t_off = np.interp([p_on, p_off], s.path_m[rows], s.t[rows])
-    t = s.t
-    live = np.where((t >= t_on) & (t < t_off), fk, 0.0)
-    v_ahead = np.interp(t - delay, t, job.tcp_speed)
-    value = 10.0 * np.clip(live * v_ahead + offset, low, high)
-    replay = replayed(job, t, value)
-    compare(job, folder, t, replay)
-    on = job.io.valve.astype(bool)
-    model = process_model(job.cell.process)
-    ratio = replay / (model.target * model.unit_scale) - 1.0
-    w = job.tcp_speed * np.gradient(t)
-    assert (w * (on & (np.abs(ratio) <= 0.05))).sum() / (w * on).sum() >= 0.99
-    assert np.abs(ratio[on]).max() <= 0.20
-    assert np.all(job.tcp_speed[on] > 1e-3 * job.cell.motion.speed)
+@pytest.mark.slow
+def test_the_seal_job_all_flying_in_krl_lays_every_seams_bead(tmp_path):
+    """cells/seal_job_kr16.yaml (border, two holes, stripe; no overlap set) with every
+    seam ``entry: flying`` laying the bead (lag 0.08 s): every seam flies (report.json
+    ``seams[].motion.entry``); the KRL's TRIGGERs switch the gun within 0.12 mm of the
+    plan's positions, and its flow replayed at the plan's speed holds the job to issue
+    37's acceptance and every seam's run to the plan's own figures."""
+    cell = tmp_path / "seal_job_flying.yaml"
+    cell.write_text(seal_job_flying(CELLS))
+    job, folder, data, krl = exported(cell, "krl", flying=True)
+    seams = json.loads((folder / "report.json").read_text())["seams"]
+    assert [s["motion"]["entry"]["entry"] for s in seams] == ["flying"] * 4
+    t, value, placed = krl_flow(job, data, krl)
+    assert np.abs(switch_errors(data, placed, "$OUT[1]")).max() <= SWITCH_TOL_M
+    quality = replayed(job, t, value)
+    assert_holds_the_bead(job, folder, t, quality)
+    plan = job.quality.values / job.quality.model.target - 1.0
+    for name in data.seam_names:
+        program, planned = (acceptance(job, r, name) for r in (ratio_to_target(job, quality), plan))
+        assert program["share"] == pytest.approx(planned["share"], abs=REPLAY_TOL), name
+        assert program["worst"] == pytest.approx(planned["worst"], abs=REPLAY_TOL), name
+        assert program["standstill"] == 0, name
+
+
+def flying_bead_cell(tmp_path, name: str, *, lead_mm: float | None = None):
+    """The one-seam demo ``name`` laying the bead, its seam flying (``replay_jobs``)."""
+    cell = tmp_path / f"{name}.yaml"
+    cell.write_text(one_seam_flying(CELLS, name, lead_mm=lead_mm))
+    return cell
+
+
+@pytest.mark.slow
+def test_a_flying_seam_in_rapid_lays_the_bead_from_its_first_millimetre(tmp_path):
+    """The weld demo's IRB 2400 laying the bead on its seam run flying: each
+    ``TriggSpeed``'s ScaleValue and ScaleLag and each ``TriggIO`` at its point (from
+    the module's own targets), replayed at the plan's speed: issue 37's acceptance."""
+    cell = flying_bead_cell(tmp_path, "weld_seam_irb2400")
+    job, folder, data, rapid = exported(cell, "rapid", flying=True)
+    text = (rapid / "OfflineProg.mod").read_text()
+    t, value, placed = rapid_flow(job, data, text)
+    assert_holds_the_bead(job, folder, t, replayed(job, t, value))
+    assert np.abs(switch_errors(data, placed, "do2")).max() <= SWITCH_TOL_M
+
+
+@pytest.mark.slow
+def test_a_flying_seam_in_urscript_lays_the_bead_from_its_first_millimetre(tmp_path):
+    """The tape demo's UR10e laying the bead on its seam run flying, with 5 mm leads
+    (``replay_jobs``: the default leads collide and fall back to rest). The
+    servoj stream's flow replayed at the plan's speed (issue 37's acceptance), its
+    gun switched by the command the tool is at where the plan sets it; the movep
+    program replayed from its text (path, speed, flow at its points)."""
+    from export.test_ur_moves import check_movep_program
+
+    cell = flying_bead_cell(tmp_path, "tape_cylinder_ur10e", lead_mm=UR_LEAD_MM)
+    job, folder, data, ur = exported(cell, "urscript", flying=True)
+    script = (ur / "offline_prog.script").read_text()
+    t, value, period = urscript_flow(job, script, 1)
+    assert_holds_the_bead(job, folder, t, replayed(job, t, value))
+    late = urscript_switch_errors(data, script, t)  # set as the command before ends
+    assert np.all(late >= 0.0) and late.max() <= job.cell.motion.speed * period + 1e-6, late
+    check_movep_program(data, tmp_path / "movep")
 
 
 def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
@@ -268,7 +256,7 @@ def test_bead_flow_law_written_in_rapid_gives_the_reported_bead(capsys, tmp_path
     ScaleValue`` (V per mm/s) read from the module, replayed at the plan's speed."""
     text = (CELLS / "weld_seam_irb2400.yaml").read_text()
     text = with_own_io(text, "tool:\n  process_io:\n    flow: {analog_output: 1}\n")
-    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD_ON_UR + "motion:"))
+    job, folder = plan_folder(capsys, tmp_path, text.replace("motion:", BEAD + "motion:"))
     module = (folder / "programs" / "OfflineProg.mod").read_text()
     speeds = re.findall(r"TriggSpeed \w+, [\d.]+, ([\d.]+), ao1, ([\d.]+);", module)
     assert speeds and float(speeds[-1][1]) == 0.0

@@ -15,9 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from calibrated import moved
-from fanuc_reader import joints_from_config, pose, read_ls
+from fanuc_reader import nominal_frames, pose, read_ls, run_statements, walk
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from program_replay import fanuc_flow, fanuc_switch_errors, replayed
+from replay_jobs import exported, import_m20ia, on_m20ia, stripe_flying, stripe_job
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation, Slerp
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
@@ -29,7 +31,6 @@ from offline_prog.export.post import write_program
 from offline_prog.io_events import IoEvent, Signal
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
-from offline_prog.robot_import.run import import_robot
 
 from conftest import with_own_io
 
@@ -56,25 +57,14 @@ def write_fanuc_job(data: JobProgramData, folder: Path) -> list[Path]:
 
 
 def _m20ia(work: Path) -> None:
-    import_robot(
-        FANUC / "fanuc_m20ia_support/urdf/m20ia.xacro",
-        name="fanuc_m20ia",
-        out=work / "robots",
-        package_paths=[FANUC],
-        vendor="fanuc",
-        samples=500,
-    )
-
-
-def _on_m20ia(text: str) -> str:
-    return text.replace("model: kuka_kr16_2\n", "model: fanuc_m20ia\n  robots_dir: robots\n")
+    import_m20ia(work, FANUC)
 
 
 @pytest.fixture(scope="module")
 def fanuc_job(tmp_path_factory):
     work = tmp_path_factory.mktemp("fanuc_job")
     _m20ia(work)
-    text = _on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
+    text = on_m20ia((REPO / "cells" / "seal_plate_kr16.yaml").read_text())
     text = text.replace("motion:", "job: {order: given}\nmotion:", 1)
     text = with_own_io(text, IO)
     cell = work / "seal_job_m20ia.yaml"
@@ -88,11 +78,7 @@ def fanuc_job(tmp_path_factory):
 def _stripe_job() -> tuple[str, str]:
     """The seal job on the M-20iA cut to its stripe, run forward in the given order:
     (the text before ``seams:``, to edit; the rest from ``seams:`` on)."""
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
-    head, rest = text.split("seams:", 1)
-    seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
-    tail = rest[rest.index("job:") :].replace("order: auto", "order: given")
-    return head, "seams:\n" + seam.replace("direction: auto", "direction: forward") + tail
+    return stripe_job(on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text()))
 
 
 @pytest.fixture(scope="module")
@@ -115,112 +101,6 @@ def stripe(tmp_path_factory):
     return JobProgramData.load(work / "plan"), work / "plan", job.robot
 
 
-def _run(folder, name="OFFLINE_PROG"):
-    """Statements in execution order: (statement, position entry or None)."""
-    out = []
-
-    def read(program):
-        ls = read_ls(folder / f"{program}.ls")
-        for statement in ls["mn"]:
-            if statement.startswith("CALL "):
-                read(statement.split()[1])
-            elif m := re.match(r"([JL]) P\[(\d+)\]", statement):
-                out.append((statement, ls["pos"][int(m[2])]))
-            elif statement.startswith(("AO[", "DO[")):
-                out.append((statement, None))
-
-    read(name)
-    return out
-
-
-def nominal_frames(folder, robot, name="OFFLINE_PROG"):
-    """{"UFRAME": (number, X_BT), "UTOOL": (number, X_EP)} (4, 4) [m] as ``<name>_FRAMES``
-    sets them (``PR[r]=P[j]`` then ``UFRAME[i]=PR[r]``); the user frame turned from FANUC's
-    world (on axis 1 at axis 2's height: base_link raised by c1) into base_link."""
-    ls, held, frames = read_ls(folder / f"{name}_FRAMES.ls"), {}, {}
-    for statement in ls["mn"]:
-        if m := re.fullmatch(r"PR\[(\d+)\]=P\[(\d+)\]", statement):
-            held[m[1]] = pose(ls["pos"][int(m[2])]["xyzwpr"])
-        elif m := re.fullmatch(r"(UFRAME|UTOOL)\[(\d+)\]=PR\[(\d+)\]", statement):
-            frames[m[1]] = (int(m[2]), held[m[3]])
-    number, X_WT = frames["UFRAME"]
-    X_BW = np.eye(4)
-    X_BW[2, 3] = robot.params.c1
-    frames["UFRAME"] = (number, X_BW @ X_WT)
-    return frames
-
-
-def _tool_curve(X_a: np.ndarray, X_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The controller's L motion from pose X_a to X_b (4, 4) of P in the user frame T:
-    (G,) shares λ of the TCP's (P's origin) straight chord and (G, 3) the tool's point
-    (T's origin) on the part there, the orientation slerped, 0.05 mm apart or closer."""
-    length = np.linalg.norm(X_b[:3, 3] - X_a[:3, 3])
-    turn = np.linalg.norm(Rotation.from_matrix(X_a[:3, :3].T @ X_b[:3, :3]).as_rotvec())
-    lam = np.linspace(0.0, 1.0, max(2, int(max(length, turn) / 5e-5) + 2))
-    R = Slerp([0, 1], Rotation.from_matrix([X_a[:3, :3], X_b[:3, :3]]))(lam).as_matrix()
-    p = X_a[:3, 3] + lam[:, None] * (X_b[:3, 3] - X_a[:3, 3])
-    return lam, np.einsum("gji,gj->gi", R, -p)
-
-
-def _walk(data, folder, robot):
-    """Replays the program: per seam (in run order), the DB switches as (output, state,
-    position [m]) and the L motions as (start, end [m], AO value), positions along the
-    tool's path on the part from the seam's start, from the program's own poses in the
-    frames the frames program sets. The controller moves P's origin (the TCP UTOOL
-    names) on a straight line with the orientation slerped, and sets a DB output when
-    that TCP comes within the DB distance of the motion's end: the switch lands where
-    the tool's point on the part is then."""
-    frames = nominal_frames(folder, robot)
-    (uf, X_BT), (ut, X_EP) = frames["UFRAME"], frames["UTOOL"]
-    X_PE, X_TB = np.linalg.inv(X_EP), np.linalg.inv(X_BT)
-    here, cumulative, ao, seams = None, 0.0, None, []
-    starts = [seam.X_PT[0, :3, 3] for seam in data.seams]  # the seams' planned starts
-    for statement, entry in _run(folder):
-        if entry is None:
-            assert statement.startswith("AO["), statement  # no plain DO statements
-            ao = float(statement.split("=")[1])
-            continue
-        if statement.startswith("J "):
-            q = robot.urdf_joints(np.radians(entry["joints"])[None])[0]
-            X_BE = robot.forward(q[None])[0]
-        else:
-            assert (entry["uf"], entry["ut"]) == (uf, ut)
-            X_BE = X_BT @ pose(entry["xyzwpr"]) @ X_PE
-            q = joints_from_config(robot, X_BE, entry["config"], entry["turns"])
-            np.testing.assert_allclose(robot.forward(q[None])[0], X_BE, atol=1e-9)
-        X_TP = X_TB @ X_BE @ X_EP
-        if statement.startswith("J "):
-            if seams and "open" in seams[-1]:
-                del seams[-1]["open"]
-            cumulative = 0.0
-        else:
-            if not seams or "open" not in seams[-1]:
-                seams.append({"open": True, "db": [], "moves": []})
-            lam, curve = _tool_curve(here, X_TP)
-            along = np.concatenate(
-                [[0.0], np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))]
-            )
-            seams[-1]["moves"].append((cumulative, cumulative + along[-1], ao))
-            assert len(re.findall(r"\bDB\b", statement)) <= 1, statement
-            if m := re.search(r"DB ([\d.]+)mm,DO\[(\d+)\]=(ON|OFF)", statement):
-                chord = np.linalg.norm(X_TP[:3, 3] - here[:3, 3])
-                at = 1.0 - min(float(m[1]) * 1e-3 / chord, 1.0) if chord > 0 else 1.0
-                seams[-1]["db"].append(
-                    (int(m[2]), m[3] == "ON", cumulative + np.interp(at, lam, along))
-                )
-            cumulative += along[-1]
-            start = starts[len(seams) - 1]
-            if "zero" not in seams[-1] and np.linalg.norm(curve[-1] - start) < 1e-6:
-                seams[-1]["zero"] = cumulative  # the approach ends at the seam's start
-        here = X_TP
-    for seam in seams:
-        zero = seam.pop("zero")
-        seam["db"] = [(n, s, p - zero) for n, s, p in seam["db"]]
-        seam["moves"] = [(a - zero, b - zero, v) for a, b, v in seam["moves"]]
-        seam.pop("open", None)
-    return seams
-
-
 def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
     data, folder, robot, cell = fanuc_job
     _check_job(data, folder, robot, cell)
@@ -234,7 +114,7 @@ def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
     # position registers are numbered per program).
 
     def statements(folder):
-        return [(re.sub(r"P\[\d+\]", "P[]", s), p) for s, p in _run(folder)]
+        return [(re.sub(r"P\[\d+\]", "P[]", s), p) for s, p in run_statements(folder)]
 
     assert max(len(read_ls(f)["mn"]) for f in folder.glob("*.ls")) > 100
     assert len(files) > len(list(folder.glob("*.ls")))
@@ -242,7 +122,7 @@ def test_fanuc_job_links_poses_and_io(fanuc_job, tmp_path):
 
 
 def _check_job(data, folder, robot, cell):
-    run = _run(folder)
+    run = run_statements(folder)
     joints = [np.radians(e["joints"]) for s, e in run if s.startswith("J ")]
     planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
     np.testing.assert_allclose(
@@ -251,7 +131,7 @@ def _check_job(data, folder, robot, cell):
         atol=JOINT_TOL_DEG,
     )
     io = load_cell(cell).tool.process_io
-    seams = _walk(data, folder, robot)
+    seams = walk(data, folder, robot)
     assert len(seams) == len(data.seam_names)
     for k, seam in enumerate(seams):
         on, off = -io.on.lead_mm * 1e-3, data.seam_lengths_m[k] - io.off.lead_mm * 1e-3
@@ -275,7 +155,7 @@ def test_fanuc_keeps_both_switches_on_a_straight_seam(stripe, tmp_path):
     """Issue 24's case: on 100 mm into the stripe, off 2 mm before its end."""
     data, _, robot = stripe
     write_fanuc_job(data, tmp_path)
-    (seam,) = _walk(data, tmp_path, robot)
+    (seam,) = walk(data, tmp_path, robot)
     on, off = -ON_LEAD_MM * 1e-3, LENGTH_M - OFF_LEAD_MM * 1e-3
     assert [(n, s) for n, s, _ in seam["db"]] == [(1, True), (1, False)]
     assert seam["db"][0][2] == pytest.approx(on, abs=SWITCH_TOL_M)
@@ -295,7 +175,7 @@ def test_fanuc_flow_replays_the_plans_ao_column(stripe, tmp_path):
     holds where the tool is at that row (its position from the row's joints)."""
     data, folder, robot = stripe
     write_fanuc_job(data, tmp_path)
-    (seam,) = _walk(data, tmp_path, robot)
+    (seam,) = walk(data, tmp_path, robot)
     with open(folder / "trajectory.csv") as f:
         rows = [r for r in csv.DictReader(f) if r["segment"] != "link"]  # the stripe's
     q = np.array([[float(r[f"q{j}"]) for j in range(1, 7)] for r in rows])  # [rad]
@@ -332,7 +212,7 @@ def test_fanuc_switches_where_the_events_say(stripe, positions_mm):
     data = dataclasses.replace(data, events=events)
     with tempfile.TemporaryDirectory() as folder:
         write_fanuc_job(data, Path(folder))
-        (seam,) = _walk(data, Path(folder), robot)
+        (seam,) = walk(data, Path(folder), robot)
     assert [s for _, s, _ in seam["db"]] == [k % 2 == 0 for k in range(len(positions_mm))]
     assert [p for _, _, p in seam["db"]] == [
         pytest.approx(p * 1e-3, abs=SWITCH_TOL_M) for p in positions_mm
@@ -366,7 +246,7 @@ def test_fanuc_switches_land_where_the_part_turns(fanuc_job):
     assert turns >= 4
     with tempfile.TemporaryDirectory() as folder:
         write_fanuc_job(dataclasses.replace(data, events=events + analog), Path(folder))
-        seam = _walk(data, Path(folder), robot)[0]
+        seam = walk(data, Path(folder), robot)[0]
     assert [s for _, s, _ in seam["db"]] == [k % 2 == 0 for k in range(len(positions))]
     landed = np.array([p for _, _, p in seam["db"]])
     assert np.abs(landed - positions).max() <= SWITCH_TOL_M
@@ -388,7 +268,7 @@ def test_plan_refuses_switches_no_sample_separates_in_one_line(tmp_path, capsys)
     from offline_prog.cli import main
 
     _m20ia(tmp_path)
-    text = _on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
+    text = on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())
     head, rest = text.split("seams:", 1)
     seam = rest[rest.index("  - name: stripe") : rest.index("job:")]
     head = head.replace("lead_mm: 5}", "lead_mm: -100}").replace("lead_mm: 2}", "lead_mm: 139.99}")
@@ -434,25 +314,13 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     write_fanuc_job(data, tmp_path)
     for _, motions in _seam_motions(tmp_path):  # coarser flow steps near rest, no short one
         _assert_no_short_motion(motions)
-    (seam,) = _walk(data, tmp_path, robot)
     s = job.samples
-    ends = np.array([b for _, b, _ in seam["moves"]])
-    values = np.array([v for _, _, v in seam["moves"]])
-    idle = job.io.settings.idle
-    # The controller holds each motion's AO from the motion's start (a step) and the
-    # model's lag takes a piecewise-linear command, so the replay runs on a grid
-    # REPLAY_STEPS times finer than the plan's rows: a step between two rows is then
-    # not smeared over a whole row interval (a motion here is two or three rows long).
-    at = np.arange((len(s.t) - 1) * REPLAY_STEPS + 1) / REPLAY_STEPS
-    t_fine = np.interp(at, np.arange(len(s.t)), s.t)
-    rows_near = np.round(at).astype(int)
-    on_path = np.isfinite(s.path_m)[np.floor(at).astype(int)] & np.isfinite(s.path_m)[rows_near]
-    path = np.interp(t_fine, s.t, np.nan_to_num(s.path_m))
-    k = np.minimum(np.searchsorted(ends, path, side="left"), len(ends) - 1)
-    held = np.where(on_path, values[k], idle)
+    # The controller holds each motion's AO from the motion's start (a step), replayed
+    # on a grid REPLAY_STEPS times finer than the plan's rows (a motion here is two or
+    # three rows long).
+    t_fine, held = fanuc_flow(job, data, tmp_path, robot, steps=REPLAY_STEPS)
     model = process_model(job.cell.process)
-    speed = np.interp(t_fine, s.t, job.tcp_speed)
-    bead = (model.predict(t_fine, speed, held) * model.unit_scale)[::REPLAY_STEPS]
+    bead = replayed(job, t_fine, held)[::REPLAY_STEPS]
     process = next(g for g in s.segments if g.kind == "process")
     rows = np.arange(process.start, process.stop)
     plan = job.quality.column[rows]
@@ -485,6 +353,25 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     assert report["model"] == "bead"
     assert share == pytest.approx(report["share_within_band"], abs=0.01)
     assert np.mean(inside_plan[check] == inside_replay[check]) > 0.99
+
+
+@pytest.mark.slow
+def test_a_flying_stripe_in_fanuc_lays_the_bead_from_its_first_millimetre(tmp_path):
+    """Issue 37: the stripe on the M-20iA run flying with the gun on at its start and
+    off at its end, laying the bead (lag 0.08 s): the AO values and DB switches the LS
+    program holds along the part (its own poses), replayed at the plan's speed, give
+    the plan's bead within 1 %, ≥ 99 % of the gun-on length within ±5 %, no row beyond
+    ±20 %, no gun-on standstill; the DB switches within ±0.5 mm of the plan's."""
+    from process.test_replay import assert_holds_the_bead
+
+    _m20ia(tmp_path)
+    cell = tmp_path / "flying.yaml"
+    cell.write_text(stripe_flying(on_m20ia((REPO / "cells" / "seal_job_kr16.yaml").read_text())))
+    job, folder, data, ls = exported(cell, "fanuc", flying=True)
+    t, held = fanuc_flow(job, data, ls, job.robot, steps=REPLAY_STEPS)
+    assert_holds_the_bead(job, folder, t, replayed(job, t, held))
+    errors = fanuc_switch_errors(data, ls, job.robot)
+    assert len(errors) == 2 and np.abs(errors).max() <= SWITCH_TOL_M
 
 
 def _seam_motions(folder, name="OFFLINE_PROG"):
@@ -553,7 +440,7 @@ def test_fanuc_approach_and_retract_run_at_the_planned_speed(fanuc_job, tmp_path
         g = segments[kind]
         own = np.arange(g.start - 1, g.stop + 1)  # the link's last row, the next's first
         written = []
-        for statement, entry in _run(tmp_path):
+        for statement, entry in run_statements(tmp_path):
             if not statement.startswith("L "):
                 continue
             p = (X_BT @ pose(entry["xyzwpr"]))[:3, 3]
@@ -581,8 +468,8 @@ def test_fanuc_ao_in_counts_is_the_volts_times_the_cells_counts_per_volt(stripe,
     io = dataclasses.replace(data.process_io, ao_unit="counts", counts_per_volt=per_volt)
     write_fanuc_job(data, tmp_path / "volts")
     write_fanuc_job(dataclasses.replace(data, process_io=io), tmp_path / "counts")
-    (volts,) = _walk(data, tmp_path / "volts", robot)
-    (counts,) = _walk(data, tmp_path / "counts", robot)
+    (volts,) = walk(data, tmp_path / "volts", robot)
+    (counts,) = walk(data, tmp_path / "counts", robot)
     assert len(volts["moves"]) == len(counts["moves"])
     for (a, b, v), (_, _, c) in zip(volts["moves"], counts["moves"], strict=True):
         assert c == round(c) and abs(c / per_volt - v) <= 0.0005 + 1 / per_volt, (a, b)
@@ -614,7 +501,7 @@ def _l_flange_poses(folder, robot) -> np.ndarray:
     """(n, 4, 4) the faceplate at each L position: UFRAME · position · UTOOL⁻¹."""
     frames = nominal_frames(folder, robot)
     X_BT, X_EP = frames["UFRAME"][1], frames["UTOOL"][1]
-    entries = [e for s, e in _run(folder) if s.startswith("L ")]
+    entries = [e for s, e in run_statements(folder) if s.startswith("L ")]
     return np.array([X_BT @ pose(e["xyzwpr"]) @ np.linalg.inv(X_EP) for e in entries])
 
 
@@ -639,7 +526,7 @@ def test_fanuc_programs_select_the_cells_frames_and_follow_their_calibration(str
     assert (frames["UFRAME"][0], frames["UTOOL"][0]) == (uf, ut)
     np.testing.assert_allclose(frames["UFRAME"][1], data.job.X_BT, atol=1e-5)
     np.testing.assert_allclose(frames["UTOOL"][1], data.job.X_EP, atol=1e-5)
-    before, (seam,) = _l_flange_poses(tmp_path, robot), _walk(data, tmp_path, robot)
+    before, (seam,) = _l_flange_poses(tmp_path, robot), walk(data, tmp_path, robot)
     rng = np.random.default_rng(0)
     X_WT_new = moved(frames["UFRAME"][1], rng)
     X_WT_new[2, 3] -= robot.params.c1  # into FANUC's world
@@ -654,6 +541,6 @@ def test_fanuc_programs_select_the_cells_frames_and_follow_their_calibration(str
     expected = X_BT_new @ np.linalg.inv(X_BT) @ before @ X_EP @ np.linalg.inv(X_EP_new)
     np.testing.assert_allclose(after, expected, atol=1e-6)
     assert np.abs(after[:, :3, 3] - before[:, :3, 3]).max() > 1e-3  # it did move
-    (moved_seam,) = _walk(data, tmp_path, robot)
+    (moved_seam,) = walk(data, tmp_path, robot)
     for (n, s, p), (n2, s2, p2) in zip(seam["db"], moved_seam["db"], strict=True):
         assert (n, s) == (n2, s2) and p2 == pytest.approx(p, abs=1e-6)

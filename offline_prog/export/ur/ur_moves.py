@@ -14,7 +14,8 @@ Points: the planned samples (``export.run_samples``) from the approach's start t
 retract's end (the job's rows there, the seam's densified samples on it); the seam's
 points from the writer's ``PointRule`` (half the path tolerance), the approach's start,
 the seam's ends, the retract's end and the sample at which each I/O event is set
-(its ``t_s``) are points; motions are split at planned samples until each holds half
+(its ``t_s``; one of those ends if the part travels less than ``merge.MIN_MOTION_M``
+from it to there) are points; motions are split at planned samples until each holds half
 the tolerance, then motions shorter than ``merge.MIN_MOTION_M`` merged where the plan
 allows (``merge.PathCheck``).
 
@@ -43,7 +44,7 @@ import dataclasses
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from offline_prog.export.merge import PathCheck
+from offline_prog.export.merge import MIN_MOTION_M, PathCheck
 from offline_prog.export.record import SeamRun
 from offline_prog.export.run_samples import run_samples
 
@@ -65,6 +66,8 @@ class UrMoves:
         accel_m_s2: (K,) the acceleration of the move to each point [m/s²].
         deviation_m: the largest distance of the tool's planned samples from the
             motions between the points, blends not counted [m] (≤ half the tolerance).
+        event_points: (E,) per event of the run (in its order), the index into
+            ``points`` of the point after whose move it is set.
     """
 
     t: np.ndarray
@@ -74,6 +77,7 @@ class UrMoves:
     speed_m_s: np.ndarray
     accel_m_s2: np.ndarray
     deviation_m: float
+    event_points: np.ndarray
 
 
 def ur_moves(job, run: SeamRun, *, chord_tol_m: float, angle_tol_rad: float) -> UrMoves:
@@ -82,10 +86,12 @@ def ur_moves(job, run: SeamRun, *, chord_tol_m: float, angle_tol_rad: float) -> 
     t, X_BP, seam_points = samples.t, samples.X_BP, samples.seam_points
     first, last = samples.first, samples.last
     check = PathCheck(X_BP, job.job.X_BT, 0.5 * chord_tol_m, 0.5 * angle_tol_rad)
-    events = {min(int(np.searchsorted(t, e.t_s - 1e-12)), len(t) - 1) for e in run.events}
-    pinned = {0, first, last, len(t) - 1} | events
+    ends = (0, first, last, len(t) - 1)
+    events = [_event_sample(t, X_BP[:, :3, 3], e.t_s, ends) for e in run.events]
+    pinned = set(ends) | set(events)
     points = _split(check, sorted(set(seam_points) | pinned))
     points = np.array(check.merge(points, pinned))
+    event_points = np.searchsorted(points, np.array(events, dtype=int))
     d, _ = check.deviations(points[:-1], points[1:])
     p = X_BP[points, :3, 3]
     length = np.linalg.norm(np.diff(p, axis=0), axis=1)  # (K-1,)
@@ -99,7 +105,18 @@ def ur_moves(job, run: SeamRun, *, chord_tol_m: float, angle_tol_rad: float) -> 
         budget_m=chord_tol_m - np.maximum(np.r_[0.0, d], np.r_[d, 0.0]),
         budget_rad=0.5 * angle_tol_rad,
     )
-    return UrMoves(t, X_BP, points, radius, speed, accel, float(d.max(initial=0.0)))
+    deviation = float(d.max(initial=0.0))
+    return UrMoves(t, X_BP, points, radius, speed, accel, deviation, event_points)
+
+
+def _event_sample(t: np.ndarray, p_BP: np.ndarray, t_s: float, ends) -> int:
+    """The sample at which an event set at ``t_s`` [s] is written: the first at or
+    after it, or a run's end (``ends``: its start, the seam's ends, its end) the part
+    travels less than ``MIN_MOTION_M`` from there (a flying seam's flow goes live
+    while the tool stands at its lead's start: a move to it would be a few µm long)."""
+    k = min(int(np.searchsorted(t, t_s - 1e-12)), len(t) - 1)
+    near = [j for j in ends if np.linalg.norm(p_BP[j] - p_BP[k]) < MIN_MOTION_M]
+    return min(near, key=lambda j: abs(j - k)) if near else k
 
 
 def _split(check: PathCheck, points: list[int]) -> list[int]:

@@ -258,9 +258,8 @@ class UrScriptPost(ControllerPost):
         points, t = moves.points, moves.t
         X_TB = np.linalg.inv(self.job.job.X_BT)
         at_point: dict[int, list] = {}
-        for event in run.events:
-            k = min(int(np.searchsorted(t, event.t_s - 1e-12)), len(t) - 1)
-            at_point.setdefault(int(np.searchsorted(points, k)), []).append(event)
+        for event, m in zip(run.events, moves.event_points, strict=True):
+            at_point.setdefault(int(m), []).append(event)
         flow, last = self._flow(run, t[points]), None
         self.lines.append(
             f"  # {run.seam}: {len(points) - 1} moves, deviation <= "
