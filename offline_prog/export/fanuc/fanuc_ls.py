@@ -76,6 +76,7 @@ from offline_prog.export.merge import PathCheck
 from offline_prog.export.points import PointRule
 from offline_prog.export.post import ControllerPost, PointOptions
 from offline_prog.export.record import JointMove, ProgramRecord, SeamRun, Switch
+from offline_prog.export.run_samples import run_samples
 from offline_prog.export.split import check_line_limit
 
 NAME_MAX = 36  # program names: letters, digits, _; this writer keeps 36 characters at most
@@ -329,35 +330,18 @@ def _deviation_remarks(check: PathCheck, motions, seam_ends, residual) -> list[s
 
 
 def _samples(rows, run: SeamRun):
-    """The seam's planned samples from its approach's start (the link's end) to its
-    retract's end: the job's approach rows, the seam's densified samples, the job's
-    retract rows; the L points before splitting; the indices of the seam's first and
-    last sample."""
-    segments = {s.kind: s for s in run.segments}
-    dense, idx = run.process.data, run.process.indices
-    approach, retract = segments.get("approach"), segments.get("retract")
-    a_rows = np.arange(approach.start, approach.stop) if approach else np.arange(0)
-    r_rows = np.arange(0)
-    if retract:
-        r_rows = np.arange(retract.start + 1, min(retract.stop, len(rows.t) - 1) + 1)
-    # A flying seam's leads are the seam's samples (dense): the job's rows on them left out.
-    a_rows = a_rows[rows.path_m[a_rows] < dense.path_m[0] - 1e-12]
-    r_rows = r_rows[~(rows.path_m[r_rows] <= dense.path_m[-1] + 1e-12)]  # NaN: kept
-    t0 = rows.t[segments["process"].start] - np.interp(0.0, dense.path_m, dense.t)
-    path_r = rows.path_m[r_rows].copy()
-    if len(path_r) > 1 and np.isnan(path_r[-1]):  # the retract's end: the next link's row
-        gap = np.linalg.norm(rows.X_PT[r_rows[-1], :3, 3] - rows.X_PT[r_rows[-2], :3, 3])
-        path_r[-1] = path_r[-2] + gap
+    """The seam's planned samples (``export.run_samples``) with the fixed tool's origin;
+    the L points before splitting; the indices of the seam's first and last sample."""
+    run_rows = run_samples(rows, run)
     samples = Samples(
-        path_m=np.concatenate([rows.path_m[a_rows], dense.path_m, path_r]),
-        t=np.concatenate([rows.t[a_rows], dense.t + t0, rows.t[r_rows]]),
-        q=np.concatenate([rows.q[a_rows], dense.q, rows.q[r_rows]]),
-        X_BP=np.concatenate([rows.X_BE[a_rows], dense.X_BE, rows.X_BE[r_rows]]) @ rows.X_EP,
+        path_m=run_rows.path_m,
+        t=run_rows.t,
+        q=run_rows.q,
+        X_BP=run_rows.X_BP,
         p_BT=rows.X_BT[:3, 3],
     )
-    n_a, n_p = len(a_rows) + int(idx[0]), len(a_rows) + int(idx[-1])
-    points = [0, *(len(a_rows) + idx), len(samples.path_m) - 1]
-    return samples, points, (n_a, n_p)
+    points = [0, *run_rows.seam_points, len(samples.path_m) - 1]
+    return samples, points, (run_rows.first, run_rows.last)
 
 
 def _flow_at(job):

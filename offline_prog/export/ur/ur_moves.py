@@ -10,7 +10,7 @@ controller interpolates P in B while the tool stands still: the flange style of
 of the poses). The nominal values of the two variables are in ``<name>_frames.script``
 only.
 
-Points: the planned samples from the approach's start (the link's end) to the
+Points: the planned samples (``export.run_samples``) from the approach's start to the
 retract's end (the job's rows there, the seam's densified samples on it); the seam's
 points from the writer's ``PointRule`` (half the path tolerance), the approach's start,
 the seam's ends, the retract's end and the sample at which each I/O event is set
@@ -45,6 +45,7 @@ from scipy.spatial.transform import Rotation
 
 from offline_prog.export.merge import PathCheck
 from offline_prog.export.record import SeamRun
+from offline_prog.export.run_samples import run_samples
 
 MOVE_MODES = ("movel", "movep")
 A_MIN_M_S2 = 0.1  # the slowest acceleration written (a speed held: UR wants one)
@@ -75,31 +76,11 @@ class UrMoves:
     deviation_m: float
 
 
-def run_samples(job, run: SeamRun) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int]]:
-    """The run's planned samples: the job's approach rows, the seam's densified samples,
-    the job's retract rows.
-
-    Returns:
-        (t (N,) [s], X_BP (N, 4, 4), seam points (K,) as sample indices, (first, last)
-        sample of the seam).
-    """
-    rows, kinds = job.job, {s.kind: s for s in run.segments}
-    dense, idx = run.process.data, run.process.indices
-    approach, retract = kinds.get("approach"), kinds.get("retract")
-    a_rows = np.arange(approach.start, approach.stop) if approach else np.arange(0)
-    r_rows = np.arange(0)
-    if retract:
-        r_rows = np.arange(retract.start + 1, min(retract.stop, len(rows.t) - 1) + 1)
-    t0 = rows.t[kinds["process"].start] - dense.t[0]
-    t = np.concatenate([rows.t[a_rows], dense.t + t0, rows.t[r_rows]])
-    X_BE = np.concatenate([rows.X_BE[a_rows], dense.X_BE, rows.X_BE[r_rows]])
-    first, last = len(a_rows) + int(idx[0]), len(a_rows) + int(idx[-1])
-    return t, X_BE @ rows.X_EP, len(a_rows) + idx, (first, last)
-
-
 def ur_moves(job, run: SeamRun, *, chord_tol_m: float, angle_tol_rad: float) -> UrMoves:
     """The run's moves (see the module docstring) within the path tolerances [m, rad]."""
-    t, X_BP, seam_points, (first, last) = run_samples(job, run)
+    samples = run_samples(job.job, run)
+    t, X_BP, seam_points = samples.t, samples.X_BP, samples.seam_points
+    first, last = samples.first, samples.last
     check = PathCheck(X_BP, job.job.X_BT, 0.5 * chord_tol_m, 0.5 * angle_tol_rad)
     events = {min(int(np.searchsorted(t, e.t_s - 1e-12)), len(t) - 1) for e in run.events}
     pinned = {0, first, last, len(t) - 1} | events
