@@ -39,7 +39,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import MAX_LEAD_CUTS, at_rest, cut_leads, with_leads
+from offline_prog.timing.lead_length import at_rest, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -324,26 +324,11 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
 
 def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:
     """Stage ``check``: the attempt with the collision check of every sample and step at
-    the cell's clearances. A flying seam whose leads collide is planned again with the
-    leads cut short of the collision (``timing.lead_length.cut_leads``, at most
-    MAX_LEAD_CUTS times), else at rest: where that one is free, it is the attempt."""
+    the cell's clearances. A flying seam that collides is planned at rest again: where
+    that one is free, the leads collided and it is the attempt."""
     checked = _checked(inputs, scene, attempt)
     if checked.collisions.collision_free or not getattr(attempt.flange, "flying", False):
         return checked
-    trial = checked
-    for _ in range(MAX_LEAD_CUTS):
-        cut = cut_leads(trial.flange, trial.collisions.collisions, planned=attempt.flange)
-        if cut is None:
-            break
-        try:
-            trial = plan_motion(inputs, attempt.rotation, cut, attempt.joints.branch)
-        except PlanFailedError:
-            break
-        if not trial.flange.flying:  # the cut leads could not be run: planned at rest
-            break
-        trial = _checked(inputs, scene, trial)
-        if trial.collisions.collision_free:
-            return trial
     try:
         rest = plan_motion(
             inputs,

@@ -79,14 +79,11 @@ class Plan:
     @property
     def entry(self) -> dict:
         """How the seam is entered and left: ``{"entry": "flying" | "rest", "reason":
-        why at rest, or why a flying seam's lead is shorter than planned ("" when it
-        is not), "lead_in_mm", "lead_out_mm"}`` (report.json)."""
+        why at rest ("" when flying), "lead_in_mm", "lead_out_mm"}`` (report.json)."""
         lead_in = 0.0 if self.lead_in is None else self.lead_in.length_m
         lead_out = 0.0 if self.lead_out is None else self.lead_out.length_m
         flying = lead_in > 0.0 or lead_out > 0.0
-        reason = getattr(self.flange, "reason", "")
-        if not flying:
-            reason = reason or "entry: rest"
+        reason = "" if flying else getattr(self.flange, "reason", "") or "entry: rest"
         return {
             "entry": "flying" if flying else "rest",
             "reason": reason,

@@ -22,13 +22,6 @@ from offline_prog.timing.time_law import sin2_time_law
 
 RAMP_MARGIN = 1.2  # the lead's ramp room, a share of the sin² law's ramp
 RAMP_SAMPLES = 4001  # time samples of the ramp that find where it reaches v
-# A lead that collides is cut to this share of its free stretch next to the seam (its
-# lift shrinks with it, so the cut lead runs nearer the seam's own poses) ...
-LEAD_CUT_SHARE = 0.75
-# ... at most this many times, and never below this share of the lead's length as
-# planned: a seam whose leads cannot be run longer starts and ends at rest.
-MAX_LEAD_CUTS = 2
-MIN_LEAD_SHARE = 0.25
 
 
 def ramp_length_m(v: float, *, a_max: float, j_max: float) -> float:
@@ -85,37 +78,6 @@ def _switch_m(cell: Cell, v: float) -> float:
     model = process_model(cell.process)
     lag = max(io.flow.lag_s if io and io.flow else 0.0, model.output_lag_s if model else 0.0)
     return ahead + lag * v
-
-
-def cut_leads(flange: LeadPath, stretches, *, planned: LeadPath | None = None) -> LeadPath | None:
-    """``flange`` with each lead that collides cut to LEAD_CUT_SHARE of its free stretch
-    next to the seam (``stretches``: ``CollisionStretch`` records, σ [m] the seam's);
-    None when a stretch reaches the seam's own σ ∈ [0, L] (the seam collides, not its
-    leads) or a lead would be cut below MIN_LEAD_SHARE of ``planned``'s (default
-    ``flange``). The reason names both lengths, for report.json."""
-    planned = planned or flange
-    L = flange.seam_length
-    lead_in, lead_out = flange.lead_in_m, flange.lead_out_m
-    for stretch in stretches:
-        low = min(stretch.sigma_start_m, stretch.sigma_end_m)
-        high = max(stretch.sigma_start_m, stretch.sigma_end_m)
-        if high >= 0.0 and low <= L:
-            return None
-        if high < 0.0:
-            lead_in = min(lead_in, LEAD_CUT_SHARE * -high)
-        else:
-            lead_out = min(lead_out, LEAD_CUT_SHARE * (low - L))
-    cut = []
-    for name, new, old in (
-        ("lead-in", lead_in, planned.lead_in_m),
-        ("lead-out", lead_out, planned.lead_out_m),
-    ):
-        if new < MIN_LEAD_SHARE * old:
-            return None
-        if new < old:
-            cut.append(f"the {name} cut to {new * 1e3:.1f} mm ({old * 1e3:.1f} mm collides)")
-    reason = "; ".join(cut)
-    return LeadPath(unwrapped(flange), lead_in_m=lead_in, lead_out_m=lead_out, reason=reason)
 
 
 def at_rest(flange: LeadPath, reason: str) -> LeadPath:
