@@ -95,6 +95,8 @@ def main(names: list[str], approach_speed: float | None) -> None:
             cycles[label] = f["cycle_s"]
             segment, at = f["worst_at"]
             print(f"{name:22s} {label:28s} {'; '.join(f['entries'])}")
+            if not job.feasible:  # its figures are of a plan that cannot be run
+                print(f"{'':22s} INFEASIBLE: {job.failure}")
             print(
                 f"{'':22s} gun-on within ±{BAND * 100:g} %: {f['share'] * 100:6.2f} %, worst "
                 f"{f['worst'] * 100:+8.2f} % ({segment} at σ = {at * 1e3:.1f} mm; "
