@@ -231,19 +231,29 @@ def first_joints(inputs: Inputs, flanges: FlangePaths) -> Attempt:
     return plan_motion(inputs, rotation, flange)
 
 
-def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = None) -> Attempt:
+def plan_motion(
+    inputs: Inputs,
+    rotation: float,
+    flange,
+    branch: int | None = None,
+    *,
+    run: MotionSetup | None = None,
+    branches: list | None = None,
+) -> Attempt:
     """Time law (§4), path IK on a branch and joint retiming for one flange path; the
     attempt's collision check is not run yet (``collisions`` None). The law runs under
     the path caps of ``motion:``, lowered where the process model needs it
     (``process.timing_bound.process_caps``: a bead's dispenser lag caps the jerk)
-    unless ``inputs.process_bound`` is False.
+    unless ``inputs.process_bound`` is False. ``run``, ``branches``: ``motion_setup``
+    of ``flange`` and every IK branch's verdict on its grid (``path_branches``), when
+    an untimed option has them (``job.untimed``).
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
-    run = motion_setup(inputs, flange)
+    run = motion_setup(inputs, flange) if run is None else run
     try:
-        joints = _joint_trajectory(inputs, run, branch)
+        joints = _joint_trajectory(inputs, run, branch, branches)
     except PlanFailedError as error:
         if not run.flange.flying:
             raise
@@ -253,7 +263,7 @@ def plan_motion(inputs: Inputs, rotation: float, flange, branch: int | None = No
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 
-def _joint_trajectory(inputs: Inputs, run, branch: int | None):
+def _joint_trajectory(inputs: Inputs, run, branch: int | None, branches: list | None = None):
     motion = inputs.cell.motion
     return plan_joint_trajectory(
         inputs.robot,
@@ -266,6 +276,7 @@ def _joint_trajectory(inputs: Inputs, run, branch: int | None):
         time_law=motion.time_law,
         process=motion.process,
         process_caps=run.caps,
+        branches=branches,
     )
 
 

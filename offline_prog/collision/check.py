@@ -29,7 +29,7 @@ from heapq import heappop, heappush
 
 import numpy as np
 
-from offline_prog.arrays import at_index, true_runs
+from offline_prog.arrays import at_index
 from offline_prog.collision.pairs import cell_pairs
 from offline_prog.collision.result import (  # noqa: F401  (re-exported)
     CollisionResult,
@@ -225,37 +225,46 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
             e,
         )
 
-    bounds = np.flatnonzero(np.r_[True, s[1:] != s[:-1], True]) if len(s) else [0]
-    minima, stretches = [], []
-    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
-        minima.append(entry(lo + int(np.argmin(dist[lo:hi]))))
-        for a, b in true_runs(dist[lo:hi] < limit[lo:hi]):
-            worst = entry(lo + a + int(np.argmin(dist[lo + a : lo + b])))
-            first, last = entry(lo + a), entry(lo + b - 1)
-            stretches.append(
-                CollisionStretch(
-                    worst.a,
-                    worst.b,
-                    worst.group,
-                    first.sample,
-                    last.sample,
-                    first.sigma_m,
-                    last.sigma_m,
-                    first.t_s,
-                    last.t_s,
-                    worst,
-                )
+    # Per shape pair (s sorted, each pair's rows together): its closest row (the first
+    # of equals) and its runs of rows below its clearance, for all pairs at once.
+    lo = np.flatnonzero(np.r_[True, s[1:] != s[:-1]]) if len(s) else np.zeros(0, dtype=int)
+    closest_rows = np.lexsort((dist, s))[lo]
+    minima = [entry(k) for k in closest_rows.tolist()]
+    below_clearance = dist < limit
+    first_row, last_row = np.zeros(len(s), dtype=bool), np.zeros(len(s), dtype=bool)
+    first_row[lo], last_row[lo[1:] - 1] = True, True
+    last_row[-1:] = True
+    starts = np.flatnonzero(below_clearance & (first_row | ~np.r_[False, below_clearance[:-1]]))
+    stops = np.flatnonzero(below_clearance & (last_row | ~np.r_[below_clearance[1:], False])) + 1
+    stretches = []
+    for a, b in zip(starts.tolist(), stops.tolist(), strict=True):
+        worst = entry(a + int(np.argmin(dist[a:b])))
+        first, last = entry(a), entry(b - 1)
+        stretches.append(
+            CollisionStretch(
+                worst.a,
+                worst.b,
+                worst.group,
+                first.sample,
+                last.sample,
+                first.sigma_m,
+                last.sigma_m,
+                first.t_s,
+                last.t_s,
+                worst,
             )
+        )
     measured = np.bincount(s[x == np.floor(x)], minlength=len(pairs.names))  # per pair
+    index_of = {pair: index for index, pair in enumerate(pairs.names)}
     for pair in minima:  # a pair pruned somewhere: its minimum there is only bounded
-        index = pairs.names.index((pair.a, pair.b))
+        index = index_of[pair.a, pair.b]
         if measured[index] < len(t) and not pairs.is_fixed[index]:
             pair.lower_bound_m = float(clear_s[index] + margin)
     minima.sort(key=lambda pair: pair.distance_m)
     stretches.sort(key=lambda stretch: stretch.sample_start)
     for pair in minima[:n_worst]:
         if pair.exact_distance_m is None:
-            index = pairs.names.index((pair.a, pair.b))
+            index = index_of[pair.a, pair.b]
             pair.exact_distance_m = pairs.exact(at_index(q, pair.sample), index)
         e, d = pair.exact_distance_m, pair.drake_distance_m
         if not (e == 0.0 and d <= 0.0) and abs(e - d) > EXACT_MISMATCH_TOL_M:
@@ -276,7 +285,7 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
     )
     # The closest approach of what moves; the fixed layout (a base on its floor) is
     # listed with the pairs and fails only by overlapping.
-    moving = [m for m in minima if not pairs.is_fixed[pairs.names.index((m.a, m.b))]]
+    moving = [m for m in minima if not pairs.is_fixed[index_of[m.a, m.b]]]
     closest = moving[0] if moving else (minima[0] if minima else None)
     min_distance = closest.distance_m if closest else np.inf
     evaluated = np.unique(x)
@@ -292,10 +301,10 @@ def _result(cell, pairs, table, q, t, sigma, clearances, n_worst, rho, start, ma
         "elapsed_s": time.perf_counter() - start,
     }
     below = np.unique(np.floor(x[dist < limit]).astype(int)).tolist()
-    margin = {(p.a, p.b): p.distance_m - clear_s[pairs.names.index((p.a, p.b))] for p in minima}
+    margin = {(p.a, p.b): p.distance_m - clear_s[index_of[p.a, p.b]] for p in minima}
     violation = min(minima, key=lambda p: margin[(p.a, p.b)], default=None)
     violated = violation is not None and margin[(violation.a, violation.b)] < 0
-    violation_clearance = clear_s[pairs.names.index((violation.a, violation.b))] if violated else 0
+    violation_clearance = clear_s[index_of[violation.a, violation.b]] if violated else 0
     return CollisionResult(
         clearance,
         not violated,

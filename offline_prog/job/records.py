@@ -24,6 +24,7 @@ from offline_prog.job.links import LinkMotion
 from offline_prog.job.order import JobOrder
 from offline_prog.job.process_io import IoColumns
 from offline_prog.joints.joint_plan import JointTrajectory
+from offline_prog.joints.path_ik import BranchResult
 from offline_prog.path.arc_length import ArcLengthPath
 from offline_prog.path.bspline_fit import FittedSpline
 from offline_prog.path.cusps import Cusp, SmoothedFlangePath
@@ -33,7 +34,7 @@ from offline_prog.path.lead import LeadPath
 from offline_prog.path.sources import PathPoints
 from offline_prog.process.quality import ProcessQuality
 from offline_prog.robot.model import RobotModel
-from offline_prog.stages import FittedPath, FlangePaths, Inputs
+from offline_prog.stages import FittedPath, FlangePaths, Inputs, MotionSetup
 from offline_prog.timing.path_timing import without_joint_limits
 from offline_prog.timing.trajectory import WorkspaceTrajectory
 
@@ -156,6 +157,9 @@ class UntimedSeam:
             them.
         first: the direction's first option (best rotation and branch); the others
             are the further branches offered beside it.
+        run: ``motion_setup`` of ``flange``; branches: every IK branch's verdict on
+            its σ grid (``path_branches``): the timed plan starts from them
+            (``stages.plan_motion``).
     """
 
     inputs: Inputs
@@ -166,6 +170,8 @@ class UntimedSeam:
     branch: int
     q_ends: np.ndarray
     first: bool
+    run: MotionSetup
+    branches: list[BranchResult]
 
 
 @dataclasses.dataclass

@@ -101,9 +101,11 @@ def untimed_options(
         return options
     others = other_branches(results, first.branch, MAX_OTHER_BRANCHES)
     # As the timed plan of another branch gets it: the first option's path as run.
-    again = motion_setup(inputs, run.flange) if others else None
-    for other in others:
-        variant, _ = _untimed(inputs, scene, fit, frames, rotation, run.flange, again, other.branch)
+    again, known = (motion_setup(inputs, run.flange) if others else None), None
+    for other in others:  # one path IK on the path as run serves each
+        variant, known = _untimed(
+            inputs, scene, fit, frames, rotation, run.flange, again, other.branch, known
+        )
         if variant is None:
             continue
         try:
@@ -123,12 +125,13 @@ def _untimed(
     flange,
     run: MotionSetup,
     branch: int | None,
+    results: list | None = None,
 ) -> tuple[UntimedSeam | None, list]:
     """(the option on ``branch`` (None: the best), or None if its path IK fails or its
-    path collides; every branch's verdict)."""
+    path collides; every branch's verdict on ``run``'s path, ``results`` if known)."""
     motion = inputs.cell.motion
     grid, results, chosen, path = path_branches(
-        inputs.robot, inputs.X_IB, run.flange, run.parameter, branch
+        inputs.robot, inputs.X_IB, run.flange, run.parameter, branch, results=results
     )
     if not chosen.feasible:
         return None, results
@@ -145,7 +148,10 @@ def _untimed(
         return None, results
     q_ends = path.q(grid[[0, -1]], chosen.q[[0, -1]])
     first = branch is None
-    return UntimedSeam(inputs, fit, frames, rotation, flange, chosen.branch, q_ends, first), results
+    option = UntimedSeam(
+        inputs, fit, frames, rotation, flange, chosen.branch, q_ends, first, run, results
+    )
+    return option, results
 
 
 def _ends(inputs: Inputs, run: MotionSetup, untimed: UntimedSeam, seam):
@@ -266,8 +272,9 @@ def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
     u = option.untimed
     timer = seam_planner.timer(option.seam, option.reverse)
     try:
+        from_untimed = functools.partial(plan_motion, run=u.run, branches=u.branches)
         attempt = timer(
-            "joints", "joint trajectory", plan_motion, u.inputs, u.rotation, u.flange, u.branch
+            "joints", "joint trajectory", from_untimed, u.inputs, u.rotation, u.flange, u.branch
         )
         attempt = timer("check", "collision check", check_attempt, u.inputs, scene, attempt)
     except PlanFailedError:
@@ -275,7 +282,7 @@ def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
     if attempt is None or not attempt.collisions.collision_free:
         return options[:j] + options[j + 1 :], False
     if options[first].plan is None:
-        run = motion_setup(u.inputs, options[first].untimed.flange)  # the first's, as run
+        run = options[first].untimed.run  # the first's flange path, as run
         as_first = dataclasses.replace(attempt, flange=run.flange, limits=run.limits)
         plan = Plan.of_attempt(u.inputs, u.fit, u.frames, as_first, timings_s=timer.timings_s)
     else:
@@ -302,7 +309,10 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
     timer = seam_planner.timer(option.seam, reverse)  # the stages' names and wall times
     known = {"fit": u.fit, "frames": u.frames}
     try:
-        unchecked = timer("joints", "joint trajectory", plan_motion, u.inputs, u.rotation, u.flange)
+        from_untimed = functools.partial(plan_motion, run=u.run, branches=u.branches)
+        unchecked = timer(
+            "joints", "joint trajectory", from_untimed, u.inputs, u.rotation, u.flange
+        )
         attempt = timer("check", "collision check", check_attempt, u.inputs, scene, unchecked)
         known |= {"joints": unchecked, "check": attempt}
     except PlanFailedError:

@@ -16,7 +16,6 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import true_runs
 from offline_prog.constants import ProcessIntent, TimeLaw
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.jerk_check import verified_timing
@@ -28,6 +27,7 @@ from offline_prog.joints.path_ik import (
     choose_branch,
     first_outside,
     singularity_distances,
+    singularity_report,
 )
 from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.robot.jacobian import joint_path_rates, urdf_chain
@@ -48,13 +48,6 @@ GRID_SPACING_M = 5e-4
 MIN_GRID_POINTS = 2001
 # Time grid that inverts σ(t) for failure messages (t to ~duration / 20000).
 TIME_INVERSION_POINTS = 20001
-# Singularity thresholds: |sin θ5| and |sin elbow| below sin(5°), shoulder 30 mm.
-NEAR_SINGULAR = {
-    "wrist": np.sin(np.deg2rad(5.0)),
-    "elbow": np.sin(np.deg2rad(5.0)),
-    "shoulder": 0.03,
-    "jacobian": 0.01,  # smallest singular value of the flange Jacobian (Drake IK robots)
-}
 
 
 class JointPlanError(PlanFailedError):
@@ -255,12 +248,19 @@ def _time_at(law: Sin2TimeLaw, sigma: float) -> float:
 
 
 def path_branches(
-    robot: RobotModel, X_IB, flange, parameter: TimeLawParameter, branch: int | None = None
+    robot: RobotModel,
+    X_IB,
+    flange,
+    parameter: TimeLawParameter,
+    branch: int | None = None,
+    *,
+    results: list[BranchResult] | None = None,
 ) -> tuple[np.ndarray, list[BranchResult], BranchResult, BranchPath]:
     """The path IK on the σ grid, before any time law: (grid (M,) σ [m], every branch's
     verdict on it, the chosen one (``branch`` if given, else the best; its ``q`` (M, 6)
     [rad] on the grid), the chosen branch's exact q(σ)). A robot of family drake has
-    one verdict, Drake IK's along the grid."""
+    one verdict, Drake IK's along the grid. ``results``: the verdicts of an earlier
+    call on the same flange path and parameter (analytic IK), not computed again."""
     length = parameter.length
     grid = np.linspace(0.0, length, max(MIN_GRID_POINTS, int(np.ceil(length / GRID_SPACING_M)) + 1))
     if robot.family == "drake":  # no closed form: Drake InverseKinematics along the grid
@@ -269,7 +269,8 @@ def path_branches(
         path = DrakeIkPath(robot, X_IB, flange, parameter)
         chosen = path.choose(grid)
         return grid, [chosen], chosen, path
-    results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
+    if results is None:
+        results = branch_results(robot, BranchPath(robot, X_IB, flange, parameter, 0).poses(grid))
     chosen = choose_branch(results) if branch is None else results[branch]
     return grid, results, chosen, BranchPath(robot, X_IB, flange, parameter, chosen.branch)
 
@@ -286,6 +287,7 @@ def plan_joint_trajectory(
     time_law: TimeLaw = TimeLaw.SIN2,
     process: ProcessIntent = ProcessIntent.CONSTANT_SPEED,
     process_caps: ProcessCaps | None = None,
+    branches: list[BranchResult] | None = None,
 ) -> JointTrajectory:
     """Joint trajectory for the flange path, or JointPlanError (σ, t, why).
 
@@ -304,8 +306,12 @@ def plan_joint_trajectory(
         process_caps: the caps ``limits`` hold (``process.timing_bound``); where
             they are below the user's, the same path is timed under the user's caps
             too, for the trade-off in cycle time (``JointTrajectory.unbounded_s``).
+        branches: every branch's verdict on this path's grid, when known
+            (``path_branches``' results): the path IK is not run again.
     """
-    grid, results, chosen, path = path_branches(robot, X_IB, flange, parameter, branch)
+    grid, results, chosen, path = path_branches(
+        robot, X_IB, flange, parameter, branch, results=branches
+    )
     if not chosen.feasible:
         sigma = float(grid[chosen.sample])
         raise JointPlanError(sigma, _time_at(limits.nominal, sigma), chosen.reason, chosen.kind)
@@ -352,11 +358,7 @@ def plan_joint_trajectory(
     margin = np.minimum(q_c.min(axis=0) - robot.q_lower, robot.q_upper - q_c.max(axis=0))
     if margin.min() < 0:  # the grid missed a limit between its points
         joint = int(np.argmin(margin))
-        i = int(
-            np.argmax(
-                (q_c[:, joint] < robot.q_lower[joint]) | (q_c[:, joint] > robot.q_upper[joint])
-            )
-        )
+        i = first_outside(robot, q, joint)
         raise JointPlanError(
             float(sigma[i]),
             float(trajectory.t[i]),
@@ -366,24 +368,7 @@ def plan_joint_trajectory(
     steps = np.abs(np.diff(q, axis=0))
     i, j = np.unravel_index(np.argmax(steps), steps.shape)
     distances = path.singularity_distances(q, sigma)
-    sigma = sigma + parameter.start  # on the seam's σ (a lead-in's negative)
-    singular = {}
-    for kind, d in distances.items():
-        k = int(np.argmin(d))
-        near = true_runs(d < NEAR_SINGULAR[kind])
-        stretches = [(float(sigma[a]), float(sigma[b - 1])) for a, b in near]
-        # Wrist and elbow distances are |sin| of an angle: report that angle.
-        value, unit = (
-            (float(d[k]), "m" if kind == "shoulder" else "m/rad")
-            if kind in ("shoulder", "jacobian")
-            else (float(np.rad2deg(np.arcsin(min(d[k], 1.0)))), "deg")
-        )
-        singular[kind] = {
-            "distance": value,
-            "unit": unit,
-            "sigma_m": float(sigma[k]),
-            "near": stretches,
-        }
+    singular = singularity_report(distances, sigma + parameter.start)  # the seam's σ
     return JointTrajectory(
         trajectory,
         chosen.branch,
@@ -392,7 +377,7 @@ def plan_joint_trajectory(
         qd,
         qdd,
         margin,
-        (int(j), float(sigma[i + 1]), float(steps[i, j])),
+        (int(j), float(sigma[i + 1] + parameter.start), float(steps[i, j])),
         singular,
         retiming,
         process_caps,

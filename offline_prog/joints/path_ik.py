@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.arrays import row_max
+from offline_prog.arrays import row_max, true_runs
 from offline_prog.errors import Failure
 from offline_prog.robot.model import RobotModel
 
@@ -253,6 +253,40 @@ def singularity_distances(robot: RobotModel, q: np.ndarray, X_BE: np.ndarray) ->
         p_05 = X_BE[:, :3, 3] - p.d6 * X_BE[:, :3, 2]
         shoulder = np.abs(np.hypot(p_05[:, 0], p_05[:, 1]) - p.d4)
     return {"wrist": wrist, "elbow": elbow, "shoulder": shoulder}
+
+
+# Singularity thresholds: |sin θ5| and |sin elbow| below sin(5°), shoulder 30 mm.
+NEAR_SINGULAR = {
+    "wrist": np.sin(np.deg2rad(5.0)),
+    "elbow": np.sin(np.deg2rad(5.0)),
+    "shoulder": 0.03,
+    "jacobian": 0.01,  # smallest singular value of the flange Jacobian (Drake IK robots)
+}
+
+
+def singularity_report(distances: dict, sigma: np.ndarray) -> dict:
+    """Per kind of ``distances`` (:func:`singularity_distances`, each (N,)): the
+    smallest distance (wrist and elbow as the angle [deg] whose |sin| they are), σ at
+    it and the stretches [(σ_start, σ_end), ...] nearer than NEAR_SINGULAR; σ (N,) [m]
+    at the samples."""
+    singular = {}
+    for kind, d in distances.items():
+        k = int(np.argmin(d))
+        near = true_runs(d < NEAR_SINGULAR[kind])
+        stretches = [(float(sigma[a]), float(sigma[b - 1])) for a, b in near]
+        # Wrist and elbow distances are |sin| of an angle: report that angle.
+        value, unit = (
+            (float(d[k]), "m" if kind == "shoulder" else "m/rad")
+            if kind in ("shoulder", "jacobian")
+            else (float(np.rad2deg(np.arcsin(min(d[k], 1.0)))), "deg")
+        )
+        singular[kind] = {
+            "distance": value,
+            "unit": unit,
+            "sigma_m": float(sigma[k]),
+            "near": stretches,
+        }
+    return singular
 
 
 def reach_excess(robot: RobotModel, X_BE: np.ndarray, *, inner: bool = True) -> np.ndarray:

@@ -64,12 +64,37 @@ class FlangeSamples:
 # (its time laws' samples): a count of 16 evicted the shared ones.
 PART_SAMPLES_MOST = 5000
 PART_CACHE_BYTES = 32 * 2**20
-_part_samples: collections.OrderedDict = collections.OrderedDict()
-_part_in_tool: collections.OrderedDict = collections.OrderedDict()
+
+
+class _KeptValues(collections.OrderedDict):
+    """key ↦ (owners, bytes, values), oldest first, with its entries' bytes summed as
+    they come and go (``nbytes``: a sum over thousands of small entries per insert was a
+    job's planning's hot spot)."""
+
+    nbytes = 0
+
+    def __setitem__(self, key, entry) -> None:
+        old = self.get(key)
+        if old is not None:
+            self.nbytes -= old[1]
+        super().__setitem__(key, entry)
+        self.nbytes += entry[1]
+
+    def __delitem__(self, key) -> None:
+        self.nbytes -= self[key][1]
+        super().__delitem__(key)
+
+    def clear(self) -> None:
+        super().clear()
+        self.nbytes = 0
+
+
+_part_samples = _KeptValues()
+_part_in_tool = _KeptValues()
 _lock = threading.Lock()
 
 
-def _kept(cache: collections.OrderedDict, key: tuple, owners: tuple, compute) -> tuple:
+def _kept(cache: _KeptValues, key: tuple, owners: tuple, compute) -> tuple:
     """compute()'s arrays, made read-only and kept under key (the last used, up to
     PART_CACHE_BYTES); ``owners`` are the objects whose ids the key holds (kept with the
     entry, so an id is theirs while it lives)."""
@@ -84,8 +109,8 @@ def _kept(cache: collections.OrderedDict, key: tuple, owners: tuple, compute) ->
     size = sum(value.nbytes for value in values)
     with _lock:  # threads may plan at once (a Dask worker's threads)
         cache[key] = (owners, size, values)
-        while sum(entry[1] for entry in cache.values()) > PART_CACHE_BYTES:
-            cache.popitem(last=False)
+        while cache.nbytes > PART_CACHE_BYTES:
+            del cache[next(iter(cache))]  # the oldest
     return values
 
 

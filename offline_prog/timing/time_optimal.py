@@ -71,6 +71,8 @@ class _GridPath:
 
     def __call__(self, ss, order=0):
         values = self._values[order]
+        if len(ss) == len(self.sigma) and np.array_equal(ss, self.sigma):  # the grid
+            return values
         index = np.clip(np.searchsorted(self.sigma, ss), 0, len(self.sigma) - 1)
         if np.allclose(self.sigma[index], ss, rtol=0, atol=1e-12):
             return values[index]
@@ -91,24 +93,80 @@ class _GridPath:
         return None
 
 
+@dataclasses.dataclass(frozen=True)
+class _JointGrid:
+    """What every TOPP-RA solve over the same joint rates and limits shares (the
+    filtered stage's rounds differ in their speed and acceleration curves and spans
+    only): the grid (``topp_grid``: indices ``keep`` (G,), ``sigma`` (G,) [m]), the
+    path's values on it with σ as the seventh joint (q, q′, q″, each (G, 7)), the
+    limits (7,) as ``_joint_constraints`` takes them, and the joint velocity
+    constraint's bounds on σ̇² (G, 2): toppra's own numbers, row by row, so a span's
+    rows are its solve's."""
+
+    rates: JointRates  # held: the memo compares it by identity
+    key: tuple
+    keep: np.ndarray
+    sigma: np.ndarray
+    values: tuple[np.ndarray, np.ndarray, np.ndarray]
+    limits: tuple[tuple[float, ...], tuple[float, ...]]
+    velocity: np.ndarray
+
+
+_LAST_GRID: list[_JointGrid] = []  # the last problem's (one process's; a solve at a time)
+
+
+def _joint_grid(rates: JointRates, qd_max, qdd_max, v_cap, a_path, grid_points) -> _JointGrid:
+    """The :class:`_JointGrid` of these rates and limits: made once for the solves that
+    follow one another on them (the last one is kept)."""
+    limits = (tuple(np.append(qd_max, v_cap)), tuple(np.append(qdd_max, a_path)))
+    key = (*limits, grid_points)
+    if _LAST_GRID and _LAST_GRID[0].rates is rates and _LAST_GRID[0].key == key:
+        return _LAST_GRID[0]
+    keep = topp_grid(rates.sigma, v_cap**2 / (2.0 * a_path), grid_points)
+    sigma = rates.sigma[keep]
+    ones = np.ones((len(sigma), 1))
+    values = (
+        np.hstack([rates.q[keep], sigma[:, None]]),
+        np.hstack([rates.dq[keep], ones]),
+        np.hstack([rates.ddq[keep], 0 * ones]),
+    )
+    velocity_limit = _joint_constraints(*limits)[0]
+    xbound = velocity_limit.compute_constraint_params(_GridPath(sigma, *values), sigma)[-1]
+    grid = _JointGrid(rates, key, keep, sigma, values, limits, xbound)
+    _LAST_GRID[:] = [grid]
+    return grid
+
+
 def _speed_curve(v_max: np.ndarray, dof: int, a_max: np.ndarray | None = None):
     """A toppra constraint σ̇ ≤ v_max (G,) at the grid points, and |σ̈| ≤ a_max (G,)
     on the step after each if given, vectorised (toppra's
     JointVelocityConstraintVarying calls Python once per grid point)."""
+    xbound = np.column_stack([np.zeros(len(v_max)), v_max**2])
+    ubound = None if a_max is None else np.column_stack([-a_max, a_max])
+    return _given(xbound, ubound, dof=dof)
+
+
+def _given(xbound: np.ndarray, ubound: np.ndarray | None = None, *, dof: int):
+    """A toppra constraint with the given bounds on σ̇² (G, 2) and on σ̈ (G, 2) or
+    None, at the solve's grid points."""
+    return _given_class()(xbound, ubound, dof)
+
+
+@functools.cache
+def _given_class():
+    """The class of :func:`_given`'s constraints (made once: toppra loads on first use)."""
     _toppra_algorithm()  # toppra without matplotlib
     from toppra.constraint import LinearConstraint
 
-    class SpeedCurve(LinearConstraint):
-        def __init__(self):
+    class Given(LinearConstraint):
+        def __init__(self, xbound, ubound, dof):
             super().__init__()
-            self.dof = dof
+            self.xbound, self.ubound, self.dof = xbound, ubound, dof
 
         def compute_constraint_params(self, path, gridpoints):
-            xbound = np.column_stack([np.zeros(len(v_max)), v_max**2])
-            ubound = None if a_max is None else np.column_stack([-a_max, a_max])
-            return None, None, None, None, None, ubound, xbound
+            return None, None, None, None, None, self.ubound, self.xbound
 
-    return SpeedCurve()
+    return Given
 
 
 def topp_grid(sigma: np.ndarray, ramp: float, most: int) -> np.ndarray:
@@ -226,20 +284,14 @@ def topp_profile(
             returned ``sigma``), from σ̇ = ends[0] at i to σ̇ = ends[1] at j [m/s]; the
             whole path, rest to rest, if None (``resolve_locally``).
     """
-    keep = topp_grid(rates.sigma, v_cap**2 / (2.0 * a_path), grid_points)
-    if span is not None:
-        keep = keep[span[0] : span[1] + 1]
-    sigma = rates.sigma[keep]
-    ones = np.ones((len(sigma), 1))
-    path = _GridPath(
-        sigma,
-        np.hstack([rates.q[keep], sigma[:, None]]),
-        np.hstack([rates.dq[keep], ones]),
-        np.hstack([rates.ddq[keep], 0 * ones]),
-    )
-    constraints = list(
-        _joint_constraints(tuple(np.append(qd_max, v_cap)), tuple(np.append(qdd_max, a_path)))
-    )
+    grid = _joint_grid(rates, qd_max, qdd_max, v_cap, a_path, grid_points)
+    lo, hi = (0, len(grid.keep) - 1) if span is None else span
+    keep, sigma = grid.keep[lo : hi + 1], grid.sigma[lo : hi + 1]
+    path = _GridPath(sigma, *(values[lo : hi + 1] for values in grid.values))
+    constraints = [
+        _given(grid.velocity[lo : hi + 1], dof=path.dof),
+        _joint_constraints(*grid.limits)[1],
+    ]
     if v_steady is not None or a_curve is not None:
         v_curve = np.full(len(sigma), v_cap) if v_steady is None else v_steady[keep]
         a_step = None if a_curve is None else np.minimum(a_curve[keep], a_path)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import base64
 import html
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -192,25 +193,25 @@ class StaticScene:
         frames = np.floor(np.asarray(times) * fps + 1e-9).astype(int)
         keep = np.r_[frames[1:] != frames[:-1], True]
         frames, poses = frames[keep].tolist(), np.asarray(poses)[:, keep]
+        keys = _Keys(frames)
         animations = []
         for path, scale in (scales or {}).items():
-            values = [[float(v)] * 3 for v in np.asarray(scale)[keep]]
-            track = {"name": ".scale", "type": "vector3", "keys": _keys(frames, values)}
+            values = np.asarray(scale, dtype=float)[keep]
+            track = {"name": ".scale", "type": "vector3", "keys": keys.uniform(values)}
             animations.append(
                 {"path": path, "clip": {"fps": fps, "name": "default", "tracks": [track]}}
             )
         for path, X in zip(paths, poses, strict=True):
-            positions = X[:, :3, 3].tolist()
-            quaternions = Rotation.from_matrix(X[:, :3, :3]).as_quat().tolist()  # x, y, z, w
+            quaternions = Rotation.from_matrix(X[:, :3, :3]).as_quat()  # x, y, z, w
             tracks = [
-                {"name": ".position", "type": "vector3", "keys": _keys(frames, positions)},
-                {"name": ".quaternion", "type": "quaternion", "keys": _keys(frames, quaternions)},
+                {"name": ".position", "type": "vector3", "keys": keys(X[:, :3, 3])},
+                {"name": ".quaternion", "type": "quaternion", "keys": keys(quaternions)},
             ]
             clip = {"fps": fps, "name": "default", "tracks": tracks}
             animations.append({"path": path, "clip": clip})
         options = {"play": True, "repetitions": 1}
         command = {"type": "set_animation", "animations": animations, "options": options}
-        self.messages.append(json.dumps(command, separators=(",", ":")))
+        self.messages.append(keys.dumps(command))
 
     def html(self, title: str) -> str:
         """The standalone page: Drake's viewer with meshcat.js inlined and these commands."""
@@ -238,6 +239,41 @@ class StaticScene:
         return page.replace("<title>Drake MeshCat</title>", f"<title>{escaped}</title>")
 
 
-def _keys(frames: list[int], values: list) -> list[dict]:
-    """Animation keyframes {time: frame, value}."""
-    return [{"time": f, "value": v} for f, v in zip(frames, values, strict=True)]
+_STAND_IN = re.compile(r'"\\u0000keys (\d+)\\u0000"')  # _Keys' stand-ins, as JSON writes them
+
+
+class _Keys:
+    """Animation keyframes [{time: frame, value: [...]}, ...] written as JSON text at
+    once per track (a long job has ~10⁶ keys: as dicts through ``json.dumps`` they were
+    most of its preview's time). ``keys(values)`` stands for one track's keys in a
+    command; :meth:`dumps` writes the command as ``json.dumps(command,
+    separators=(",", ":"))`` writes it with the keys as dicts, character for character.
+    """
+
+    def __init__(self, frames: list[int]):
+        self._starts = [f'{{"time":{f:d},"value":[' for f in frames]
+        self._tracks: list[str] = []
+
+    def __call__(self, values: np.ndarray) -> str:
+        """A stand-in for the keys of (len(frames), k) ``values``, one row per frame."""
+        text = json.dumps(np.asarray(values, dtype=float).tolist(), separators=(",", ":"))
+        return self._track(text[2:-2].split("],["))  # each row's numbers, as JSON writes them
+
+    def uniform(self, values: np.ndarray) -> str:
+        """The stand-in for a uniform scale's keys: [v, v, v] for each of ``values``
+        (len(frames),), each distinct value written once (a seam's highlight: 0 or 1)."""
+        bits, inverse = np.unique(
+            np.asarray(values, dtype=float).view(np.int64), return_inverse=True
+        )
+        texts = [",".join([json.dumps(v)] * 3) for v in bits.view(float).tolist()]
+        return self._track(list(map(texts.__getitem__, inverse.ravel().tolist())))
+
+    def _track(self, rows: list[str]) -> str:
+        keys = "]},".join(map(str.__add__, self._starts, rows))
+        self._tracks.append(f"[{keys}]}}]" if self._starts else "[]")
+        return f"\x00keys {len(self._tracks) - 1}\x00"
+
+    def dumps(self, command: dict) -> str:
+        """``command`` as JSON, each stand-in replaced by its track's keys."""
+        text = json.dumps(command, separators=(",", ":"))
+        return _STAND_IN.sub(lambda match: self._tracks[int(match[1])], text)

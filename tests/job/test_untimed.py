@@ -51,10 +51,10 @@ def _failing_branch(monkeypatch, branch: int):
     (the other branches a direction offers), as a joint-rate failure would."""
     original = stages.plan_motion
 
-    def plan_motion(inputs, rotation, flange, asked=None):
+    def plan_motion(inputs, rotation, flange, asked=None, **known):  # known: run, branches
         if asked == branch:
             raise JointPlanError(0.0, 0.0, "injected: no time law", Failure.JOINT_RATE_LIMIT)
-        return original(inputs, rotation, flange, asked)
+        return original(inputs, rotation, flange, asked, **known)
 
     monkeypatch.setattr(stages, "plan_motion", plan_motion)
     monkeypatch.setattr(untimed, "plan_motion", plan_motion)

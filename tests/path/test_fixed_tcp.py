@@ -166,3 +166,5 @@ def test_kept_part_values_stay_within_their_bytes(rng, monkeypatch):
     again = fixed_tcp.part_samples(base.path, base.normal, grids[1])
     np.testing.assert_array_equal(again[0], base.path(grids[1], order=2)[0])
     assert len(fixed_tcp._part_samples) == 3
+    kept = fixed_tcp._part_samples
+    assert kept.nbytes == sum(entry[1] for entry in kept.values())  # the running sum
