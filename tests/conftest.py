@@ -31,6 +31,22 @@ POSITION_TOL_M = 1e-9
 ANGLE_TOL_RAD = 1e-9
 
 
+def planned_text(text: str, folder: Path, *, name: str = "cell.yaml"):
+    """A demo cell's ``text`` (its ``data/`` paths the repository's) written as
+    ``folder/name``, planned (asserted feasible) and its outputs written to
+    ``folder/plan``: (the job, its JobProgramData)."""
+    from offline_prog.export.job_program import JobProgramData
+    from offline_prog.plan import plan_job
+    from offline_prog.results.job_folder import write_job_outputs
+
+    cell = folder / name
+    cell.write_text(text.replace(": data/", f": {CELLS}/data/"), encoding="utf-8")
+    job = plan_job(cell)
+    assert job.feasible, job.failure
+    write_job_outputs(job, folder / "plan")
+    return job, JobProgramData.load(folder / "plan")
+
+
 def random_curve_points(rng, *, closed: bool, n: int = 300, scale: float = 0.2) -> np.ndarray:
     """(n, 3) points on a smooth random Fourier curve that stays far from straight."""
     phase = np.linspace(0.0, 2 * np.pi, n, endpoint=not closed) * (1.0 if closed else 0.7)

@@ -10,10 +10,8 @@ from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.points import PointRule
 from offline_prog.export.record import program_record
 from offline_prog.export.run_samples import run_samples
-from offline_prog.plan import plan_job
-from offline_prog.results.job_folder import write_job_outputs
 
-from conftest import CELLS
+from conftest import CELLS, planned_text
 
 
 @pytest.fixture(scope="module")
@@ -51,18 +49,11 @@ def test_a_flying_seams_straight_moves_end_at_its_leads_at_any_sample_rate(flyin
     starts where the lead-out ends, at 2 samples per second (the job's rows then hold
     neither the leads' ends) as at the demo's rate: the same targets and lengths."""
     text = (CELLS / "seal_plate_kr16.yaml").read_text(encoding="utf-8")
-    text = text.replace(": data/", f": {CELLS}/data/").replace(
-        "  closed: true\n", "  closed: true\n  entry: flying\n"
-    )
-    cell = tmp_path / "slow_rate.yaml"
-    cell.write_text(text.replace("  max_jerk:", "  sample_rate_hz: 2\n  max_jerk:", 1))
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    write_job_outputs(job, tmp_path / "plan")
+    text = text.replace("  closed: true\n", "  closed: true\n  entry: flying\n")
+    text = text.replace("  max_jerk:", "  sample_rate_hz: 2\n  max_jerk:", 1)
+    _, slow_rate = planned_text(text, tmp_path)
     rule = PointRule("flange", "X_TP", 5e-5, 1e-3)
-    runs = [
-        program_record(d, rule).runs()[0] for d in (flying, JobProgramData.load(tmp_path / "plan"))
-    ]
+    runs = [program_record(d, rule).runs()[0] for d in (flying, slow_rate)]
     for run in runs:
         dense = run.process.data
         np.testing.assert_allclose(run.approach.X_PT, dense.X_PT[0], atol=1e-9)

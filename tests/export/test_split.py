@@ -10,10 +10,8 @@ import pytest
 from offline_prog.export.formats import export
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.split import MIN_LINE_LIMIT, split_blocks
-from offline_prog.plan import plan_job
-from offline_prog.results.job_folder import write_job_outputs
 
-from conftest import CELLS, with_own_io
+from conftest import CELLS, planned_text, with_own_io
 from rapid_reader import rapid_procs
 
 IO = (
@@ -134,13 +132,9 @@ def test_rapid_job_split_at_a_small_limit_runs_as_the_unsplit_one(planned_job, t
 
 @pytest.mark.slow  # plans a job of its own
 def test_rapid_job_with_io_split_switches_as_the_unsplit_one(tmp_path):
-    cell = tmp_path / "weld_io.yaml"
-    text = (CELLS / "weld_seam_irb2400.yaml").read_text().replace(": data/", f": {CELLS}/data/")
-    cell.write_text(with_own_io(text, IO))
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    write_job_outputs(job, tmp_path / "plan")
-    run = check_rapid_split(JobProgramData.load(tmp_path / "plan"), tmp_path, 30)
+    text = with_own_io((CELLS / "weld_seam_irb2400.yaml").read_text(), IO)
+    _, data = planned_text(text, tmp_path)
+    run = check_rapid_split(data, tmp_path, 30)
     assert sum(line.startswith("TriggIO") for line in run) == 2
     assert sum(line.startswith("TriggSpeed") for line in run) == 2
 

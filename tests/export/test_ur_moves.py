@@ -13,10 +13,8 @@ from offline_prog.export.formats import export
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.ur.urscript import ANALOG_RANGE_V, ANALOG_STEP_V
 from offline_prog.io_events import Signal
-from offline_prog.plan import plan_job
-from offline_prog.results.job_folder import write_job_outputs
 
-from conftest import CELLS, with_own_io
+from conftest import CELLS, planned_text, with_own_io
 
 IO_TOL_M = 1e-3  # an output switched within 1 mm of where the plan sets it
 IO = (
@@ -117,13 +115,8 @@ def test_movep_program_replayed_from_its_text_stays_within_the_path_tolerance(da
 def test_movep_program_switches_the_process_output_where_the_plan_sets_it(tmp_path):
     """The tape cell with a digital output and a flow of its own: the replay as above,
     and each ``set_standard_digital_out`` at the point where the plan sets it."""
-    cell = tmp_path / "tape_io.yaml"
-    text = (CELLS / "tape_cylinder_ur10e.yaml").read_text().replace(": data/", f": {CELLS}/data/")
-    cell.write_text(with_own_io(text, IO))
-    job = plan_job(cell)
-    assert job.feasible, job.failure
-    write_job_outputs(job, tmp_path / "plan")
-    data = JobProgramData.load(tmp_path / "plan")
+    text = with_own_io((CELLS / "tape_cylinder_ur10e.yaml").read_text(), IO)
+    _, data = planned_text(text, tmp_path)
     waypoints, steps = check_movep_program(data, tmp_path / "out")
     rows, switched = data.job, []
     run = [s for s in data.segments if s.seam]
