@@ -39,7 +39,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import at_rest, with_leads
+from offline_prog.timing.lead_length import fallbacks, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -68,6 +68,9 @@ class Inputs:
     # The process model's caps on the process stretch's time law (process.timing_bound);
     # False plans under the user's caps alone (the trade-off's comparison).
     process_bound: bool = True
+    # The seam's normal approach and retract distances [m] (0: another kind), which a
+    # flying seam's leads take over (timing.lead_length); set by job.seams.seam_inputs.
+    normal_moves_m: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclasses.dataclass
@@ -258,8 +261,14 @@ def plan_motion(
         if not run.flange.flying:
             raise
         reason = f"the lead-in or lead-out: {error.failure.reason}"
-        run = motion_setup(inputs, at_rest(run.flange, reason))
-        joints = _joint_trajectory(inputs, run, branch)
+        for leads in fallbacks(run.flange, reason):
+            run = motion_setup(inputs, leads)
+            try:
+                joints = _joint_trajectory(inputs, run, branch)
+                break
+            except PlanFailedError:
+                if not leads.flying:  # at rest: the seam itself fails
+                    raise
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 
@@ -335,22 +344,21 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
 
 def check_attempt(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:
     """Stage ``check``: the attempt with the collision check of every sample and step at
-    the cell's clearances. A flying seam that collides is planned at rest again: where
-    that one is free, the leads collided and it is the attempt."""
+    the cell's clearances. A flying seam that collides is planned again with leads that
+    keep their own lift (where they took a normal move over, ``timing.lead_length``),
+    then at rest: the first of these that is free is the attempt."""
     checked = _checked(inputs, scene, attempt)
     if checked.collisions.collision_free or not getattr(attempt.flange, "flying", False):
         return checked
-    try:
-        rest = plan_motion(
-            inputs,
-            attempt.rotation,
-            at_rest(attempt.flange, "the lead-in or lead-out collides"),
-            attempt.joints.branch,
-        )
-    except PlanFailedError:
-        return checked
-    rest = _checked(inputs, scene, rest)
-    return rest if rest.collisions.collision_free else checked
+    for flange in fallbacks(attempt.flange, "the lead-in or lead-out collides"):
+        try:
+            retry = plan_motion(inputs, attempt.rotation, flange, attempt.joints.branch)
+        except PlanFailedError:
+            continue
+        retry = _checked(inputs, scene, retry)
+        if retry.collisions.collision_free:
+            return retry
+    return checked
 
 
 def _checked(inputs: Inputs, scene: DrakeCell, attempt: Attempt) -> Attempt:

@@ -10,10 +10,11 @@ share of the gun-on length whose predicted quality (bead area, heat input, nip
 temperature) is within ±5 % of the target (the model's band for heat input and tape:
 its own tolerance), the worst gun-on row against the target, the gun-on rows where the
 tool stands, the cycle time and the approach + retract time (a flying seam's leads
-count as approach and retract). ``--approach-speed`` adds the weld demo's setting of
-the issue (approach and retract under 3 s). The programs replay the plan's outputs
-within 1 % (tests/process/test_replay.py, tests/robot_import/test_fanuc_job.py), so
-these are the programs' figures too.
+count as approach and retract), and the leads' top tool speed against the seam's
+(at most 1: the process speed holds on the leads too). ``--approach-speed`` adds the
+weld demo's setting of the issue (approach and retract under 3 s). The programs
+replay the plan's outputs within 1 % (tests/process/test_replay.py,
+tests/robot_import/test_fanuc_job.py), so these are the programs' figures too.
 """
 
 from __future__ import annotations
@@ -56,6 +57,12 @@ def figures(job) -> dict:
     accepted = acceptance(job, ratio)
     worst = accepted["worst_row"]
     moves = sum(g.t_stop - g.t_start for g in s.segments if g.kind in ("approach", "retract"))
+    lead_over = [
+        float(lead.tcp_speed.max() / o.plan.trajectory.tcp_speed.max())
+        for o in job.chosen
+        for lead in (o.plan.lead_in, o.plan.lead_out)
+        if lead is not None
+    ]
     return {
         "entries": [
             f"{o.name}: {o.plan.entry['entry']}"
@@ -68,6 +75,7 @@ def figures(job) -> dict:
         "standstill": accepted["standstill"],
         "cycle_s": float(s.t[-1]),
         "moves_s": float(moves),
+        "lead_over": max(lead_over, default=float("nan")),
     }
 
 
@@ -102,7 +110,8 @@ def main(names: list[str], approach_speed: float | None) -> None:
                 f"{f['worst'] * 100:+8.2f} % ({segment} at σ = {at * 1e3:.1f} mm; "
                 f"{'ok' if abs(f['worst']) <= WORST_ALLOWED else 'beyond'} ±20 %), "
                 f"gun-on standstill rows {f['standstill']}, cycle {f['cycle_s']:.2f} s, "
-                f"approach+retract {f['moves_s']:.2f} s"
+                f"approach+retract {f['moves_s']:.2f} s, "
+                f"leads' top tool speed / seam's {f['lead_over']:.3f}"
             )
         print(f"{'':22s} cycle flying / rest {cycles['flying'] / cycles['rest']:.3f}")
 

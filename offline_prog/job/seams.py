@@ -86,7 +86,17 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
         points = load_points(job.file, seam_cell)
     if reverse:
         points = reversed_points(points)
-    return dataclasses.replace(job, cell=seam_cell, points=points, speed=process_speed(cell, k))
+    moves = tuple(
+        spec.distance_mm * 1e-3 if spec.kind == "normal" else 0.0
+        for spec in (seam.approach, seam.retract)
+    )
+    return dataclasses.replace(
+        job,
+        cell=seam_cell,
+        points=points,
+        speed=process_speed(cell, k),
+        normal_moves_m=moves,
+    )
 
 
 def _has_seam_column(file, seam: SeamConfig) -> bool:

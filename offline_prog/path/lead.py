@@ -5,21 +5,29 @@ For a flying entry the time law runs a longer path, the seam with a lead-in befo
 σ = 0 and a lead-out after σ = L, so that it crosses both ends at the process speed;
 the approach and retract then start and end at rest at the leads' far ends.
 
-A lead continues the flange path X_IE(s) past an end s_e (u = s − s_e: negative on
-the lead-in, positive on the lead-out) by its second-order expansion, with the tool
+A lead continues the flange path X_IE(s) past an end s_e by its second-order
+expansion in u (negative on the lead-in, positive on the lead-out), with the tool
 lifted off the part along the end frame's normal:
 
     p_IE(u) = p_e + u·p′_e + ½u²·p″_e + h(u)·e,        h(u) = H·|u/δ|³,
     R_IE(u) = Exp(u·w_e + ½u²·w′_e) · R_e,
 
 with e = R_IP·n (the direction the part moves in I when the tool backs off the
-surface along −n, as ``job.approach`` moves it), δ the lead's length and H =
-LIFT_RATIO·δ. Position, velocity and acceleration of the flange and its angular
-velocity and its rate are continuous at the end (the joints' q, q̇ and q̈ too), and the
-lift starts with zero slope and curvature, so the first and last millimetres of a lead
-(where the gun opens and closes) lie on the seam's tangent. The lead's parameter is
-the seam's s continued (the tool's path length up to O(u²κ²)); the TCP speed
-the plan reports is the exact rigid-body one.
+surface along −n, as ``job.approach`` moves it), δ the lead's extent along the
+tangent and H its lift: LIFT_RATIO·δ, or a normal approach's (retract's) distance
+when the lead takes that move over (``timing.lead_length``): the tool then comes down
+onto the seam at speed along one curve instead of stopping at its foot. The lead is
+parameterized by the tool's path length in P, σ − s_e = ±ℓ(u) with
+ℓ(u) = ∫₀^|u| √(1 + h′(v)²) dv (the tangent's and the lift's share; the rest is
+O(u²κ²)), so the time law's cap on σ̇ caps the tool's speed on the lead as on the
+seam: a lead asked to be λ long reaches δ = λ / ℓ₁ along the tangent,
+ℓ₁(r) = ∫₀¹ √(1 + 9r²x⁴) dx at r = LIFT_RATIO, and runs ℓ₁(H/δ)·δ ≥ λ. With
+du/dσ = 1/g, g = √(1 + h′²), d²u/dσ² = −h′h″/g⁴, the chain rule gives the
+σ-derivatives. Position, velocity and acceleration of the flange and its angular
+velocity and its rate are continuous at the end (the joints' q, q̇ and q̈ too), and
+the lift starts with zero slope and curvature, so the first and last millimetres of a
+lead (where the gun opens and closes) lie on the seam's tangent. The TCP speed the
+plan reports is the exact rigid-body one.
 
 The wrapped path is evaluated on the seam's own σ (negative on the lead-in, beyond L
 on the lead-out), so a reader that asks for σ ∈ [0, L] gets the seam's samples bit for
@@ -29,18 +37,41 @@ bit; with both leads 0 (``entry: rest``) the wrapper changes nothing.
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
+from scipy.interpolate import CubicHermiteSpline
 
 from offline_prog.path.fixed_tcp import FlangeSamples
 
-# The lift at a lead's far end, a share of its length: the approach and retract along
-# the normal are shorter by it (``job.approach``); near the seam the lift is tiny (at a
-# tenth of the lead from the end, LIFT_RATIO/1000 of its length).
+# The least lift at a lead's far end, a share of its extent δ: the approach and retract
+# along the normal are shorter by the lift (``job.approach``); near the seam the lift is
+# tiny (at a tenth of the extent from the end, a thousandth of the lift).
 LIFT_RATIO = 1.0
+# The most lift per extent of a lead that takes over a normal approach or retract: its
+# extent grows with the lift beyond it, so it turns onto the seam no sharper than this.
+MAX_LIFT_RATIO = 2.0
+# Samples of ℓ(u)/δ over u/δ ∈ [0, 1] that invert the lead's arc length (by cubic
+# Hermite interpolation with the exact slopes 1/g: u and du/dσ agree to ~1e-11).
+ARC_SAMPLES = 2001
 # Step of the central difference that gives the lead's dw_s (the derivative of the
 # closed-form angular velocity per metre) [m].
 ROTATION_RATE_STEP_M = 1e-5
+
+
+@functools.lru_cache(maxsize=64)
+def arc_table(ratio: float) -> tuple[float, CubicHermiteSpline]:
+    """(ℓ₁, x(ℓ/δ)) of a lead whose lift is ``ratio`` (H/δ) of its extent: its length
+    along the tool's path per its extent, and u/δ at a length ℓ/δ from the seam's end
+    (module docstring)."""
+    x = np.linspace(0.0, 1.0, ARC_SAMPLES)
+    g = np.sqrt(1.0 + (3.0 * ratio * x**2) ** 2)  # dℓ/du at u/δ = x
+    dg = 18.0 * ratio**2 * x**3 / g  # its derivative in x
+    # ℓ/δ at x: the trapezoid rule with its end correction (error O(Δx⁴)).
+    step = np.diff(x)
+    pieces = 0.5 * step * (g[1:] + g[:-1]) + step**2 / 12.0 * (dg[:-1] - dg[1:])
+    arc = np.concatenate([[0.0], np.cumsum(pieces)])
+    return float(arc[-1]), CubicHermiteSpline(arc, x, 1.0 / g)
 
 
 def _skew(a: np.ndarray) -> np.ndarray:
@@ -74,42 +105,82 @@ def _exp_and_left_jacobian(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return R, J
 
 
+def lead_shape(length_m: float, lift_m: float = 0.0) -> tuple[float, float, float]:
+    """(δ, H, λ) [m] of a lead asked to be ``length_m`` long with at least ``lift_m`` of
+    lift: its extent along the tangent, δ = max(length/ℓ₁(LIFT_RATIO), lift/MAX_LIFT_RATIO);
+    its lift, H = max(LIFT_RATIO·δ, lift); its length along the tool's path,
+    λ = ℓ₁(H/δ)·δ (all 0 for a length of 0: that end at rest)."""
+    if length_m <= 0.0:
+        return 0.0, 0.0, 0.0
+    extent = max(length_m / arc_table(LIFT_RATIO)[0], lift_m / MAX_LIFT_RATIO)
+    lift = max(LIFT_RATIO * extent, lift_m)
+    return extent, lift, arc_table(lift / extent)[0] * extent
+
+
 @dataclasses.dataclass(frozen=True)
 class _End:
-    """The flange path at one end: s_e [m], its samples there and the lead's lift."""
+    """The flange path at one end, s_e [m] and its samples there, and the lead's shape:
+    its extent δ along the tangent, its lift H [m] along e_I (3,) and its table."""
 
     s: float
     samples: FlangeSamples
-    length: float  # δ [m]
-    e_I: np.ndarray  # (3,) the lift's direction in I
+    extent: float
+    lift: float
+    e_I: np.ndarray
+
+    length: float  # λ: along the tool's path [m]
+
+    @property
+    def ratio(self) -> float:
+        """H/δ."""
+        return self.lift / self.extent if self.extent > 0.0 else 0.0
 
 
 class LeadPath:
-    """A flange path (``FlangePath`` or ``SmoothedFlangePath``) with a lead-in of
-    ``lead_in_m`` before σ = 0 and a lead-out of ``lead_out_m`` after σ = L (module
-    docstring); its domain is [−lead_in_m, L + lead_out_m].
+    """A flange path (``FlangePath`` or ``SmoothedFlangePath``) with a lead-in before
+    σ = 0 and a lead-out after σ = L (module docstring); its domain is
+    [−lead_in_m, L + lead_out_m].
 
     Args:
         inner: the seam's flange path over [0, L].
-        lead_in_m, lead_out_m: the leads' lengths δ [m] (0: that end at rest).
+        lead_in_m, lead_out_m: the leads' least lengths along the tool's path [m] (the
+            room their time law needs; 0: that end at rest).
+        lifts_m: the least lifts (lead-in, lead-out) at their far ends [m]: a lead that
+            takes over a normal approach or retract lifts by its distance (longer along
+            the tool's path then: ``lead_in_m`` and ``lead_out_m`` are the lengths run,
+            :func:`lead_shape`).
         reason: why the seam starts and ends at rest ("" when flying), for report.json.
     """
 
-    def __init__(self, inner, *, lead_in_m: float, lead_out_m: float, reason: str = ""):
+    def __init__(
+        self,
+        inner,
+        *,
+        lead_in_m: float,
+        lead_out_m: float,
+        lifts_m: tuple[float, float] = (0.0, 0.0),
+        reason: str = "",
+    ):
         self.inner = inner
-        self.lead_in_m, self.lead_out_m = float(lead_in_m), float(lead_out_m)
+        self.asked = {"lead_in_m": lead_in_m, "lead_out_m": lead_out_m, "lifts_m": lifts_m}
         self.reason = reason
-        seam_length = inner.length
         self._ends = [
-            self._end(0.0, self.lead_in_m),
-            self._end(seam_length, self.lead_out_m),
+            self._end(s, *lead_shape(float(length), float(lift)))
+            for s, length, lift in zip(
+                (0.0, inner.length), (lead_in_m, lead_out_m), lifts_m, strict=True
+            )
         ]
+        self.lead_in_m, self.lead_out_m = (end.length for end in self._ends)
 
-    def _end(self, s: float, length: float) -> _End:
+    def around(self, inner) -> LeadPath:
+        """These leads, as asked, around another flange path of the same seam."""
+        return LeadPath(inner, **self.asked, reason=self.reason)
+
+    def _end(self, s: float, extent: float, lift: float, length: float) -> _End:
         f = self.inner(np.array([s]))
         R_PE = self.inner.X_PE.rotation().matrix()
         R_IP = f.R_IE[0] @ R_PE.T
-        return _End(s, f, length, R_IP @ f.R_PF[0][:, 1])
+        return _End(s, f, extent, lift, R_IP @ f.R_PF[0][:, 1], length)
 
     def __getattr__(self, name: str):  # X_IT, X_PE, path, normal, exact, tool_turn, …
         if name.startswith("__") or name == "inner":
@@ -123,8 +194,8 @@ class LeadPath:
 
     @property
     def lifts_m(self) -> tuple[float, float]:
-        """(the lead-in's, the lead-out's) lift off the part at its far end [m]."""
-        return LIFT_RATIO * self.lead_in_m, LIFT_RATIO * self.lead_out_m
+        """(the lead-in's, the lead-out's) lift H off the part at its far end [m]."""
+        return self._ends[0].lift, self._ends[1].lift
 
     @property
     def seam_length(self) -> float:
@@ -188,19 +259,27 @@ class LeadPath:
         if end.length <= 0.0:
             raise ValueError(f"σ = {s[0]:.6g} m is beyond the path's end (no lead there)")
         f = end.samples
-        u = s - end.s
-        x = u / end.length
-        H = LIFT_RATIO * end.length
-        h = H * np.abs(x) ** 3
-        dh = 3.0 * H * x * np.abs(x) / end.length
-        ddh = 6.0 * H * np.abs(x) / end.length**2
+        extent, ratio = end.extent, end.ratio  # δ [m], H/δ
+        table_length, extent_at = arc_table(ratio)
+        arc = np.minimum(np.abs(s - end.s) / extent, table_length)  # ℓ/δ
+        x = np.copysign(extent_at(arc), s - end.s)  # u/δ
+        u = x * extent
+        h = end.lift * np.abs(x) ** 3
+        dh = 3.0 * ratio * x * np.abs(x)  # dh/du
+        ddh = 6.0 * ratio * np.abs(x) / extent  # d²h/du²
+        g = np.sqrt(1.0 + dh**2)
+        du, ddu = 1.0 / g, -dh * ddh / g**4  # du/dσ, d²u/dσ²
         p0, dp0, ddp0 = f.p_IE[0], f.dp_IE[0], f.ddp_IE[0]
         p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
-        dp_IE = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
-        ddp_IE = ddp0 + ddh[:, None] * end.e_I
-        R_IE, w_s = self._rotation(end, u)
+        dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
+        ddp_u = ddp0 + ddh[:, None] * end.e_I
+        dp_IE = dp_u * du[:, None]
+        ddp_IE = ddp_u * (du**2)[:, None] + dp_u * ddu[:, None]
+        R_IE, w_u = self._rotation(end, u)
         step = ROTATION_RATE_STEP_M
-        dw_s = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
+        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
+        w_s = w_u * du[:, None]
+        dw_s = dw_u * (du**2)[:, None] + w_u * ddu[:, None]
         # The tool point T and the tool-fixed process frame in P (X_PT = X_PE·X_EI·X_IT).
         X_PE = self.inner.X_PE
         R_PE, p_PE = X_PE.rotation().matrix(), X_PE.translation()

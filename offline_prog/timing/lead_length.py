@@ -8,6 +8,12 @@ under the seam's caps times RAMP_MARGIN. On the
 lead-in the gun is switched before the seam's start (``lead_mm`` and the valve's
 ``delay_s`` at v) and the flow command leads by the dispenser's lag: that stretch
 must already run at v, so it is added; likewise before the end for the lead-out.
+
+Where the seam's normal approach (retract) runs at the process speed, the default, a
+lead may take that move over: it lifts by the move's distance (``path.lead``) and the
+tool comes down onto the seam along one curve, with no stop at the move's foot; it
+does where that is the shorter run (``_lifts_m``): on the sealing demo, not on the
+8 mm/s weld, whose ramps are too short for a stop to cost much.
 """
 
 from __future__ import annotations
@@ -15,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from offline_prog.config.cell import Cell
-from offline_prog.path.lead import LeadPath, unwrapped
+from offline_prog.config.process_speed import approach_speed
+from offline_prog.path.lead import LeadPath, lead_shape, unwrapped
 from offline_prog.process.registry import process_model
 from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.timing.time_law import sin2_time_law
@@ -35,20 +42,13 @@ def ramp_length_m(v: float, *, a_max: float, j_max: float) -> float:
     return float(sigma[reached[0]] if len(reached) else sigma[-1])
 
 
-def lead_length_m(v: float, *, a_max: float, j_max: float, switch_m: float) -> float:
-    """A lead's length [m]: the ramp to v with its margin, plus ``switch_m`` [m] (the
-    stretch before a seam end that is run at v for its switches)."""
-    return RAMP_MARGIN * ramp_length_m(v, a_max=a_max, j_max=j_max) + switch_m
-
-
 def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> LeadPath:
     """The flange path as timed (``inputs``: the seam's ``stages.Inputs``): with a
     lead-in and lead-out (``path.lead``) for ``entry: flying``, with leads of 0 and the
     reason otherwise. ``decided``: a path whose
     entry was decided before (a forced rest stays at rest)."""
     if decided is not None:
-        lead_in, lead_out = decided.lead_in_m, decided.lead_out_m
-        return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, reason=decided.reason)
+        return decided.around(flange)
     cell, motion = inputs.cell, inputs.cell.motion
     rest = ""
     if cell.path.entry == "rest":
@@ -59,12 +59,33 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         rest = "speed_reference flange (the leads run on the tool's path)"
     if rest:
         return LeadPath(flange, lead_in_m=0.0, lead_out_m=0.0, reason=rest)
+    v = inputs.speed.v_m_s
+    ramp = ramp_length_m(v, a_max=caps.a_max, j_max=caps.j_max)
     if motion.lead_mm is not None:
         length = motion.lead_mm * 1e-3
     else:
-        v = inputs.speed.v_m_s
-        length = lead_length_m(v, a_max=caps.a_max, j_max=caps.j_max, switch_m=_switch_m(cell, v))
-    return LeadPath(flange, lead_in_m=length, lead_out_m=length)
+        length = RAMP_MARGIN * ramp + _switch_m(cell, v)
+    lifts = _lifts_m(inputs, length, ramp)
+    return LeadPath(flange, lead_in_m=length, lead_out_m=length, lifts_m=lifts)
+
+
+def _lifts_m(inputs, length: float, ramp: float) -> tuple[float, float]:
+    """The least lifts of the lead-in and lead-out [m]: a normal approach's (retract's)
+    distance (``Inputs.normal_moves_m``) where the lead takes that move over, 0 where
+    not. It does where the move runs at the process speed (the default
+    ``motion.approach_speed``) and the one longer lead is shorter than the lead, the rest
+    of the straight move and its stop (two ramps of ``ramp`` [m]) run at that speed:
+    the tool then comes down onto the seam along one curve."""
+    v = inputs.speed.v_m_s
+    if not np.isclose(approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12):
+        return 0.0, 0.0
+    _, plain_lift, plain = lead_shape(length)
+    lifts = []
+    for distance in inputs.normal_moves_m:
+        taken = lead_shape(length, distance)[2]
+        shorter = taken < plain + (distance - plain_lift) + 2.0 * ramp
+        lifts.append(distance if distance > plain_lift and shorter else 0.0)
+    return lifts[0], lifts[1]
 
 
 def _switch_m(cell: Cell, v: float) -> float:
@@ -83,3 +104,13 @@ def _switch_m(cell: Cell, v: float) -> float:
 def at_rest(flange: LeadPath, reason: str) -> LeadPath:
     """``flange`` with both ends at rest, for ``reason`` (a lead that cannot be run)."""
     return LeadPath(unwrapped(flange), lead_in_m=0.0, lead_out_m=0.0, reason=reason)
+
+
+def fallbacks(flange: LeadPath, reason: str) -> list[LeadPath]:
+    """What a flying seam whose leads cannot be run tries next, in order: leads with
+    their own lift (where they took a normal move over, ``_lifts_m``), then both ends
+    at rest for ``reason``."""
+    rest = at_rest(flange, reason)
+    if not any(flange.asked["lifts_m"]):
+        return [rest]
+    return [LeadPath(unwrapped(flange), **(flange.asked | {"lifts_m": (0.0, 0.0)})), rest]

@@ -38,6 +38,11 @@ def flying_seal(tmp_path_factory):
     return _planned(tmp_path_factory.mktemp("flying"), "flying")
 
 
+@pytest.fixture(scope="module")
+def resting_seal(tmp_path_factory):
+    return _planned(tmp_path_factory.mktemp("rest"), "rest")
+
+
 @pytest.mark.slow
 def test_the_seal_demo_crosses_its_seam_ends_at_the_process_speed(flying_seal):
     job, folder = flying_seal
@@ -85,8 +90,31 @@ def test_the_bead_is_on_target_from_the_first_millimetre_to_the_last(flying_seal
 
 
 @pytest.mark.slow
-def test_entry_rest_starts_and_ends_the_seam_at_rest(tmp_path):
-    job, _ = _planned(tmp_path, "rest")
+def test_the_leads_take_the_normal_moves_over_at_the_process_speed(flying_seal, resting_seal):
+    """The demo's 50 mm normal approach and retract run at the process speed (the
+    default): the leads take them over, lifting 50 mm, so the tool comes down onto the
+    seam along one curve with no stop at its foot; on the leads the tool keeps to the
+    process speed (their parameter is its path length), and the cycle is shorter than
+    the plan at rest."""
+    job, _ = flying_seal
+    s, v = job.samples, job.cell.motion.speed
+    flange = job.chosen[0].plan.flange
+    assert flange.lifts_m == pytest.approx((0.05, 0.05))
+    g = _seam_segments(job)
+    assert s.path_m[g["approach"].start] == pytest.approx(-flange.lead_in_m, abs=1e-9)
+    assert s.path_m[g["retract"].stop - 1] == pytest.approx(
+        flange.seam_length + flange.lead_out_m, abs=1e-9
+    )
+    for kind in ("approach", "retract"):
+        rows = slice(g[kind].start, g[kind].stop)
+        assert job.tcp_speed[rows].max() <= v * 1.005, (kind, job.tcp_speed[rows].max())
+    rest, _ = resting_seal
+    assert s.t[-1] < rest.samples.t[-1], (s.t[-1], rest.samples.t[-1])
+
+
+@pytest.mark.slow
+def test_entry_rest_starts_and_ends_the_seam_at_rest(resting_seal):
+    job, _ = resting_seal
     plan = job.chosen[0].plan
     assert plan.entry == {
         "entry": "rest",

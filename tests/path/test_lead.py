@@ -6,7 +6,7 @@ seam itself."""
 import numpy as np
 import pytest
 
-from offline_prog.path.lead import LIFT_RATIO, LeadPath, path_ends
+from offline_prog.path.lead import MAX_LIFT_RATIO, LeadPath, path_ends
 
 from conftest import random_flange_path, rotation_log
 
@@ -62,14 +62,14 @@ def test_lead_derivatives_match_finite_differences(rng):
 def test_the_lead_in_starts_on_the_tangent_and_lifts_off_the_part(rng):
     """The tool point T in P: within the lead's first tenth it is off the seam's tangent
     line by at most a thousandth of the lift; at the lead's far end it has backed off
-    the surface (against n) by the lift, LIFT_RATIO of the lead."""
+    the surface (against n) by the lift (LIFT_RATIO of its extent along the tangent)."""
     flange = random_flange_path(rng, closed=False)
     lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=0.0)
     start = flange(np.array([0.0]))
     p0, t0, n0 = start.p_PF[0], start.R_PF[0][:, 0], start.R_PF[0][:, 1]
     near = lead(np.linspace(-0.1 * LEAD_M, 0.0, 20)).p_PF - p0
     off_line = near - np.outer(near @ t0, t0)
-    lift = LIFT_RATIO * LEAD_M
+    lift = lead.lifts_m[0]
     assert np.linalg.norm(off_line, axis=1).max() <= 2e-3 * lift + 0.5 * (0.1 * LEAD_M) ** 2 * 50
     far = lead(np.array([-LEAD_M])).p_PF[0] - p0
     assert far @ t0 < 0.0  # before the start
@@ -86,3 +86,40 @@ def test_leads_of_zero_change_nothing_on_the_seam(rng):
     assert path_ends(lead) == (0.0, flange.length) and not lead.flying
     with pytest.raises(ValueError, match="no lead"):
         lead(np.array([-1e-3]))
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("lift", [0.0, 0.05])
+def test_a_lead_is_parameterized_by_the_tools_path_length(rng, closed, lift):
+    """On both leads the tool point moves in P by dσ per dσ (|dp_PT/dσ| = 1 within
+    1 %, the O(u²κ²) the expansion leaves), so the time law's σ̇ ≤ v caps the tool's
+    speed there as on the seam, and a lead's tool path is as long as the lead; a lead
+    that takes over a 50 mm normal move too."""
+    for _ in range(3):
+        flange = random_flange_path(rng, closed=closed)
+        lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M, lifts_m=(lift, lift))
+        assert lead.lead_in_m >= LEAD_M and lead.lead_out_m >= LEAD_M
+        for s in (
+            np.linspace(-LEAD_M, 0.0, 3001),
+            np.linspace(0.0, LEAD_M, 3001) + flange.length,
+        ):
+            p = lead(s).p_PF
+            rate = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(s)
+            assert np.abs(rate - 1.0).max() <= 0.01, np.abs(rate - 1.0).max()
+
+
+def test_a_lead_that_takes_a_normal_move_over_lifts_by_its_distance(rng):
+    """Lifted to the approach's 50 mm, the lead's far end is 50 mm off the surface
+    (against n) and its extent along the tangent at least MAX_LIFT_RATIO below the
+    lift; its first tenth still hugs the tangent."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=0.0, lifts_m=(0.05, 0.0))
+    assert lead.lifts_m == (0.05, 0.0)
+    start = flange(np.array([0.0]))
+    p0, t0, n0 = start.p_PF[0], start.R_PF[0][:, 0], start.R_PF[0][:, 1]
+    far = lead(np.array([-lead.lead_in_m])).p_PF[0] - p0
+    assert -(far @ n0) == pytest.approx(0.05, rel=0.2)
+    assert -(far @ t0) >= 0.05 / MAX_LIFT_RATIO * 0.8
+    extent = -(far @ t0)
+    near = lead(np.linspace(-0.1 * extent, 0.0, 20)).p_PF - p0
+    assert np.abs(near @ n0).max() <= 2e-3 * 0.05 + 0.5 * (0.1 * extent) ** 2 * 50
