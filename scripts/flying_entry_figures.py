@@ -1,5 +1,5 @@
 """Flying seam entry and exit (issue 37): each demo cell with a process model planned
-with every seam at rest (``entry: rest``, the default) and flying (``entry: flying``),
+with every seam at rest (``entry: rest``) and flying (``entry: flying``, the default),
 in one process.
 
 Run: ``PYTHONPATH=. python scripts/flying_entry_figures.py [--cells NAME ...]

@@ -187,12 +187,13 @@ class PathConfig:
     # A closed seam's bead runs past its start by this much before the gun closes [mm]
     # (the path runs on over its first overlap_mm); refused on an open seam.
     overlap_mm: float = 0.0
-    # rest | flying. rest: the seam starts and ends at rest. flying: the tool reaches
-    # the seam's start already at the process speed and leaves its end at it (a lead-in
-    # and lead-out along the seam's tangent, lifting off the part, timed with the seam:
-    # path.lead). A lead that cannot be run (out of reach, a joint limit, a collision,
-    # speed_reference flange) falls back to rest; report.json names the entry and why.
-    entry: str = "rest"
+    # flying | rest. flying (the default): the tool reaches the seam's start already at
+    # the process speed and leaves its end at it (a lead-in and lead-out along the
+    # seam's tangent, lifting off the part, timed with the seam: path.lead). A lead
+    # that cannot be run (out of reach, a joint limit, a collision, speed_reference
+    # flange) falls back to rest; report.json names the entry and why. rest: the seam
+    # starts and ends at rest (a cusp at its end, a process that must start standing).
+    entry: str = "flying"
 
 
 @dataclasses.dataclass

@@ -1,6 +1,6 @@
 """Flying seam entry and exit: the tool reaches the seam's start at the process speed and
 leaves its end at it, so the bead is on target from the first millimetre to the last;
-``entry: rest`` (the default) keeps the seam starting and ending at rest and
+``entry: flying`` is the default; ``entry: rest`` keeps the seam starting and ending at rest and
 report.json says so."""
 
 import json
