@@ -54,6 +54,10 @@ MAX_LIFT_RATIO = 2.0
 # Samples of ℓ(u)/δ over u/δ ∈ [0, 1] that invert the lead's arc length (by cubic
 # Hermite interpolation with the exact slopes 1/g: u and du/dσ agree to ~1e-11).
 ARC_SAMPLES = 2001
+# A lead's length along the tool's path matches the asked one within LENGTH_TOL after
+# at most LENGTH_ITERATIONS scalings of its extent.
+LENGTH_TOL = 1e-9
+LENGTH_ITERATIONS = 6
 # Step of the central difference that gives the lead's dw_s (the derivative of the
 # closed-form angular velocity per metre) [m].
 ROTATION_RATE_STEP_M = 1e-5
@@ -117,18 +121,21 @@ def lead_shape(length_m: float, lift_m: float = 0.0) -> tuple[float, float, floa
     return extent, lift, arc_table(lift / extent)[0] * extent
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass
 class _End:
     """The flange path at one end, s_e [m] and its samples there, and the lead's shape:
-    its extent δ along the tangent, its lift H [m] along e_I (3,) and its table."""
+    its side (−1 the lead-in, +1 the lead-out), its extent δ along the tangent, its lift
+    H [m] along e_I (3,); its length λ along the tool's path [m] and u/δ at a length ℓ/δ
+    from the end (``x_at``), filled in by ``LeadPath._table``."""
 
     s: float
     samples: FlangeSamples
+    side: float
     extent: float
     lift: float
     e_I: np.ndarray
-
-    length: float  # λ: along the tool's path [m]
+    length: float = 0.0
+    x_at: CubicHermiteSpline | None = None
 
     @property
     def ratio(self) -> float:
@@ -165,9 +172,9 @@ class LeadPath:
         self.asked = {"lead_in_m": lead_in_m, "lead_out_m": lead_out_m, "lifts_m": lifts_m}
         self.reason = reason
         self._ends = [
-            self._end(s, *lead_shape(float(length), float(lift)))
-            for s, length, lift in zip(
-                (0.0, inner.length), (lead_in_m, lead_out_m), lifts_m, strict=True
+            self._shaped(self._end(s, side, *lead_shape(length, lift)[:2]), length, lift)
+            for s, side, length, lift in zip(
+                (0.0, inner.length), (-1.0, 1.0), (lead_in_m, lead_out_m), lifts_m, strict=True
             )
         ]
         self.lead_in_m, self.lead_out_m = (end.length for end in self._ends)
@@ -176,11 +183,64 @@ class LeadPath:
         """These leads, as asked, around another flange path of the same seam."""
         return LeadPath(inner, **self.asked, reason=self.reason)
 
-    def _end(self, s: float, extent: float, lift: float, length: float) -> _End:
+    def _end(self, s: float, side: float, extent: float, lift: float) -> _End:
         f = self.inner(np.array([s]))
         R_PE = self.inner.X_PE.rotation().matrix()
         R_IP = f.R_IE[0] @ R_PE.T
-        return _End(s, f, extent, lift, R_IP @ f.R_PF[0][:, 1], length)
+        return _End(s, f, side, extent, lift, R_IP @ f.R_PF[0][:, 1])
+
+    def _shaped(self, end: _End, asked: float, lift: float) -> _End:
+        """``end`` with its table, its extent scaled (lead_shape's λ leaves the seam's
+        curvature out) so that the lead is ``asked`` long along the tool's path (at
+        least that where a lift of ``lift`` makes it longer)."""
+        for _ in range(LENGTH_ITERATIONS if end.extent > 0.0 else 0):
+            end.length, end.x_at = self._table(end)
+            error = end.length / asked - 1.0
+            if abs(error) <= LENGTH_TOL or (error > 0.0 and end.lift == lift):
+                break
+            end.extent /= 1.0 + error
+            end.lift = max(LIFT_RATIO * end.extent, lift)
+        return end
+
+    def _table(self, end: _End) -> tuple[float, CubicHermiteSpline]:
+        """(λ, x(ℓ/δ)) of a lead: ℓ/δ = ∫₀^x g dx′ at ARC_SAMPLES values of x = |u|/δ by
+        the trapezoid rule with its end correction (d/dx = g, d²/dx² = ±δ·g′), inverted
+        by cubic Hermite interpolation with the exact slopes 1/g."""
+        x = np.linspace(0.0, 1.0, ARC_SAMPLES)
+        g, dg = self._speed(end, *self._along(end, end.side * x * end.extent)[:5])
+        slope, curvature = g, end.side * end.extent * dg
+        step = np.diff(x)
+        pieces = 0.5 * step * (slope[1:] + slope[:-1])
+        pieces += step**2 / 12.0 * (curvature[:-1] - curvature[1:])
+        arc = np.concatenate([[0.0], np.cumsum(pieces)])
+        return float(arc[-1] * end.extent), CubicHermiteSpline(arc, x, 1.0 / g)
+
+    def _along(self, end: _End, u: np.ndarray):
+        """The lead at u (N,) [m] from its end, per metre of u: (p_IE, p′_IE, p″_IE
+        (N, 3), w_u, w′_u (N, 3), R_IE (N, 3, 3))."""
+        f = end.samples
+        x = u / end.extent
+        ratio = end.ratio
+        h = end.lift * np.abs(x) ** 3
+        dh = 3.0 * ratio * x * np.abs(x)  # dh/du
+        ddh = 6.0 * ratio * np.abs(x) / end.extent  # d²h/du²
+        p0, dp0, ddp0 = f.p_IE[0], f.dp_IE[0], f.ddp_IE[0]
+        p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
+        dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
+        ddp_u = ddp0 + ddh[:, None] * end.e_I
+        R_IE, w_u = self._rotation(end, u)
+        step = ROTATION_RATE_STEP_M
+        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
+        return p_IE, dp_u, ddp_u, w_u, dw_u, R_IE
+
+    def _speed(self, end, p_IE, dp_u, ddp_u, w_u, dw_u) -> tuple[np.ndarray, np.ndarray]:
+        """(g, dg/du) (N,): the tool point's speed in P per metre of u, the rigid-body
+        g = |p′_IE + w_u × (p_IT − p_IE)| (X_PT = X_PE·X_EI·X_IT), and its derivative."""
+        r = self.inner.X_IT.translation() - p_IE
+        v = dp_u + np.cross(w_u, r)
+        dv = ddp_u + np.cross(dw_u, r) - np.cross(w_u, dp_u)
+        g = np.linalg.norm(v, axis=1)
+        return g, np.einsum("ni,ni->n", v, dv) / g
 
     def __getattr__(self, name: str):  # X_IT, X_PE, path, normal, exact, tool_turn, …
         if name.startswith("__") or name == "inner":
@@ -259,25 +319,13 @@ class LeadPath:
         if end.length <= 0.0:
             raise ValueError(f"σ = {s[0]:.6g} m is beyond the path's end (no lead there)")
         f = end.samples
-        extent, ratio = end.extent, end.ratio  # δ [m], H/δ
-        table_length, extent_at = arc_table(ratio)
-        arc = np.minimum(np.abs(s - end.s) / extent, table_length)  # ℓ/δ
-        x = np.copysign(extent_at(arc), s - end.s)  # u/δ
-        u = x * extent
-        h = end.lift * np.abs(x) ** 3
-        dh = 3.0 * ratio * x * np.abs(x)  # dh/du
-        ddh = 6.0 * ratio * np.abs(x) / extent  # d²h/du²
-        g = np.sqrt(1.0 + dh**2)
-        du, ddu = 1.0 / g, -dh * ddh / g**4  # du/dσ, d²u/dσ²
-        p0, dp0, ddp0 = f.p_IE[0], f.dp_IE[0], f.ddp_IE[0]
-        p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
-        dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
-        ddp_u = ddp0 + ddh[:, None] * end.e_I
+        arc = np.minimum(np.abs(s - end.s) / end.extent, end.length / end.extent)  # ℓ/δ
+        u = end.side * end.extent * end.x_at(arc)
+        p_IE, dp_u, ddp_u, w_u, dw_u, R_IE = self._along(end, u)
+        g, dg = self._speed(end, p_IE, dp_u, ddp_u, w_u, dw_u)
+        du, ddu = 1.0 / g, -dg / g**3  # du/dσ, d²u/dσ²
         dp_IE = dp_u * du[:, None]
         ddp_IE = ddp_u * (du**2)[:, None] + dp_u * ddu[:, None]
-        R_IE, w_u = self._rotation(end, u)
-        step = ROTATION_RATE_STEP_M
-        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
         w_s = w_u * du[:, None]
         dw_s = dw_u * (du**2)[:, None] + w_u * ddu[:, None]
         # The tool point T and the tool-fixed process frame in P (X_PT = X_PE·X_EI·X_IT).
