@@ -9,7 +9,7 @@ A lead continues the flange path X_IE(s) past an end s_e by its second-order
 expansion in u (negative on the lead-in, positive on the lead-out), with the tool
 lifted off the part along the end frame's normal:
 
-    p_IE(u) = p_e + u·p′_e + ½u²·p″_e + h(u)·e,        h(u) = H·|u/δ|³,
+    p_IE(u) = p_e + u·p′_e + ½u²·p″_e + h(u)·e,        h(u) = H·|u/δ|⁴,
     R_IE(u) = Exp(u·w_e + ½u²·w′_e) · R_e,
 
 with e = R_IP·n (the direction the part moves in I when the tool backs off the
@@ -17,17 +17,18 @@ surface along −n, as ``job.approach`` moves it), δ the lead's extent along th
 tangent and H its lift: LIFT_RATIO·δ, or a normal approach's (retract's) distance
 when the lead takes that move over (``timing.lead_length``): the tool then comes down
 onto the seam at speed along one curve instead of stopping at its foot. The lead is
-parameterized by the tool's path length in P, σ − s_e = ±ℓ(u) with
-ℓ(u) = ∫₀^|u| √(1 + h′(v)²) dv (the tangent's and the lift's share; the rest is
-O(u²κ²)), so the time law's cap on σ̇ caps the tool's speed on the lead as on the
-seam: a lead asked to be λ long reaches δ = λ / ℓ₁ along the tangent,
-ℓ₁(r) = ∫₀¹ √(1 + 9r²x⁴) dx at r = LIFT_RATIO, and runs ℓ₁(H/δ)·δ ≥ λ. With
-du/dσ = 1/g, g = √(1 + h′²), d²u/dσ² = −h′h″/g⁴, the chain rule gives the
-σ-derivatives. Position, velocity and acceleration of the flange and its angular
-velocity and its rate are continuous at the end (the joints' q, q̇ and q̈ too), and
-the lift starts with zero slope and curvature, so the first and last millimetres of a
-lead (where the gun opens and closes) lie on the seam's tangent. The TCP speed the
-plan reports is the exact rigid-body one.
+parameterized by the tool's path length in P, σ − s_e = ±ℓ(u),
+ℓ(u) = ∫₀^|u| g, with g = |p′_IE + w_u × (p_IT − p_IE)| the tool point's rigid-body
+speed in P per metre of u (X_PT = X_PE·X_EI·X_IT), integrated per end and inverted by
+cubic Hermite interpolation; so the time law's cap on σ̇ caps the tool's speed on the
+lead as on the seam, and the lead is as long along the tool's path as asked (its
+extent scaled to it; :func:`lead_shape` sizes it leaving the seam's curvature out).
+With du/dσ = 1/g and d²u/dσ² = −g′/g³ the chain rule gives the σ-derivatives.
+Position, velocity and acceleration of the flange and its angular velocity and its
+rate are continuous at the end (the joints' q, q̇ and q̈ too), and the lift starts with
+zero slope, curvature and jerk: where the gun opens and closes, a few millimetres from
+the end, the nozzle is at its working height (5 mm from the end of a 50 mm lift over
+25 mm: 0.08 mm off). The TCP speed the plan reports is the exact rigid-body one.
 
 The wrapped path is evaluated on the seam's own σ (negative on the lead-in, beyond L
 on the lead-out), so a reader that asks for σ ∈ [0, L] gets the seam's samples bit for
@@ -45,33 +46,32 @@ from scipy.interpolate import CubicHermiteSpline
 from offline_prog.path.fixed_tcp import FlangeSamples
 
 # The least lift at a lead's far end, a share of its extent δ: the approach and retract
-# along the normal are shorter by the lift (``job.approach``); near the seam the lift is
-# tiny (at a tenth of the extent from the end, a thousandth of the lift).
+# along the normal are shorter by the lift (``job.approach``).
 LIFT_RATIO = 1.0
+# The lift's power: h = H·|u/δ|⁴ rises with zero slope, curvature and jerk.
+LIFT_POWER = 4
 # The most lift per extent of a lead that takes over a normal approach or retract: its
 # extent grows with the lift beyond it, so it turns onto the seam no sharper than this.
 MAX_LIFT_RATIO = 2.0
 # Samples of ℓ(u)/δ over u/δ ∈ [0, 1] that invert the lead's arc length (by cubic
 # Hermite interpolation with the exact slopes 1/g: u and du/dσ agree to ~1e-11).
 ARC_SAMPLES = 2001
+# A lead's length along the tool's path matches the asked one within LENGTH_TOL after
+# at most LENGTH_ITERATIONS scalings of its extent.
+LENGTH_TOL = 1e-9
+LENGTH_ITERATIONS = 6
 # Step of the central difference that gives the lead's dw_s (the derivative of the
 # closed-form angular velocity per metre) [m].
 ROTATION_RATE_STEP_M = 1e-5
 
 
 @functools.lru_cache(maxsize=64)
-def arc_table(ratio: float) -> tuple[float, CubicHermiteSpline]:
-    """(ℓ₁, x(ℓ/δ)) of a lead whose lift is ``ratio`` (H/δ) of its extent: its length
-    along the tool's path per its extent, and u/δ at a length ℓ/δ from the seam's end
-    (module docstring)."""
+def unit_length(ratio: float) -> float:
+    """ℓ₁(r) = ∫₀¹ √(1 + (4r·x³)²) dx: the length of a straight lead lifting r·δ per its
+    extent δ (the trapezoid rule on ARC_SAMPLES points), for sizing leads."""
     x = np.linspace(0.0, 1.0, ARC_SAMPLES)
-    g = np.sqrt(1.0 + (3.0 * ratio * x**2) ** 2)  # dℓ/du at u/δ = x
-    dg = 18.0 * ratio**2 * x**3 / g  # its derivative in x
-    # ℓ/δ at x: the trapezoid rule with its end correction (error O(Δx⁴)).
-    step = np.diff(x)
-    pieces = 0.5 * step * (g[1:] + g[:-1]) + step**2 / 12.0 * (dg[:-1] - dg[1:])
-    arc = np.concatenate([[0.0], np.cumsum(pieces)])
-    return float(arc[-1]), CubicHermiteSpline(arc, x, 1.0 / g)
+    g = np.sqrt(1.0 + (LIFT_POWER * ratio * x ** (LIFT_POWER - 1)) ** 2)
+    return float(np.sum(0.5 * (g[1:] + g[:-1]) * np.diff(x)))
 
 
 def _skew(a: np.ndarray) -> np.ndarray:
@@ -107,33 +107,32 @@ def _exp_and_left_jacobian(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def lead_shape(length_m: float, lift_m: float = 0.0) -> tuple[float, float, float]:
     """(δ, H, λ) [m] of a lead asked to be ``length_m`` long with at least ``lift_m`` of
-    lift: its extent along the tangent, δ = max(length/ℓ₁(LIFT_RATIO), lift/MAX_LIFT_RATIO);
-    its lift, H = max(LIFT_RATIO·δ, lift); its length along the tool's path,
-    λ = ℓ₁(H/δ)·δ (all 0 for a length of 0: that end at rest)."""
+    lift: its extent along the tangent, δ = max(length/ℓ₁(LIFT_RATIO),
+    lift/MAX_LIFT_RATIO); its lift, H = max(LIFT_RATIO·δ, lift); its length along the
+    tool's path (the seam's curvature left out), λ = ℓ₁(H/δ)·δ (all 0 for a length of
+    0: that end at rest)."""
     if length_m <= 0.0:
         return 0.0, 0.0, 0.0
-    extent = max(length_m / arc_table(LIFT_RATIO)[0], lift_m / MAX_LIFT_RATIO)
+    extent = max(length_m / unit_length(LIFT_RATIO), lift_m / MAX_LIFT_RATIO)
     lift = max(LIFT_RATIO * extent, lift_m)
-    return extent, lift, arc_table(lift / extent)[0] * extent
+    return extent, lift, unit_length(lift / extent) * extent
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass
 class _End:
     """The flange path at one end, s_e [m] and its samples there, and the lead's shape:
-    its extent δ along the tangent, its lift H [m] along e_I (3,) and its table."""
+    its side (−1 the lead-in, +1 the lead-out), its extent δ along the tangent, its lift
+    H [m] along e_I (3,); its length λ along the tool's path [m] and u/δ at a length ℓ/δ
+    from the end (``x_at``), filled in by ``LeadPath._table``."""
 
     s: float
     samples: FlangeSamples
+    side: float
     extent: float
     lift: float
     e_I: np.ndarray
-
-    length: float  # λ: along the tool's path [m]
-
-    @property
-    def ratio(self) -> float:
-        """H/δ."""
-        return self.lift / self.extent if self.extent > 0.0 else 0.0
+    length: float = 0.0
+    x_at: CubicHermiteSpline | None = None
 
 
 class LeadPath:
@@ -165,9 +164,9 @@ class LeadPath:
         self.asked = {"lead_in_m": lead_in_m, "lead_out_m": lead_out_m, "lifts_m": lifts_m}
         self.reason = reason
         self._ends = [
-            self._end(s, *lead_shape(float(length), float(lift)))
-            for s, length, lift in zip(
-                (0.0, inner.length), (lead_in_m, lead_out_m), lifts_m, strict=True
+            self._shaped(self._end(s, side, *lead_shape(length, lift)[:2]), length, lift)
+            for s, side, length, lift in zip(
+                (0.0, inner.length), (-1.0, 1.0), (lead_in_m, lead_out_m), lifts_m, strict=True
             )
         ]
         self.lead_in_m, self.lead_out_m = (end.length for end in self._ends)
@@ -176,11 +175,63 @@ class LeadPath:
         """These leads, as asked, around another flange path of the same seam."""
         return LeadPath(inner, **self.asked, reason=self.reason)
 
-    def _end(self, s: float, extent: float, lift: float, length: float) -> _End:
+    def _end(self, s: float, side: float, extent: float, lift: float) -> _End:
         f = self.inner(np.array([s]))
         R_PE = self.inner.X_PE.rotation().matrix()
         R_IP = f.R_IE[0] @ R_PE.T
-        return _End(s, f, extent, lift, R_IP @ f.R_PF[0][:, 1], length)
+        return _End(s, f, side, extent, lift, R_IP @ f.R_PF[0][:, 1])
+
+    def _shaped(self, end: _End, asked: float, lift: float) -> _End:
+        """``end`` with its table, its extent scaled (lead_shape's λ leaves the seam's
+        curvature out) so that the lead is ``asked`` long along the tool's path (at
+        least that where a lift of ``lift`` makes it longer)."""
+        for _ in range(LENGTH_ITERATIONS if end.extent > 0.0 else 0):
+            end.length, end.x_at = self._table(end)
+            error = end.length / asked - 1.0
+            if abs(error) <= LENGTH_TOL or (error > 0.0 and end.lift == lift):
+                break
+            end.extent /= 1.0 + error
+            end.lift = max(LIFT_RATIO * end.extent, lift)
+        return end
+
+    def _table(self, end: _End) -> tuple[float, CubicHermiteSpline]:
+        """(λ, x(ℓ/δ)) of a lead: ℓ/δ = ∫₀^x g dx′ at ARC_SAMPLES values of x = |u|/δ by
+        the trapezoid rule with its end correction (d/dx = g, d²/dx² = ±δ·g′), inverted
+        by cubic Hermite interpolation with the exact slopes 1/g."""
+        x = np.linspace(0.0, 1.0, ARC_SAMPLES)
+        g, dg = self._speed(end, *self._along(end, end.side * x * end.extent)[:5])
+        slope, curvature = g, end.side * end.extent * dg
+        step = np.diff(x)
+        pieces = 0.5 * step * (slope[1:] + slope[:-1])
+        pieces += step**2 / 12.0 * (curvature[:-1] - curvature[1:])
+        arc = np.concatenate([[0.0], np.cumsum(pieces)])
+        return float(arc[-1] * end.extent), CubicHermiteSpline(arc, x, 1.0 / g)
+
+    def _along(self, end: _End, u: np.ndarray):
+        """The lead at u (N,) [m] from its end, per metre of u: (p_IE, p′_IE, p″_IE
+        (N, 3), w_u, w′_u (N, 3), R_IE (N, 3, 3))."""
+        f = end.samples
+        x, n = u / end.extent, LIFT_POWER
+        h = end.lift * np.abs(x) ** n
+        dh = np.sign(u) * n * end.lift * np.abs(x) ** (n - 1) / end.extent  # dh/du
+        ddh = n * (n - 1) * end.lift * np.abs(x) ** (n - 2) / end.extent**2  # d²h/du²
+        p0, dp0, ddp0 = f.p_IE[0], f.dp_IE[0], f.ddp_IE[0]
+        p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
+        dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
+        ddp_u = ddp0 + ddh[:, None] * end.e_I
+        R_IE, w_u = self._rotation(end, u)
+        step = ROTATION_RATE_STEP_M
+        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
+        return p_IE, dp_u, ddp_u, w_u, dw_u, R_IE
+
+    def _speed(self, end, p_IE, dp_u, ddp_u, w_u, dw_u) -> tuple[np.ndarray, np.ndarray]:
+        """(g, dg/du) (N,): the tool point's speed in P per metre of u, the rigid-body
+        g = |p′_IE + w_u × (p_IT − p_IE)| (X_PT = X_PE·X_EI·X_IT), and its derivative."""
+        r = self.inner.X_IT.translation() - p_IE
+        v = dp_u + np.cross(w_u, r)
+        dv = ddp_u + np.cross(dw_u, r) - np.cross(w_u, dp_u)
+        g = np.linalg.norm(v, axis=1)
+        return g, np.einsum("ni,ni->n", v, dv) / g
 
     def __getattr__(self, name: str):  # X_IT, X_PE, path, normal, exact, tool_turn, …
         if name.startswith("__") or name == "inner":
@@ -259,25 +310,13 @@ class LeadPath:
         if end.length <= 0.0:
             raise ValueError(f"σ = {s[0]:.6g} m is beyond the path's end (no lead there)")
         f = end.samples
-        extent, ratio = end.extent, end.ratio  # δ [m], H/δ
-        table_length, extent_at = arc_table(ratio)
-        arc = np.minimum(np.abs(s - end.s) / extent, table_length)  # ℓ/δ
-        x = np.copysign(extent_at(arc), s - end.s)  # u/δ
-        u = x * extent
-        h = end.lift * np.abs(x) ** 3
-        dh = 3.0 * ratio * x * np.abs(x)  # dh/du
-        ddh = 6.0 * ratio * np.abs(x) / extent  # d²h/du²
-        g = np.sqrt(1.0 + dh**2)
-        du, ddu = 1.0 / g, -dh * ddh / g**4  # du/dσ, d²u/dσ²
-        p0, dp0, ddp0 = f.p_IE[0], f.dp_IE[0], f.ddp_IE[0]
-        p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
-        dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
-        ddp_u = ddp0 + ddh[:, None] * end.e_I
+        arc = np.minimum(np.abs(s - end.s) / end.extent, end.length / end.extent)  # ℓ/δ
+        u = end.side * end.extent * end.x_at(arc)
+        p_IE, dp_u, ddp_u, w_u, dw_u, R_IE = self._along(end, u)
+        g, dg = self._speed(end, p_IE, dp_u, ddp_u, w_u, dw_u)
+        du, ddu = 1.0 / g, -dg / g**3  # du/dσ, d²u/dσ²
         dp_IE = dp_u * du[:, None]
         ddp_IE = ddp_u * (du**2)[:, None] + dp_u * ddu[:, None]
-        R_IE, w_u = self._rotation(end, u)
-        step = ROTATION_RATE_STEP_M
-        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
         w_s = w_u * du[:, None]
         dw_s = dw_u * (du**2)[:, None] + w_u * ddu[:, None]
         # The tool point T and the tool-fixed process frame in P (X_PT = X_PE·X_EI·X_IT).
