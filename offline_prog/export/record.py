@@ -31,10 +31,6 @@ from offline_prog.export.points import PointRule, process_points
 from offline_prog.export.program import ProgramData
 from offline_prog.io_events import IoEvent, Signal
 
-# A straight approach or retract shorter than this is none (a flying seam's lead took
-# the move over: the link ends where the lead-in starts) [m]: no statement is written.
-EMPTY_MOVE_M = 1e-6
-
 
 @dataclasses.dataclass(frozen=True)
 class Switch:
@@ -101,10 +97,9 @@ class Process:
 @dataclasses.dataclass(frozen=True)
 class SeamRun:
     """Seam ``seam`` as run, ``number`` from 1 in run order: approach, process, retract
-    (no approach or retract where the cell asks for none or a flying seam's lead took
-    it over: ``EMPTY_MOVE_M``), its job ``segments``, the job's ``rows`` from the
-    approach's first to the retract's last, and the seam's I/O ``events`` in time
-    order."""
+    (no approach or retract where the cell asks for none), its job ``segments``, the
+    job's ``rows`` from the approach's first to the retract's last, and the seam's
+    I/O ``events`` in time order."""
 
     seam: str
     number: int
@@ -166,7 +161,6 @@ def _seam_run(job, number, segments, points, flow_where_set) -> SeamRun:
         for kind in ("approach", "retract")
         if kind in by_kind
     }
-    moves = {kind: move for kind, move in moves.items() if move.length_m >= EMPTY_MOVE_M}
     process = _process(job.seams[k], seam, number, points)
     events = tuple(e for e in job.events if e.seam == seam)
     rows = slice(segments[0].start, min(segments[-1].stop + 1, len(job.job.t)))
