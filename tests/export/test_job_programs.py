@@ -252,6 +252,11 @@ def test_rapid_job_links_approach_retract_and_io(folders):
     axes[:, 2] += axes[:, 1]  # the IRB 2400's axis 3: q2 + q3 (its robot.yaml j23_factor 1)
     np.testing.assert_allclose([joints[t] for t in targets], axes, atol=JOINT_TOL_DEG)
     triggs, here, position, switched, q_link = {}, None, 0.0, {}, None
+    # The seam's plane: its start point p0 and the surface normal n in P (a DXF seam);
+    # a flying seam's lead lifts off it, the straight approach and retract the rest.
+    seam = data.seams[0]
+    p0 = np.array([np.interp(0.0, seam.path_m, seam.X_PT[:, i, 3]) for i in range(3)])
+    n_P = np.array(load_cell(folders.cells["rapid"]).path.normal, float)
     for line in run:
         if line.startswith("TriggIO"):
             name, rest = line.split()[1].rstrip(","), line.split(",", 1)[1]
@@ -264,15 +269,16 @@ def test_rapid_job_links_approach_retract_and_io(folders):
             q_link = planned[targets.index(m[2])]
             continue
         p = points[m[2]]
-        if m[2] == "pA1":
+        if m[2] == "pA1":  # it ends at the seam's first sample (a flying lead-in's start)
             start = tool_in_part_from_joints(data, q_link)
-            assert np.linalg.norm(p - start) == pytest.approx(0.05, abs=LENGTH_TOL_M)
-            position = 0.0
+            off_part = (p0 - start) @ n_P  # the tool backs off the surface along −n
+            assert off_part == pytest.approx(0.05, abs=LENGTH_TOL_M)  # its distance
+            position = seam.path_m[0]
         else:
             step = np.linalg.norm(p - here)
-            if m[2] == "pR1":
-                assert step == pytest.approx(0.05, abs=LENGTH_TOL_M)
             position += step
+            if m[2] == "pR1":  # it ends its distance off the part
+                assert (p0 - p) @ n_P == pytest.approx(0.05, abs=LENGTH_TOL_M)
         here = p
         if m[1] == "TriggL":
             for name in re.findall(r"\b(tOn|tOff)\b", line):
