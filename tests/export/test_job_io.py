@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 from program_readers import Switch, krl_items, rapid_items, tool_in_part
 
 from offline_prog.config.cell import load_cell
+from offline_prog.constants import FLOW_PRIME_LAGS
 from offline_prog.export.formats import controller_post
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.post import write_program
@@ -36,6 +37,9 @@ END_P = np.array([0.120, 0.080, 0.0])
 LENGTH_M = float(np.linalg.norm(END_P - START_P))  # 240 mm
 ON_LEAD_MM, OFF_LEAD_MM, PER_MPS, OFFSET_V, LAG_S = -100.0, 2.0, 40.0, 0.5, 0.1
 SPEED_M_S = 0.15  # the stripe's speed in the cell
+# The stripe runs flying (the default entry): its flow goes live this many lags ahead
+# of the valve, the tool at the stripe's speed there.
+PRIME_S = FLOW_PRIME_LAGS * LAG_S
 
 
 def write(data: JobProgramData, fmt: str, folder: Path) -> list[Path]:
@@ -85,25 +89,34 @@ def asked() -> tuple[float, float]:
     return -ON_LEAD_MM * 1e-3, LENGTH_M - OFF_LEAD_MM * 1e-3
 
 
-def along(p_PT: np.ndarray, off_line_m: float = 1e-4) -> float:
-    """Position of a tool point on the part along the stripe from its start [m] (the
-    approach and retract are tangent: on the stripe's line; a flying seam's leads lift
-    off it by up to ``off_line_m``)."""
-    u = (END_P - START_P) / LENGTH_M
-    assert np.linalg.norm(np.cross(p_PT - START_P, u)) < off_line_m  # on the line
-    return float((p_PT - START_P) @ u)
+def along(data: JobProgramData, p_PT: np.ndarray, off_path_m: float = 1e-4) -> float:
+    """Position of a tool point on the part along the stripe's planned path [m] (the
+    plan's ``path_m``: from the seam's start, negative on the approach, beyond L on the
+    retract; a flying seam's leads curve off the stripe's line): the point must lie
+    within ``off_path_m`` of the tool's planned path on the part."""
+    rows = data.job
+    planned = np.flatnonzero(np.isfinite(rows.path_m))  # the stripe's approach .. retract
+    p, s = rows.X_PT[planned, :3, 3], rows.path_m[planned]
+    a, b = p[:-1], p[1:]
+    step = b - a
+    squared = np.maximum(np.einsum("ij,ij->i", step, step), 1e-30)  # rows at rest repeat
+    x = np.clip(np.einsum("ij,ij->i", p_PT - a, step) / squared, 0.0, 1.0)
+    gap = np.linalg.norm(a + x[:, None] * step - p_PT, axis=1)
+    k = int(np.argmin(gap))
+    assert gap[k] < off_path_m  # on the planned path
+    return float(s[k] + x[k] * (s[k + 1] - s[k]))
 
 
 # --- KRL ------------------------------------------------------------------------------
 
 
-def krl_events(data, folder, off_line_m: float = 1e-4):
+def krl_events(data, folder):
     """(the run's statements, [(what, value, position [m], DELAY [ms])] of every
-    TRIGGER in run order): the switch point's position projected on the stripe's line
+    TRIGGER in run order): the switch point's position along the planned path
     (``along``)."""
     run, items = krl_items(data, folder)
     switches = [s for s in items if isinstance(s, Switch)]
-    return run, [(s.what, s.value, along(s.p_PT, off_line_m), s.delay_s * 1e3) for s in switches]
+    return run, [(s.what, s.value, along(data, s.p_PT), s.delay_s * 1e3) for s in switches]
 
 
 def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
@@ -118,11 +131,11 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
     # Both fall on the stripe's own LIN(s): the seam module holds both TRIGGERs.
     module = next(f for f in files if f.name == "offline_prog_1.src").read_text()
     assert len(re.findall(r"^TRIGGER .* DO \$OUT\[1\]", module, re.M)) == 2
-    # The flow: its factor goes live lag_s earlier: at v · lag_s before the on switch
+    # The flow: its factor goes live PRIME_S earlier: at v · PRIME_S before the on switch
     # (the stripe runs at its speed there), and is cut at the off switch (not led).
     flow = [(value, position, delay) for what, value, position, delay in events if "_FK" in what]
     assert [float(v) for v, _, _ in flow] == [pytest.approx(PER_MPS / 10), 0.0]
-    assert flow[0][1] == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
+    assert flow[0][1] == pytest.approx(on - SPEED_M_S * PRIME_S, abs=IO_TOL_M)
     assert flow[1][1] == pytest.approx(off, abs=IO_TOL_M)  # cut as the valve closes
     assert all(delay == 0 for _, _, delay in flow)  # no negative DELAY to be clamped
     # One ANOUT ON before any motion, idle until a trigger: no constant factor.
@@ -141,7 +154,7 @@ def test_krl_keeps_both_switches_on_one_lin(stripe, tmp_path):
 def rapid_events(data, text):
     """[(trigger kind, value, position [m], ScaleLag or None)] in run order."""
     switches = [s for s in rapid_items(data, text) if isinstance(s, Switch)]
-    return [(s.what, s.value, along(s.p_PT), s.lag_s) for s in switches]
+    return [(s.what, s.value, along(data, s.p_PT), s.lag_s) for s in switches]
 
 
 def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
@@ -157,14 +170,15 @@ def test_rapid_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     ]
     flow = [(float(v), p, lag) for what, v, p, lag in events if what == "ao1"]
     assert [v for v, _, _ in flow] == [pytest.approx(PER_MPS / 1000), 0.0]
-    # ScaleLag leads both: the cut-off is placed where the tool is lag_s after the
-    # valve closes (the seam's end, where it comes to rest), so the controller sets it
-    # as the valve closes (the flow stays live until then).
+    # ScaleLag leads both by lag_s: the flow goes live where the tool is lag_s after the
+    # plan sets it (PRIME_S before the on switch), and the cut-off is placed where the
+    # tool is lag_s after the valve closes (on the lead-out, the stripe flying), so the
+    # controller sets it as the valve closes (the flow stays live until then).
     cut = next(e for e in data.events if e.signal is Signal.ANALOG and not e.state)
     close = next(e for e in data.events if e.signal is Signal.DIGITAL and not e.state)
     assert cut.t_s == pytest.approx(close.t_s) and cut.path_m > off
     assert [p for _, p, _ in flow] == [
-        pytest.approx(on, abs=IO_TOL_M),
+        pytest.approx(on - SPEED_M_S * (PRIME_S - LAG_S), abs=IO_TOL_M),
         pytest.approx(cut.path_m, abs=IO_TOL_M),
     ]
     assert all(lag == LAG_S for _, _, lag in flow)  # ScaleLag is the cell's lag_s
@@ -181,7 +195,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     period = float(re.search(r"servoj\(.*t=([\d.]+)", "\n".join(lines))[1])
     q_of = lambda line: np.array(re.search(r"\(\[([^\]]*)\]", line)[1].split(","), float)  # noqa: E731
     servoj = [i for i, line in enumerate(lines) if line.startswith("servoj(")]
-    positions = {i: along(tool_in_part(data, q_of(lines[i]))) for i in servoj}
+    positions = {i: along(data, tool_in_part(data, q_of(lines[i]))) for i in servoj}
     digital, analog, pending = [], [], []
     for i, line in enumerate(lines):
         if line.startswith("set_standard"):
@@ -196,7 +210,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     # The stream advances by v·period per command: the switch is at most that late.
     for (_, p, _), asked_m in zip(digital, (on, off), strict=True):
         assert asked_m - 1e-6 <= p <= asked_m + SPEED_M_S * period + IO_TOL_M
-    # The flow: idle before it goes live lag_s (lag_s / period commands) ahead of the
+    # The flow: idle before it goes live PRIME_S (PRIME_S / period commands) ahead of the
     # gun, the live value at once (not a ramp from idle), idle again as the gun closes
     # (the cut-off is not led: a flow cut lag_s early thins the seam's end).
     volts = [(float(v) * 10.0, p, i) for v, p, i in analog]
@@ -204,7 +218,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     first = next(k for k, (v, _, _) in enumerate(volts) if v > OFFSET_V + 0.01)
     assert all(v == pytest.approx(OFFSET_V) for v, _, _ in volts[:first])
     assert volts[first][0] == pytest.approx(live_flow, rel=0.01)
-    assert volts[first][1] == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
+    assert volts[first][1] == pytest.approx(on - SPEED_M_S * PRIME_S, abs=IO_TOL_M)
     back = next(k for k in range(first, len(volts)) if volts[k][0] < OFFSET_V + 0.01)
     assert volts[back][0] == pytest.approx(OFFSET_V)
     assert all(v == pytest.approx(OFFSET_V) for v, _, _ in volts[back:])
@@ -212,7 +226,7 @@ def test_urscript_switches_and_flow_at_the_cells_positions(stripe, tmp_path):
     def commands_between(i, j):
         return servoj.index(j) - servoj.index(i)
 
-    lead = LAG_S / period
+    lead = PRIME_S / period
     assert commands_between(volts[first][2], digital[0][2]) == pytest.approx(lead, abs=1.01)
     assert commands_between(volts[back][2], digital[1][2]) == pytest.approx(0, abs=1.01)
     # The speed at the switch, from the program's own joints: the flow follows it.
@@ -235,7 +249,7 @@ def test_trajectory_csv_flow_leads_the_output_by_the_lag_and_is_cut_with_it(stri
     t_on, t_off = t[np.argmax(do == 1)], t[len(do) - np.argmax(do[::-1] == 1)]
     t_live, t_idle = t[np.argmax(live)], t[len(live) - np.argmax(live[::-1])]
     dt = np.diff(t).max()
-    assert t_live == pytest.approx(t_on - LAG_S, abs=dt)
+    assert t_live == pytest.approx(t_on - PRIME_S, abs=dt)
     assert t_idle == pytest.approx(t_off, abs=dt)  # the cut-off is not led
     assert np.all(ao[~live] == OFFSET_V)  # idle: the flow at zero speed
 

@@ -18,6 +18,7 @@ from scipy.spatial.transform import Rotation
 
 from offline_prog.config.cell import load_cell
 from offline_prog.export.job_program import JobProgramData
+from offline_prog.export.merge import MIN_MOTION_M
 from offline_prog.plan import plan_job
 from offline_prog.results.job_folder import write_job_outputs
 
@@ -142,32 +143,60 @@ def test_krl_job_links_approach_retract_and_io(folders, tmp_path):
     axes = np.array([[v for k, v in krl_fields(f).items() if k.startswith("A")] for f in ptp])
     planned = [data.link_waypoints[0][0]] + [q for w in data.link_waypoints for q in w[1:]]
     np.testing.assert_allclose(axes, np.rad2deg(planned), atol=JOINT_TOL_DEG)
-    # Walk the statements: the tool's point on the part, its path position per seam.
+    # Walk the statements: the tool's point on the part, its path position per seam
+    # (from the seam's first planned sample: a flying seam's lead-in starts before 0).
     q_link, pending, here, position, k, switched = None, None, None, 0.0, -1, {}
+    ends = {}  # seam k ↦ [p_PT where its approach starts, where its retract ends] [m]
     for module, line in run:
         if line.startswith("PTP "):
+            if k in ends and ends[k][1] is None:
+                ends[k][1] = here
             q_link = np.deg2rad(axes[[f for f in ptp].index(main[line.split()[1]][1])])
         elif line.startswith("TRIGGER") and "DO $OUT[" in line:  # the process output
             pending = (float(re.search(r"PATH=(-?[\d.]+)", line)[1]) * 1e-3, "TRUE" in line)
         elif line.startswith("LIN "):
             name = line.split()[1]
             p = krl_tool_in_part(krl_fields(decls[module][name][1]))
-            if name.startswith("XA"):  # the approach ends at the seam's start: position 0
+            in_seam = re.fullmatch(r"offline_prog_(\d+)(_\d+)?", module)
+            if name.startswith("XA") or (in_seam and int(in_seam[1]) - 1 != k):
+                # The seam's approach (a straight LIN) or its first LIN from the link's end
+                # (a flying seam's lead took the straight move over: none is written).
                 k += 1
-                length = np.linalg.norm(p - tool_in_part_from_joints(data, q_link))
+                here = tool_in_part_from_joints(data, q_link)
+                ends[k] = [here, None]
+                position = data.seams[k].path_m[0]
                 spec = specs[data.seam_names[k]].approach
-                assert length == pytest.approx(spec.distance_mm * 1e-3, abs=LENGTH_TOL_M)
-                position = 0.0
-            else:
+                if name.startswith("XA"):  # it ends at the seam's first sample
+                    length = np.linalg.norm(p - here)
+                    assert length > MIN_MOTION_M  # no empty LIN where a lead took it over
+                    if spec.kind == "tangent":
+                        assert length == pytest.approx(spec.distance_mm * 1e-3, abs=LENGTH_TOL_M)
+                    here = p
+            if here is not p:
                 step = np.linalg.norm(p - here)
-                if name.startswith("XR"):
+                assert step > MIN_MOTION_M or not name.startswith("XR")  # none empty
+                if name.startswith("XR") and specs[data.seam_names[k]].retract.kind == "tangent":
                     spec = specs[data.seam_names[k]].retract
                     assert step == pytest.approx(spec.distance_mm * 1e-3, abs=LENGTH_TOL_M)
                 position += step
+            if in_seam:  # a seam's point: where the plan's path puts it (a lead's σ is
+                # shorter than the tool's path on a curved seam's lead: position it there)
+                seam = data.seams[k]
+                gap = np.linalg.norm(seam.X_PT[:, :3, 3] - p, axis=1)
+                assert gap.min() < LENGTH_TOL_M  # the program's point is the plan's
+                position = seam.path_m[np.argmin(gap)]
             here = p
             if pending is not None:  # PATH = -d: d before this motion's end point
                 switched.setdefault(k, {})[pending[1]] = position + pending[0]
                 pending = None
+    # A normal approach starts, a normal retract ends its distance off the part along
+    # the seams' normal (P's z, into the plate): at rest straight along it, flying partly
+    # or wholly on the lead.
+    for k, (start, end) in ends.items():
+        spec = specs[data.seam_names[k]]
+        for move, p in ((spec.approach, start), (spec.retract, end)):
+            if move.kind == "normal":
+                assert -p[2] == pytest.approx(move.distance_mm * 1e-3, abs=LENGTH_TOL_M)
     assert sorted(switched) == list(range(len(data.seam_names)))
     for k in switched:
         on, off = asked(folders.cells["krl"], data, k)
@@ -223,6 +252,11 @@ def test_rapid_job_links_approach_retract_and_io(folders):
     axes[:, 2] += axes[:, 1]  # the IRB 2400's axis 3: q2 + q3 (its robot.yaml j23_factor 1)
     np.testing.assert_allclose([joints[t] for t in targets], axes, atol=JOINT_TOL_DEG)
     triggs, here, position, switched, q_link = {}, None, 0.0, {}, None
+    # The seam's plane: its start point p0 and the surface normal n in P (a DXF seam);
+    # a flying seam's lead lifts off it, the straight approach and retract the rest.
+    seam = data.seams[0]
+    p0 = np.array([np.interp(0.0, seam.path_m, seam.X_PT[:, i, 3]) for i in range(3)])
+    n_P = np.array(load_cell(folders.cells["rapid"]).path.normal, float)
     for line in run:
         if line.startswith("TriggIO"):
             name, rest = line.split()[1].rstrip(","), line.split(",", 1)[1]
@@ -235,15 +269,16 @@ def test_rapid_job_links_approach_retract_and_io(folders):
             q_link = planned[targets.index(m[2])]
             continue
         p = points[m[2]]
-        if m[2] == "pA1":
+        if m[2] == "pA1":  # it ends at the seam's first sample (a flying lead-in's start)
             start = tool_in_part_from_joints(data, q_link)
-            assert np.linalg.norm(p - start) == pytest.approx(0.05, abs=LENGTH_TOL_M)
-            position = 0.0
+            off_part = (p0 - start) @ n_P  # the tool backs off the surface along −n
+            assert off_part == pytest.approx(0.05, abs=LENGTH_TOL_M)  # its distance
+            position = seam.path_m[0]
         else:
             step = np.linalg.norm(p - here)
-            if m[2] == "pR1":
-                assert step == pytest.approx(0.05, abs=LENGTH_TOL_M)
             position += step
+            if m[2] == "pR1":  # it ends its distance off the part
+                assert (p0 - p) @ n_P == pytest.approx(0.05, abs=LENGTH_TOL_M)
         here = p
         if m[1] == "TriggL":
             for name in re.findall(r"\b(tOn|tOff)\b", line):

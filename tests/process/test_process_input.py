@@ -135,7 +135,11 @@ def test_a_bead_without_its_flow_output(capsys, tmp_path):
 def test_a_bead_lag_longer_than_the_approach_names_the_bead_key(capsys, tmp_path):
     """The flow leads by the bead's lag_s: a lag the approach cannot hold names the key
     the user set (process.bead.lag_s), not the flow's own lag_s (not given with a bead)."""
-    code, err = plan(capsys, tmp_path, SEAL.replace("lag_s: 0.08", "lag_s: 1.0", 1))
+    text = SEAL.replace("lag_s: 0.08", "lag_s: 1.0", 1)
+    # At rest: a flying seam's lead-in is sized to hold the lag, so only a seam that
+    # starts standing has an approach too short for it.
+    text = text.replace("  closed: true\n", "  closed: true\n  entry: rest\n", 1)
+    code, err = plan(capsys, tmp_path, text)
     assert code == 2 and len(err) == 1, err
     assert ": process.bead.lag_s: " in err[0] and "approach" in err[0], err
 

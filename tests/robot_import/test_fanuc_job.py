@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from test_import_fanuc import FANUC, REPO, pytestmark  # noqa: F401  (skip without ../shared)
 
 from offline_prog.config.cell import load_cell
+from offline_prog.constants import FLOW_PRIME_LAGS
 from offline_prog.export.formats import controller_post
 from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.post import write_program
@@ -162,10 +163,10 @@ def test_fanuc_keeps_both_switches_on_a_straight_seam(stripe, tmp_path):
     assert seam["db"][1][2] == pytest.approx(off, abs=SWITCH_TOL_M)
     statements = [s for f in tmp_path.glob("*.ls") for s in read_ls(f)["mn"]]
     assert sum("DO[" in s for s in statements if not s.startswith("!")) == 2  # not the flow
-    # The flow goes live lag_s ahead of the on switch (at the stripe's speed), and is
-    # cut as the gun closes (not led).
+    # The flow goes live FLOW_PRIME_LAGS lags ahead of the on switch (the stripe runs
+    # flying, the default: at its speed there), and is cut as the gun closes (not led).
     first = next(a for a, _, v in seam["moves"] if v > OFFSET_V + 0.01)
-    assert first == pytest.approx(on - SPEED_M_S * LAG_S, abs=IO_TOL_M)
+    assert first == pytest.approx(on - SPEED_M_S * FLOW_PRIME_LAGS * LAG_S, abs=IO_TOL_M)
     last = max(b for _, b, v in seam["moves"] if v > OFFSET_V + 0.01)
     assert last == pytest.approx(off, abs=IO_TOL_M)  # live until the valve closes
 
@@ -348,7 +349,8 @@ def test_fanuc_flow_replayed_through_the_bead_gives_the_reported_bead(bead_strip
     plan_every = job.quality.column[every]
     replay_every = (bead[every] >= low) & (bead[every] <= high)
     w = np.gradient(s.path_m[every])
-    share = (w * replay_every).sum() / (w * np.isfinite(plan_every)).sum()
+    open_every = np.isfinite(plan_every)  # the gun open (the flow is primed before it)
+    share = (w * (replay_every & open_every)).sum() / (w * open_every).sum()
     report = json.loads((folder / "report.json").read_text())["quality"]
     assert report["model"] == "bead"
     assert share == pytest.approx(report["share_within_band"], abs=0.01)
@@ -397,12 +399,16 @@ def test_fanuc_merged_motions_hold_the_path_tolerance_and_are_long(fanuc_job, tm
     FINE end either."""
     from offline_prog.export.density import DEFAULT_CHORD_TOL_M
 
-    data, _, _, _ = fanuc_job
+    data, _, robot, _ = fanuc_job
     write_fanuc_job(data, tmp_path)
     for k, (mn, motions) in enumerate(_seam_motions(tmp_path)):
         stated = re.search(r"deviation <= ([\d.]+)", " ".join(s.lstrip("! ") for s in mn))
         assert stated and float(stated[1]) * 1e-3 <= DEFAULT_CHORD_TOL_M
-        X_TP = np.array([X for _, X, _ in motions])
+        # The chain starts where the link before it ends (its last joint target: on a
+        # flying seam whose lead took the approach over, the lead-in's start).
+        X_BE = robot.forward(data.link_waypoints[k][-1][None])[0]
+        X_TP_start = np.linalg.inv(data.job.X_BT) @ X_BE @ data.job.X_EP
+        X_TP = np.array([X_TP_start] + [X for _, X, _ in motions])
         curve = []
         for a, b in zip(X_TP, X_TP[1:], strict=False):
             length = np.linalg.norm(b[:3, 3] - a[:3, 3])
