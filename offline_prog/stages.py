@@ -318,13 +318,12 @@ def motion_setup(inputs: Inputs, flange) -> MotionSetup:
         except ValueError as error:
             raise InputError(inputs.file, "motion.cusp_smoothing_mm", str(error)) from None
     speed = inputs.speed.v_m_s
-    caps = process_caps(
-        process_model(inputs.cell.process) if inputs.process_bound else None,
-        v_process=speed,
-        a_max=motion.max_acceleration,
-        j_max=motion.max_jerk,
-    )
-    flange = with_leads(inputs, flange, caps, leads)
+    user = dict(v_process=speed, a_max=motion.max_acceleration, j_max=motion.max_jerk)
+    bounded = process_caps(process_model(inputs.cell.process), **user)
+    caps = bounded if inputs.process_bound else process_caps(None, **user)
+    # The leads are sized for the bound either way: planned without it (the trade-off's
+    # comparison), the job runs the same path, only its time law is the user's.
+    flange = with_leads(inputs, flange, bounded, leads)
     parameter = TimeLawParameter(flange, motion.speed_reference)
     limits = PathLimits.of(
         inputs.robot, parameter.length, v_process=speed, a_max=caps.a_max, j_max=caps.j_max

@@ -78,6 +78,16 @@ class Plan:
             self.trajectory = self.joints.trajectory
 
     @property
+    def law_origin(self) -> tuple[float, float]:
+        """(σ [m], t [s]) where the seam's time law starts, on the seam's own scale (σ
+        and t 0 at its start): a flying seam's lead-in's start (its −length, −duration),
+        (0, 0) at rest. The law's slowdowns and speed reductions are on the law's scale:
+        add these to put them on the seam's."""
+        if self.lead_in is None:
+            return 0.0, 0.0
+        return float(self.lead_in.s[0]), -float(self.lead_in.t[-1])
+
+    @property
     def entry(self) -> dict:
         """How the seam is entered and left: ``{"entry": "flying" | "rest", "reason":
         why at rest ("" when flying), "lead_in_mm", "lead_out_mm"}`` (report.json)."""

@@ -62,12 +62,15 @@ def _ramp_speeds(sigma: np.ndarray, *, v: float, a: float) -> np.ndarray:
     return np.minimum(v, np.minimum(rise, fall))
 
 
-def end_moves_s(seam, motion, speed: float) -> float:
+def end_moves_s(seam, motion, speed: float, *, lifts: tuple[float, float] = (0.0, 0.0)) -> float:
     """The approach's and retract's sin² durations [s] (``job.approach``: at the seam's
-    process speed ``speed`` [m/s])."""
+    process speed ``speed`` [m/s]); ``lifts`` [m]: a flying seam's leads' (approach,
+    retract), by which its normal moves are shorter (``job.approach.seam_ends``)."""
     total = 0.0
-    for spec in (seam.approach, seam.retract):
+    for spec, lift in zip((seam.approach, seam.retract), lifts, strict=True):
         d = spec.distance_mm * 1e-3
+        if spec.kind == "normal":
+            d = max(0.0, d - lift)
         if spec.kind != "none" and d > 0.0:
             law = sin2_time_law(
                 d, v_max=speed, a_max=motion.max_acceleration, j_max=motion.max_jerk

@@ -25,7 +25,7 @@ import numpy as np
 
 from offline_prog.job.seams import job_config, job_seams
 from offline_prog.joints.path_ik import singularity_distances
-from offline_prog.placement.bound import SeamTimes, job_times, seam_times
+from offline_prog.placement.bound import SeamTimes, end_moves_s, job_times, seam_times
 from offline_prog.placement.cheap_law import law_seam_s
 from offline_prog.placement.collision_look import collision_look, look_rows
 from offline_prog.placement.context import Context, placed_inputs, placed_stands, rigid
@@ -157,9 +157,12 @@ def rank(ctx: Context, candidate: Candidate) -> Evaluation:
         return dataclasses.replace(screened, stage="rank")
     X_IT, X_PE = rigid(candidate.X_IT), rigid(candidate.X_PE)
     times = []
-    for view, (v, t) in zip(ctx.seams, seams, strict=True):
-        law = law_seam_s(view, v, X_IT, X_PE)
-        times.append(dataclasses.replace(t, estimate_s=law + t.moves_s))
+    for view, seam, (v, t) in zip(ctx.seams, job_seams(ctx.inputs.cell), seams, strict=True):
+        law, lifts = law_seam_s(view, v, X_IT, X_PE)  # a flying seam's leads included
+        motion, speed = view.inputs.cell.motion, view.inputs.speed.v_m_s
+        times.append(
+            dataclasses.replace(t, estimate_s=law + end_moves_s(seam, motion, speed, lifts=lifts))
+        )
     _, estimate = job_times(times, home_c(ctx), ctx.inputs.robot)
     inputs = placed_inputs(ctx, candidate)
     motion = inputs.cell.motion

@@ -77,6 +77,7 @@ def robot_report(plan: Plan) -> dict:
     """Branch, joint-limit margins, joint steps, singularities and speed reductions."""
     robot, joints = plan.robot, plan.joints
     retiming, top = joints.retiming, plan.process_speed.v_m_s
+    origin = plan.law_origin[0]  # the law's σ less this is the seam's
     joint, sigma, step = joints.largest_step
     use_speed = np.abs(robot.controller_joints(joints.qd)) / robot.qd_max
     use_accel = np.abs(robot.controller_joints(joints.qdd)) / robot.qdd_max
@@ -104,7 +105,9 @@ def robot_report(plan: Plan) -> dict:
                 "speed_m_s": v,
                 "reduction_percent": 100.0 * (1.0 - v / top),
             }
-            for a, b, v in _merged(retiming.reductions)
+            for a, b, v in _merged(
+                tuple((a + origin, b + origin, v) for a, b, v in retiming.reductions)
+            )
         ],
         "ramp_acceleration_scale": retiming.a_scale,
         "cycle_time_without_joint_limits_s": plan.nominal_duration_s,
@@ -128,6 +131,7 @@ def timing_report(plan: Plan) -> dict:
     retiming = joints.retiming
     if motion.time_law != TimeLaw.TIME_OPTIMAL:
         return out
+    sigma0, t0 = plan.law_origin
     return out | {
         "process": motion.process,
         # TOPP-RA under the joint velocity/acceleration limits, the TCP cap and the path
@@ -142,12 +146,12 @@ def timing_report(plan: Plan) -> dict:
             "feasible_share_of_path": _finite_or_none(retiming.speed_held[1]),
             "tolerance_percent": 100.0 * HOLD,
         },
-        "slowdowns": [
+        "slowdowns": [  # on the seam's scale (a flying seam's lead-in: σ, t < 0)
             {
-                "sigma_start_m": slow.sigma_m[0],
-                "sigma_end_m": slow.sigma_m[1],
-                "t_start_s": slow.t_s[0],
-                "t_end_s": slow.t_s[1],
+                "sigma_start_m": slow.sigma_m[0] + sigma0,
+                "sigma_end_m": slow.sigma_m[1] + sigma0,
+                "t_start_s": slow.t_s[0] + t0,
+                "t_end_s": slow.t_s[1] + t0,
                 "speed_min_m_s": slow.speed_min_m_s,
                 "joint": slow.joint,
                 "constraint": slow.constraint,

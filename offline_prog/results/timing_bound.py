@@ -80,14 +80,14 @@ def timing_bound_report(job: JobPlan) -> dict | None:
 
 def _below_band(job: JobPlan, low: float) -> list[dict]:
     """The process stretches slower than ``low`` [m/s], each with its cause: the start
-    or stop ramp (from or to rest), else a slowdown the joints force, with the joint
-    and limit where the time law names them (a minimum speed cannot beat a joint
-    limit)."""
+    or stop ramp (from or to rest, a seam at rest: a flying seam's are on its leads),
+    else a slowdown the joints force, with the joint and limit where the time law names
+    them (a minimum speed cannot beat a joint limit)."""
     if low <= 0.0:
         return []
     out = []
     samples, speed = job.samples, job.tcp_speed
-    by_seam = {option.name: option.plan.joints.retiming.slowdowns for option in job.chosen}
+    by_seam = {option.name: option.plan for option in job.chosen}
     for segment in samples.segments:
         if segment.kind != "process":
             continue
@@ -95,12 +95,13 @@ def _below_band(job: JobPlan, low: float) -> list[dict]:
         for a, b in true_runs(speed[rows] < low):
             stretch = rows[a:b]
             sigma = (float(samples.path_m[stretch[0]]), float(samples.path_m[stretch[-1]]))
-            if a == 0:
+            plan = by_seam[segment.seam]  # a flying seam's ramps are on its leads
+            if a == 0 and plan.lead_in is None:
                 cause = "start ramp"
-            elif b == len(rows):
+            elif b == len(rows) and plan.lead_out is None:
                 cause = "stop ramp"
             else:
-                cause = _slowdown_cause(by_seam[segment.seam], sigma)
+                cause = _slowdown_cause(plan, sigma)
             out.append(
                 {
                     "seam": segment.seam,
@@ -115,11 +116,14 @@ def _below_band(job: JobPlan, low: float) -> list[dict]:
     return out
 
 
-def _slowdown_cause(slowdowns, sigma: tuple[float, float]) -> str:
-    """The joint limit behind a slowdown over ``sigma`` [m] (the time law's
-    ``slowdowns``, time_optimal), or a plain "slowdown" (sin2 does not say)."""
-    for slow in slowdowns:
-        if slow.joint is not None and slow.sigma_m[0] <= sigma[1] and sigma[0] <= slow.sigma_m[1]:
+def _slowdown_cause(plan, sigma: tuple[float, float]) -> str:
+    """The joint limit behind a slowdown over the seam's ``sigma`` [m] (its time law's
+    ``slowdowns``, time_optimal, on the law's scale: ``Plan.law_origin``), or a plain
+    "slowdown" (sin2 does not say)."""
+    origin = plan.law_origin[0]
+    for slow in plan.joints.retiming.slowdowns:
+        a, b = slow.sigma_m[0] + origin, slow.sigma_m[1] + origin
+        if slow.joint is not None and a <= sigma[1] and sigma[0] <= b:
             return (
                 f"slowdown: joint {slow.joint} {slow.constraint} limit (a minimum speed "
                 "cannot beat it)"

@@ -119,4 +119,7 @@ def test_pruned_pair_minima_are_labelled_as_bounds():
     assert bounded and exact
     clearance = plan.cell.motion.clearance
     for pair in bounded:  # certified: the true minimum is above clearance + margin
-        assert pair.lower_bound_m > clearance and pair.distance_m >= pair.lower_bound_m
+        # (to rounding: on the seam the tool body is 25 mm under the plate, which is just
+        # clearance + margin; a flying seam's leads lift it farther, so it is pruned there)
+        assert pair.lower_bound_m > clearance
+        assert pair.distance_m >= pair.lower_bound_m - 1e-12

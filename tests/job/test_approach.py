@@ -30,13 +30,17 @@ def _ends(planned_job, speed):
 @pytest.mark.parametrize("speed", [None, 0.05])
 def test_approach_and_retract_run_at_the_approach_speed(planned_job, speed):
     """The tool's peak speed along the move is the approach speed (default: the process
-    speed, 8 mm/s); at 50 mm/s both moves take under 1.5 s instead of over 6 s."""
+    speed, 8 mm/s); at 50 mm/s both moves take under 1.5 s instead of over 6 s. The
+    move and the flying seam's lead (lifting off the part by its lift) together take
+    the tool the asked 50 mm off the surface."""
     approach, retract = _ends(planned_job, speed)
+    lifts = planned_job(WELD)[0].chosen[0].plan.flange.lifts_m  # (lead-in, lead-out)
     expected = 0.008 if speed is None else speed
-    for move in (approach, retract):
+    for move, lift in zip((approach, retract), lifts, strict=True):
         v = np.abs(np.gradient(move.delta, move.t))
         assert v.max() == pytest.approx(expected, rel=0.01)
-        assert np.linalg.norm(move.p_PT[-1] - move.p_PT[0]) == pytest.approx(0.05, abs=1e-9)
+        length = np.linalg.norm(move.p_PT[-1] - move.p_PT[0])
+        assert length + lift == pytest.approx(0.05, abs=1e-9)
     total = approach.duration + retract.duration
     assert (total > 12.0) if speed is None else (total < 3.0)
 

@@ -55,13 +55,17 @@ def test_joints_within_limits_everywhere(job):
 
 
 def test_approach_and_retract_distances_as_asked(job):
-    """The tool's point on the part (forward kinematics of the planned joints) moves in a
-    straight line of the asked length onto the seam's first point and off its last."""
+    """The tool's point on the part (forward kinematics of the planned joints) comes onto
+    each seam's first point from the asked distance and leaves its last point by it: a
+    "normal" move starts (ends) that far off the surface along −n, a "tangent" one runs
+    that far along the seam's tangent, in a straight line. On a flying seam (the
+    default) a lead joins the straight move to the seam's end, where the tool is at
+    speed; a lead that takes a normal move over lifts by (part of) its distance, and the
+    straight move along −n is what is left."""
     plan, _ = job
     cell = plan.cell
     robot = plan.robot
     specs = {s.name: s for s in cell.seams}
-    X_IB = np.eye(4)  # the demo's base is at I
     from offline_prog.config.cell import transform
 
     X_BT = (
@@ -69,24 +73,43 @@ def test_approach_and_retract_distances_as_asked(job):
         @ transform(cell.tool.X_IT).GetAsMatrix4()
     )
     X_PE = transform(cell.part.X_PE).GetAsMatrix4()
-    del X_IB
     rows_of = {s.label: (s.start, s.stop) for s in plan.samples.segments}
+    flying = 0
     for option in plan.chosen:
+        seam = option.plan
+        lead_in, lead_out = (
+            lead.length_m if lead else 0.0 for lead in (seam.lead_in, seam.lead_out)
+        )
+        flying += lead_in > 0.0
         for end in ("approach", "retract"):
             spec = getattr(specs[option.name], end)
+            d = spec.distance_mm * 1e-3
             start, stop = rows_of[f"{end}:{option.name}"]
-            q = plan.samples.q[start : stop + 1]  # up to the next segment's first row
-            p_PT = (X_PE @ np.linalg.inv(robot.forward(q)) @ X_BT)[:, :3, 3]
-            length = np.linalg.norm(p_PT[-1] - p_PT[0])
-            assert length == pytest.approx(spec.distance_mm * 1e-3, abs=1e-6), (option.name, end)
-            # Straight: every point within 1 µm of the chord.
-            chord = (p_PT[-1] - p_PT[0]) / length
-            off = (p_PT - p_PT[0]) - np.outer((p_PT - p_PT[0]) @ chord, chord)
-            assert np.linalg.norm(off, axis=1).max() < 1e-6
-            # Off the surface along −n for "normal" (the demo's n is +z of P).
-            if spec.kind == "normal":
+            rows = slice(start, stop + 1)  # up to the next segment's first row
+            p_PT = (X_PE @ np.linalg.inv(robot.forward(plan.samples.q[rows])) @ X_BT)[:, :3, 3]
+            path = plan.samples.path_m[rows]
+            if end == "approach":  # the straight move: σ ≤ −lead-in; then the lead
+                on_seam, straight = p_PT[-1], path <= -lead_in + 1e-8
+            else:  # the last row is the next link's (path_m NaN): the move's far end
+                on_seam, straight = p_PT[0], path >= seam.path.length + lead_out - 1e-8
+                straight[-1] = True
+            assert abs(on_seam[2]) < 1e-6, (option.name, end)  # on the underside
+            line = p_PT[straight]
+            chord = line[-1] - line[0]
+            length = np.linalg.norm(chord)
+            if length > 0.0:  # straight: every point within 1 µm of the chord
+                axis = chord / length
+                off = (line - line[0]) - np.outer((line - line[0]) @ axis, axis)
+                assert np.linalg.norm(off, axis=1).max() < 1e-6, (option.name, end)
+            if spec.kind == "normal":  # off the surface along −n (the demo's n is +z of P)
                 leaving = p_PT[0] if end == "approach" else p_PT[-1]
-                assert leaving[2] == pytest.approx(-spec.distance_mm * 1e-3, abs=1e-6)
+                assert leaving[2] == pytest.approx(-d, abs=1e-6), (option.name, end)
+                assert length == 0.0 or abs(abs(chord[2]) - length) < 1e-6
+                if lead_in == 0.0:  # at rest: the straight move alone
+                    assert length == pytest.approx(d, abs=1e-6), (option.name, end)
+            else:  # tangent: the straight move runs the asked distance
+                assert length == pytest.approx(d, abs=1e-6), (option.name, end)
+    assert flying == len(plan.chosen)  # the default: every seam runs flying
 
 
 def test_process_io_switches_at_the_requested_positions(job):

@@ -99,7 +99,9 @@ def test_weld_ramps_below_the_band_are_named(tmp_path):
     from offline_prog.results.timing_bound import timing_bound_report
 
     cell = tmp_path / "weld.yaml"
-    cell.write_text(PATH.replace("SPEED", "0.006") + WELD)
+    # At rest: a flying seam (the default) has no ramp on it (they are on its leads).
+    rest = PATH.replace("  units: mm\n", "  units: mm\n  entry: rest\n", 1)
+    cell.write_text(rest.replace("SPEED", "0.006") + WELD)
     job = plan_job(cell)
     report = timing_bound_report(job)
     assert not report["applied"] and report["difference_s"] == 0.0
@@ -134,13 +136,16 @@ def test_joint_slowdowns_below_the_band_are_named_with_their_joint(tmp_path):
     cell.write_text(text + WELD.replace("[0.5, 0.7]", "[0.0288, 0.0384]"))
     job = plan_job(cell)
     report = timing_bound_report(job)
-    slowdowns = [s for s in job.chosen[0].plan.joints.retiming.slowdowns if s.joint is not None]
+    plan = job.chosen[0].plan
+    assert plan.entry["entry"] == "flying"  # the default: its ramps are on its leads
+    slowdowns = [s for s in plan.joints.retiming.slowdowns if s.joint is not None]
     corners = [s for s in report["below_speed_band"] if s["cause"].startswith("slowdown")]
-    assert len(corners) == len(slowdowns) == 4
+    assert len(corners) == len(slowdowns) == len(report["below_speed_band"]) == 4
+    origin = plan.law_origin[0]  # the law's σ counts from the lead-in's start
     for corner, slow in zip(corners, slowdowns, strict=True):
         assert corner["cause"].startswith(f"slowdown: joint {slow.joint} {slow.constraint}")
-        assert slow.sigma_m[0] <= corner["sigma_start_m"] <= corner["sigma_end_m"]
-        assert corner["sigma_end_m"] <= slow.sigma_m[1]
+        assert slow.sigma_m[0] + origin <= corner["sigma_start_m"] <= corner["sigma_end_m"]
+        assert corner["sigma_end_m"] <= slow.sigma_m[1] + origin
         assert abs(corner["speed_min_m_s"] - slow.speed_min_m_s) < 1e-6
     low = report["speed_band_m_s"][0]
     assert all(s["speed_min_m_s"] < low for s in report["below_speed_band"])

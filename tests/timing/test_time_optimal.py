@@ -346,21 +346,35 @@ def test_cycle_without_joint_limits_is_the_fastest_jerk_limited_motion(planned_f
     assert not without_joint_limits(short, "sin2")[1]
     plan, folder = planned_folder("seal_plate_kr16")
     assert plan.cell.motion.time_law == "time_optimal"  # the default
-    duration, fastest = plan.trajectory.duration, plan.nominal_duration_s
+    # The law times the whole path it runs, rest to rest: a flying seam's with its
+    # lead-in and lead-out (the seam's own rows cross its ends at the process speed).
+    duration, fastest = plan.joints.retiming.law.duration, plan.nominal_duration_s
     if plan.joints.unbounded_s is not None:  # a process model's bound (issue 28): the
         # sin² staircase holds the bead better than the fastest ramps; the law under the
         # user's own caps is the one that reaches the fastest motion
         motion = plan.cell.motion
         user = sin2_time_law(
-            plan.path.length,
+            plan.flange.length,
             v_max=plan.process_speed.v_m_s,
             a_max=motion.max_acceleration,
             j_max=motion.max_jerk,
         )
         duration, fastest = plan.joints.unbounded_s, without_joint_limits(user, "time_optimal")[0]
     assert fastest <= duration <= 1.001 * fastest
+    report = json.loads((folder / "report.json").read_text())
+    if plan.flange.flying:  # no ramp on the seam: it runs L/v from its start to its end
+        v, length = plan.process_speed.v_m_s, plan.path.length
+        assert plan.trajectory.duration == pytest.approx(length / v, rel=1e-6)
+        # report.json puts the law's ramps where they are, on the seam's scale: on the
+        # leads (σ and t < 0 before the seam's start, beyond L and its duration after)
+        slowdowns = report["robot_motion"]["slowdowns"]
+        ramps = [s for s in slowdowns if s["constraint"] == "start/stop"]
+        assert len(ramps) == 2
+        assert ramps[0]["sigma_end_m"] < 0.0 and ramps[0]["t_end_s"] < 0.0
+        assert ramps[1]["sigma_start_m"] > length
+        assert ramps[1]["t_start_s"] > plan.trajectory.duration
     # The seal demo reaches its speed: report.json does not call its path short.
-    assert json.loads((folder / "report.json").read_text())["motion"]["top_speed_reduced"] is False
+    assert report["motion"]["top_speed_reduced"] is False
 
 
 @pytest.mark.slow
