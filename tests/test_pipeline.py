@@ -36,13 +36,11 @@ def test_process_io_of_a_path_cell_is_planned_and_written(tmp_path):
     """tool.process_io on a path: cell was ignored without a word (issue 24): as a
     one-seam job it switches on the path, in trajectory.csv, report.json and the KRL."""
     text = (CELLS / "seal_plate_kr16.yaml").read_text()
-    io = (
-        "  process_io:\n    on:  {digital_output: 3, lead_mm: 5}\n"
-        "    off: {digital_output: 3, lead_mm: 2}\n"
-    )
+    valve = "    on:  {digital_output: 1}\n    off: {digital_output: 1}\n"
+    io = "    on:  {digital_output: 3, lead_mm: 5}\n    off: {digital_output: 3, lead_mm: 2}\n"
     cell = tmp_path / "seal_io.yaml"
-    assert "  process_io:\n" in text  # the demo's flow output (its bead model's)
-    cell.write_text(text.replace("  process_io:\n", io, 1))
+    assert valve in text  # the demo's gun valve (its flow output: its bead model's)
+    cell.write_text(text.replace(valve, io, 1))
     out = tmp_path / "out"
     done = subprocess.run(
         [sys.executable, "-m", "offline_prog", "plan", str(cell), "--out", str(out)],

@@ -240,22 +240,36 @@ def test_a_flying_seam_in_urscript_lays_the_bead_from_its_first_millimetre(flyin
     assert_holds_the_bead(job, folder, t, replayed(job, t, value))
 
 
-def test_sealing_demo_compensation_is_at_least_as_good(planned_job):
+def _compensation_rows(job):
+    """(inside with compensation, inside without) (N,) per row."""
+    quality, (low, high) = job.quality, job.quality.model.band
+    inside_on = (quality.values >= low) & (quality.values <= high)
+    inside_off = (quality.uncompensated >= low) & (quality.uncompensated <= high)
+    return inside_on, inside_off
+
+
+def test_sealing_demo_compensation_is_at_least_as_good(planned_job, tmp_path):
     """The issue's figure: on the sealing demo, the share of process length within ±5 %
     of the bead's target with compensation on is at least that with it off, on the job
-    and on every seam (README, Process quality)."""
+    and on every seam (README, Process quality); no row is outside the band with
+    compensation where it is inside without (the lead never spoils a good bead). Flying
+    at a steady speed there is little to compensate; the demo at rest (its ramps)
+    shows compensation winning."""
+    from conftest import planned_text
+
     job, folder = planned_job("seal_plate_kr16")
     report = json.loads((folder / "report.json").read_text())["quality"]
     assert report["model"] == "bead" and report["band"] == pytest.approx([11.4, 12.6])
     assert report["share_within_band"] >= report["share_within_band_uncompensated"]
     for seam in report["seams"].values():
         assert seam["share_within_band"] >= seam["share_within_band_uncompensated"]
-    assert report["share_within_band"] > 0.95
-    # Everywhere: no row is outside the band with compensation where it is inside
-    # without (the lead never spoils a good bead), and compensation wins somewhere.
-    quality, (low, high) = job.quality, job.quality.model.band
-    inside_on = (quality.values >= low) & (quality.values <= high)
-    inside_off = (quality.uncompensated >= low) & (quality.uncompensated <= high)
+    assert report["share_within_band"] > 0.99
+    inside_on, inside_off = _compensation_rows(job)
+    assert not np.any(inside_off & ~inside_on)
+    text = (CELLS / "seal_plate_kr16.yaml").read_text(encoding="utf-8")
+    text = text.replace("  closed: true\n", "  closed: true\n  entry: rest\n")
+    rest, _ = planned_text(text, tmp_path)
+    inside_on, inside_off = _compensation_rows(rest)
     assert not np.any(inside_off & ~inside_on)
     assert np.count_nonzero(inside_on & ~inside_off) > 0
 
