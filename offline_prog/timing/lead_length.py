@@ -61,21 +61,22 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         return LeadPath(flange, lead_in_m=0.0, lead_out_m=0.0, reason=rest)
     v = inputs.speed.v_m_s
     ramp = ramp_length_m(v, a_max=caps.a_max, j_max=caps.j_max)
-    if motion.lead_mm is not None:
+    if motion.lead_mm is not None:  # the user's length: the leads keep it
         length = motion.lead_mm * 1e-3
-    else:
-        length = RAMP_MARGIN * ramp + _switch_m(cell, v)
+        return LeadPath(flange, lead_in_m=length, lead_out_m=length)
+    length = RAMP_MARGIN * ramp + _switch_m(cell, v)
     lifts = _lifts_m(inputs, length, ramp)
     return LeadPath(flange, lead_in_m=length, lead_out_m=length, lifts_m=lifts)
 
 
 def _lifts_m(inputs, length: float, ramp: float) -> tuple[float, float]:
-    """The least lifts of the lead-in and lead-out [m]: a normal approach's (retract's)
-    distance (``Inputs.normal_moves_m``) where the lead takes that move over, 0 where
-    not. It does where the move runs at the process speed (the default
-    ``motion.approach_speed``) and the one longer lead is shorter than the lead, the rest
-    of the straight move and its stop (two ramps of ``ramp`` [m]) run at that speed:
-    the tool then comes down onto the seam along one curve."""
+    """The least lifts of the default leads [m] (a ``motion.lead_mm`` keeps its length
+    and own lift): a normal approach's (retract's) distance (``Inputs.normal_moves_m``)
+    where the lead takes that move over, 0 where not. It does where the move runs at
+    the process speed (the default ``motion.approach_speed``) and the one longer lead
+    is shorter than the lead, the rest of the straight move and its stop (two ramps of
+    ``ramp`` [m]) run at that speed: the tool then comes down onto the seam along one
+    curve."""
     v = inputs.speed.v_m_s
     if not np.isclose(approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12):
         return 0.0, 0.0

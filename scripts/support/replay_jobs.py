@@ -5,7 +5,8 @@ planned and exported to one controller's program.
 Per controller: KUKA the seal job (border, two holes, stripe) with every seam flying;
 ABB the weld demo's seam; UR the tape demo's seam with 5 mm leads (with its default leads the
 lead collides, link_3 with link_6, and the seam falls back to rest; 8, 12 and 20 mm
-leads leave the approach's start closer to the part than the clearance); FANUC the seal job's stripe
+leads leave the approach's start closer to the part than the clearance; 5 mm is too
+short for the ramp to 0.15 m/s: the seam starts at 0.03 m/s); FANUC the seal job's stripe
 on the M-20iA imported from the ROS-Industrial support packages.
 """
 
