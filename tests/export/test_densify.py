@@ -70,7 +70,8 @@ def true_deviation(plan, data, s_points, X_points) -> tuple[float, float]:
 def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> float:
     """Largest distance [m] of the tool's trace on the part from the continuous path when
     the controller interpolates the written KRL poses X_TP = X_PT⁻¹ (P in T: position
-    linear, orientation slerp) between consecutive points."""
+    linear, orientation slerp) between consecutive points on the seam (σ in [0, L],
+    as ``true_frames``; motions that reach onto a flying seam's leads are left out)."""
     s, X = true_frames(plan, data)
     lam = np.linspace(0.0, 1.0, grid + 1)
     worst = 0.0
@@ -80,6 +81,8 @@ def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> fl
         R_TP = X_TP_a[:3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
         p_TP = X_TP_a[:3, 3] + lam[:, None] * (X_TP_b[:3, 3] - X_TP_a[:3, 3])
         trace = -np.einsum("nji,nj->ni", R_TP, p_TP)  # the tool's origin in P: p_PT
+        if s_points[a] < s[0] or s_points[b] > s[-1]:  # (partly) on a flying seam's lead
+            continue  # (σ < 0 or > L): the seam's curve does not hold it
         inside = (s >= s_points[a]) & (s <= s_points[b])
         path = X[inside, :3, 3]
         start, step = path[:-1], np.diff(path, axis=0)
