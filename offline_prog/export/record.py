@@ -31,6 +31,9 @@ from offline_prog.export.points import PointRule, process_points
 from offline_prog.export.program import ProgramData
 from offline_prog.io_events import IoEvent, Signal
 
+# Path positions closer than this are one (a lead's end and the seam's sample there) [m].
+PATH_TOL_M = 1e-6
+
 
 @dataclasses.dataclass(frozen=True)
 class Switch:
@@ -97,9 +100,10 @@ class Process:
 @dataclasses.dataclass(frozen=True)
 class SeamRun:
     """Seam ``seam`` as run, ``number`` from 1 in run order: approach, process, retract
-    (no approach or retract where the cell asks for none), its job ``segments``, the
-    job's ``rows`` from the approach's first to the retract's last, and the seam's
-    I/O ``events`` in time order."""
+    (no approach or retract where there is no straight move: the cell asks for none,
+    or a flying seam's lead took it over and the link ends where the lead-in starts),
+    its job ``segments``, the job's ``rows`` from the approach's first to the retract's
+    last, and the seam's I/O ``events`` in time order."""
 
     seam: str
     number: int
@@ -159,7 +163,7 @@ def _seam_run(job, number, segments, points, flow_where_set) -> SeamRun:
     moves = {
         kind: _linear_move(job, by_kind[kind], number, k)
         for kind in ("approach", "retract")
-        if kind in by_kind
+        if kind in by_kind and _has_straight_move(job, by_kind[kind], k)
     }
     process = _process(job.seams[k], seam, number, points)
     events = tuple(e for e in job.events if e.seam == seam)
@@ -168,6 +172,19 @@ def _seam_run(job, number, segments, points, flow_where_set) -> SeamRun:
         seam, number, moves.get("approach"), process, moves.get("retract"), segments, rows, events
     )
     return _with_switches(run, job.seam_lengths_m[k], flow_where_set)
+
+
+def _has_straight_move(job: JobProgramData, segment: JobSegment, k: int) -> bool:
+    """Whether an approach or retract segment holds a straight move, not only a flying
+    seam's lead: the straight move's rows lie beyond the seam's samples along the path
+    (``job.stages``: path_m −(lead-in + δ) before them, L + lead-out + δ after them),
+    a lead alone starts (ends) on the seam's first (last) sample."""
+    path, seam = job.job.path_m, job.seams[k].path_m
+    if segment.kind == "approach":
+        return bool(path[segment.start] < seam[0] - PATH_TOL_M)
+    end = min(segment.stop, len(path) - 1)  # the next link's first row: NaN
+    beyond = path[segment.start : end + 1]
+    return bool(np.nanmax(beyond, initial=-np.inf) > seam[-1] + PATH_TOL_M)
 
 
 def _linear_move(job: JobProgramData, segment: JobSegment, number: int, k: int) -> LinearMove:

@@ -70,7 +70,8 @@ def true_deviation(plan, data, s_points, X_points) -> tuple[float, float]:
 def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> float:
     """Largest distance [m] of the tool's trace on the part from the continuous path when
     the controller interpolates the written KRL poses X_TP = X_PT⁻¹ (P in T: position
-    linear, orientation slerp) between consecutive points."""
+    linear, orientation slerp) between consecutive points on the seam (σ in [0, L],
+    as ``true_frames``; motions that reach onto a flying seam's leads are left out)."""
     s, X = true_frames(plan, data)
     lam = np.linspace(0.0, 1.0, grid + 1)
     worst = 0.0
@@ -80,6 +81,8 @@ def pose_interpolation_deviation(plan, data, s_points, X_points, grid=400) -> fl
         R_TP = X_TP_a[:3, :3] @ Rotation.from_rotvec(lam[:, None] * rotvec).as_matrix()
         p_TP = X_TP_a[:3, 3] + lam[:, None] * (X_TP_b[:3, 3] - X_TP_a[:3, 3])
         trace = -np.einsum("nji,nj->ni", R_TP, p_TP)  # the tool's origin in P: p_PT
+        if s_points[a] < s[0] or s_points[b] > s[-1]:  # (partly) on a flying seam's lead
+            continue  # (σ < 0 or > L): the seam's curve does not hold it
         inside = (s >= s_points[a]) & (s <= s_points[b])
         path = X[inside, :3, 3]
         start, step = path[:-1], np.diff(path, axis=0)
@@ -100,8 +103,9 @@ def written_points(data, fmt: str, folder, rule: PointRule):
         decls = re.findall(r"^DECL E6POS (XA1|XP\d+)=\{([^}]*)\}", main.read_text(), re.M)
         decls += re.findall(r"^DECL E6POS (XP\d+)=\{([^}]*)\}", module.read_text(), re.M)
         fields = [{k: float(v) for k, v in (i.split() for i in d.split(","))} for _, d in decls]
-        X_TP = np.array([krl_pose(f) for f in fields])
-        X_PT = np.linalg.inv(X_TP)
+        X_PT = np.linalg.inv(np.array([krl_pose(f) for f in fields]))
+        if run.approach is None:  # the link's last PTP reaches the first point (a lead's start)
+            X_PT = np.concatenate([krl_ptp_tool_in_part(data, folder)[None], X_PT])
     else:
         text = (folder / "OfflineProg.mod").read_text()
         targets = dict(re.findall(r"robtarget (\w+) := \[(\[[^\]]*\],\[[^\]]*\])", text))
@@ -109,6 +113,22 @@ def written_points(data, fmt: str, folder, rule: PointRule):
         X_PT = np.array([rapid_pose(targets[n]) for n in names])
     assert len(X_PT) == len(indices)
     return seam.path_m[indices], X_PT, (run.process.max_chord_m, run.process.max_angle_rad)
+
+
+def krl_ptp_tool_in_part(data, folder) -> np.ndarray:
+    """(4, 4) X_PT of the main program's last PTP before the seam's module is called:
+    the E6AXIS target [deg] through the robot's forward kinematics."""
+    from offline_prog.robot.model import load_robot
+
+    src, dat = ((folder / f"offline_prog.{ext}").read_text() for ext in ("src", "dat"))
+    before = src[: src.index("\noffline_prog_1( )")]  # the call, not its EXT
+    name = re.findall(r"^PTP (\w+)$", before, re.M)[-1]
+    axes = re.search(rf"^DECL E6AXIS {name}=\{{([^}}]*)\}}", dat, re.M)[1]
+    fields = {k: float(v) for k, v in (i.split() for i in axes.split(","))}
+    q = np.deg2rad([fields[f"A{i}"] for i in range(1, 7)])
+    X_BE = load_robot(data.robot).forward(q[None])[0]
+    rows = data.job
+    return np.linalg.inv(X_BE @ rows.X_EP) @ rows.X_BT  # X_PT = X_PE · X_EB · X_BT
 
 
 def krl_pose(f) -> np.ndarray:

@@ -163,14 +163,43 @@ def pose_errors(X_a, X_b):
 
 
 def seam_lins(motions):
-    """The seam's LIN targets: the approach's end (its first point) and the module's."""
-    approach = next(k for k, m in enumerate(motions) if m["point"] == "XA1")
-    lins = [motions[approach]]
-    for m in motions[approach + 1 :]:
+    """The seam's LIN targets after its first point (its module's), and the motion that
+    reaches its first point: the approach's LIN ``XA1``, or the link's last PTP where
+    a flying seam's lead took the straight approach over (no ``XA1`` is written)."""
+    first = next(k for k, m in enumerate(motions) if m["module"] != "offline_prog")
+    start = motions[first - 1]
+    lins = []
+    for m in motions[first:]:
         if m["module"] == "offline_prog":
             break
         lins.append(m)
-    return lins
+    return start, lins
+
+
+def first_point_pose(start, settings, plant, convention="X_TP"):
+    """X_BE (4, 4) at the seam's first point, from the motion that reaches it: the
+    approach LIN's pose, or Drake's forward kinematics of the link's last PTP target."""
+    if start["kind"] == "LIN":
+        return flange_poses([start], settings, convention)[0]
+    q = np.deg2rad([start["fields"][f"A{i}"] for i in range(1, 7)])
+    return link_poses(plant, q, ["tool0"])["tool0"]
+
+
+def seam_flange_poses(motions, settings, plant, convention="X_TP"):
+    """X_BE (K, 4, 4) at the seam's points as the program reaches them."""
+    start, lins = seam_lins(motions)
+    first = first_point_pose(start, settings, plant, convention)
+    return np.concatenate([first[None], flange_poses(lins, settings, convention)])
+
+
+def assert_start_is_the_records(data, start):
+    """The seam's first point is reached by XA1 where the record has a straight
+    approach, else by the link's last PTP (the lead-in starts where the link ends)."""
+    (run,) = program_record(data, None).runs()
+    if run.approach is None:
+        assert start["kind"] == "PTP" and start["module"] == "offline_prog"
+    else:
+        assert start["point"] == "XA1" and start["kind"] == "LIN"
 
 
 def record_points(data, convention="X_TP", **tolerances):
@@ -181,27 +210,31 @@ def record_points(data, convention="X_TP", **tolerances):
 
 
 @pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
-def test_round_trip_reproduces_the_flange_poses(data, tmp_path, convention):
+def test_round_trip_reproduces_the_flange_poses(data, tmp_path, plant, convention):
     export(data, "krl", tmp_path, tcp_pose_convention=convention)
     motions, settings = read_program(tmp_path)
     assert settings["IPO_MODE"] == "#TCP"
-    lins = seam_lins(motions)
+    start, lins = seam_lins(motions)
+    assert_start_is_the_records(data, start)
     seam, indices = record_points(data, convention)
-    assert [m["point"] for m in lins] == ["XA1"] + [f"XP{k + 1}" for k in range(1, len(indices))]
+    assert [m["point"] for m in lins] == [f"XP{k + 1}" for k in range(1, len(indices))]
     assert indices[0] == 0 and indices[-1] == len(seam.t) - 1 and np.all(np.diff(indices) > 0)
-    dp, da = pose_errors(flange_poses(lins, settings, convention), seam.X_BE[indices])
+    X_BE = seam_flange_poses(motions, settings, plant, convention)
+    dp, da = pose_errors(X_BE, seam.X_BE[indices])
     assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    # An exact stop where the approach ends and at the seam's end; blending in between.
-    assert [m["blended"] for m in lins] == [False] + [True] * (len(lins) - 2) + [False]
+    # An exact stop where the seam's first point is reached and at the seam's end;
+    # blending in between.
+    assert [m["blended"] for m in [start, *lins]] == [False] + [True] * (len(lins) - 1) + [False]
     # The other convention would put the flange elsewhere.
     other = {"X_TP": "X_PF", "X_PF": "X_TP"}[convention]
-    assert pose_errors(flange_poses(lins, settings, other), seam.X_BE[indices])[0] > 0.01
+    assert pose_errors(flange_poses(lins, settings, other), seam.X_BE[indices[1:]])[0] > 0.01
 
 
 def test_ptp_targets_are_the_planned_joints_and_put_the_flange_there(data, tmp_path, plant):
     """E6AXIS A_i = URDF q_i in degrees: home first, then each link's waypoints; Drake's
-    forward kinematics of the last one before the approach is the flange where the
-    approach starts."""
+    forward kinematics of the last one before the seam is the flange where its approach
+    starts (on a flying seam whose lead took the straight move over: the lead-in's
+    start)."""
     export(data, "krl", tmp_path)
     motions, _ = read_program(tmp_path)
     ptp = [m for m in motions if m["kind"] == "PTP"]
@@ -210,7 +243,8 @@ def test_ptp_targets_are_the_planned_joints_and_put_the_flange_there(data, tmp_p
     np.testing.assert_allclose(axes, np.rad2deg(planned), atol=1e-5)
     assert all(m["fields"][f"E{i}"] == 0.0 for m in ptp for i in range(1, 7))
     assert ptp[0]["point"] == "XHOME" and motions[-1]["kind"] == "PTP"
-    before = motions[[m["point"] for m in motions].index("XA1") - 1]
+    start, _ = seam_lins(motions)
+    before = [m for m in motions[: motions.index(start) + 1] if m["kind"] == "PTP"][-1]
     X_BE = link_poses(
         plant, np.deg2rad([before["fields"][f"A{i}"] for i in range(1, 7)]), ["tool0"]
     )
@@ -232,9 +266,11 @@ def geometric_status(plant, q_rad):
 def test_status_and_turn_on_the_plan(data, tmp_path, plant):
     export(data, "krl", tmp_path)
     motions, _ = read_program(tmp_path)
-    lins = seam_lins(motions)
+    start, lins = seam_lins(motions)
+    if start["kind"] == "LIN":  # the approach's end: the seam's first point
+        lins = [start, *lins]
     seam, indices = record_points(data)
-    q = seam.q[indices]
+    q = seam.q[indices[-len(lins) :]]
     turn = np.array([m["fields"]["T"] for m in lins])
     expected = sum((q[:, i] < 0).astype(int) << i for i in range(6))  # bit i: A(i+1) < 0
     np.testing.assert_array_equal(turn, expected)
@@ -282,14 +318,14 @@ def distance_to_polyline(points, line):
 
 
 @pytest.mark.parametrize("chord_mm", [0.05, 0.2])
-def test_exported_points_follow_the_dense_plan(data, tmp_path, chord_mm):
+def test_exported_points_follow_the_dense_plan(data, tmp_path, plant, chord_mm):
     """The controller moves the fixed TCP in straight lines across the part between the
     written points: every densified sample of the seam lies within the chord tolerance
     of that line, orientation by slerp within the angle tolerance."""
     chord, angle = chord_mm * 1e-3, np.deg2rad(0.1)
     export(data, "krl", tmp_path, chord_tol_m=chord, angle_tol_rad=angle)
     motions, settings = read_program(tmp_path)
-    X_BE = flange_poses(seam_lins(motions), settings)
+    X_BE = seam_flange_poses(motions, settings, plant)
     X_PT = np.linalg.inv(data.job.X_BT) @ X_BE @ data.job.X_EP
     X_PT = np.linalg.inv(X_PT)  # the written tool frames in P, from the file
     seam, indices = record_points(data, chord_tol_m=chord, angle_tol_rad=angle)
@@ -313,13 +349,15 @@ def test_exported_points_follow_the_dense_plan(data, tmp_path, chord_mm):
 def test_vel_cp_follows_the_planned_speed(slowed, tmp_path):
     export(slowed, "krl", tmp_path)
     motions, _ = read_program(tmp_path)
-    lins = seam_lins(motions)
+    start, lins = seam_lins(motions)
+    assert_start_is_the_records(slowed, start)
     seam, indices = record_points(slowed)
     speed = slowed.seams[0].process_speed_m_s
-    assert lins[0]["vel_cp"] == pytest.approx(speed, abs=1e-4)  # the approach
+    if start["kind"] == "LIN":
+        assert start["vel_cp"] == pytest.approx(speed, abs=1e-4)  # the approach
     for k, (i, j) in enumerate(zip(indices[:-1], indices[1:], strict=True)):
         planned = seam.tcp_speed[i : j + 1].max()
-        assert planned - 1e-4 - 1e-9 <= lins[k + 1]["vel_cp"] <= max(planned, 1e-3) + 1e-9
+        assert planned - 1e-4 - 1e-9 <= lins[k]["vel_cp"] <= max(planned, 1e-3) + 1e-9
     assert min(m["vel_cp"] for m in lins) < speed  # the slowed corners
 
 
@@ -389,10 +427,11 @@ def test_a_non_opw_robot_is_refused(data, tmp_path):
 
 
 @pytest.mark.parametrize("convention", ["X_TP", "X_PF"])
-def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, convention):
-    """``offline-prog export --tcp-pose-convention``: the approach ends on each seam's
-    first point and the seam's last LIN on its last, read back under the convention the
-    header names."""
+def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, plant, convention):
+    """``offline-prog export --tcp-pose-convention``: each seam's first point is reached
+    (by its approach's LIN, or the link's last PTP where a flying seam's lead took the
+    approach over) and the seam's last LIN ends on its last, read back under the
+    convention the header names; a retract LIN only where the record has one."""
     from offline_prog.cli import main
 
     plan_dir = planned_job("seal_job_kr16")[1]
@@ -400,16 +439,30 @@ def test_a_job_exports_with_either_tcp_pose_convention(planned_job, tmp_path, co
     assert main([*argv, "--tcp-pose-convention", convention]) == 0
     motions, settings = read_program(tmp_path)
     job = JobProgramData.load(plan_dir)
-    lin = [m for m in motions if m["kind"] == "LIN"]
-    for seam in job.seams:
-        first = lin.pop(0)  # the approach's end: the seam's first point
-        while lin[0]["module"] != "offline_prog":  # the seam's LINs in its module
-            last = lin.pop(0)
-        lin.pop(0)  # the retract
-        X_BE = flange_poses([first, last], settings, convention)
+    runs = program_record(job, None).runs()
+    assert len(runs) == len(job.seams)
+    for run, seam in zip(runs, job.seams, strict=True):
+        first = next(k for k, m in enumerate(motions) if m["module"] != "offline_prog")
+        start = motions[first - 1]
+        assert start["kind"] == ("PTP" if run.approach is None else "LIN")
+        motions = motions[first:]
+        module = motions[0]["module"]
+        while motions[0]["module"] != "offline_prog":  # the seam's LINs in its module
+            last = motions.pop(0)
+        assert last["module"] == module
+        if run.retract is not None:
+            retract = motions.pop(0)
+            assert retract["kind"] == "LIN" and retract["point"] == f"XR{run.number}"
+        assert motions[0]["kind"] == "PTP"  # the next link (or home's return)
+        X_BE = np.array(
+            [
+                first_point_pose(start, settings, plant, convention),
+                flange_poses([last], settings, convention)[0],
+            ]
+        )
         dp, da = pose_errors(X_BE, seam.X_BE[[0, -1]])
         assert dp <= POSITION_TOL_M and da <= ANGLE_TOL_DEG
-    assert not lin
+    assert all(m["kind"] == "PTP" for m in motions)
     assert f"({convention})" in (tmp_path / "offline_prog.src").read_text()
 
 
@@ -449,7 +502,11 @@ def test_a_calibration_of_the_frames_moves_the_whole_program(data, tmp_path):
     text = re.sub(r"TOOL_DATA\[1\]=\{[^}]*\}", f"TOOL_DATA[1]={{{krl_frame(X_EP)}}}", text)
     frm.write_text(text)
     motions, settings = read_program(tmp_path)
-    X_BE = flange_poses(seam_lins(motions), settings)
+    start, lins = seam_lins(motions)
+    if start["kind"] == "LIN":  # the approach's end moves too (a PTP target does not)
+        lins = [start, *lins]
+    X_BE = flange_poses(lins, settings)
+    indices = indices[-len(lins) :]
     expected = (
         X_BT @ np.linalg.inv(rows.X_BT) @ seam.X_BE[indices] @ rows.X_EP @ np.linalg.inv(X_EP)
     )

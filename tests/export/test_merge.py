@@ -78,3 +78,26 @@ def test_nothing_merges_where_the_path_or_the_writer_forbids():
     assert check.merge(points, set(), lambda i, k, j: False) == points  # the writer forbids
     p = np.zeros((50, 3))
     assert merge_short(points, p, pinned=set(points), fits=lambda i, k, j: True) == points
+
+
+def test_a_free_end_slides_away_from_a_pinned_point_where_no_merge_holds():
+    """A switch point pinned 0.4 mm after a point on a gentle arc (radius 10 mm, samples
+    0.1 mm apart), the motion before 2 mm long: dropping the free point cuts the arc by
+    more than the tolerance, so it slides back along the samples instead: every motion
+    is then at least 0.5 mm long and holds the tolerance, the pinned point stays."""
+    radius, n = 10e-3, 61
+    angle = np.arange(n) * 0.1e-3 / radius
+    X_BP = np.tile(np.eye(4), (n, 1, 1))
+    X_BP[:, :3, 3] = -radius * np.column_stack([np.sin(angle), 1 - np.cos(angle), 0 * angle])
+    X_BT = np.eye(4)  # the tool's point on the part: the arc itself
+    points, pinned = [0, 20, 24, 60], {24}
+    check = PathCheck(X_BP, X_BT, CHORD_TOL_M, ANGLE_TOL_RAD)
+    assert independent_deviation(X_BP, X_BT, 0, 24) > CHORD_TOL_M  # 20 may not go
+    p = X_BP[:, :3, 3]
+    stays = merge_short(points, p, pinned=pinned, fits=lambda i, k, j: check.fits(i, j))
+    assert stays == points  # without sliding the 0.4 mm motion stays
+    merged = check.merge(points, pinned)
+    assert 24 in merged and merged[0] == 0 and merged[-1] == 60 and len(merged) == 4
+    for a, b in zip(merged[:-2], merged[1:-1], strict=True):  # the last motion was long
+        assert np.linalg.norm(p[b] - p[a]) >= MIN_MOTION_M
+        assert independent_deviation(X_BP, X_BT, a, b) <= CHORD_TOL_M + 1e-7

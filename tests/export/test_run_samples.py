@@ -43,20 +43,27 @@ def test_a_flying_seams_samples_run_once_in_time_order_through_its_leads(flying)
 
 
 @pytest.mark.slow  # plans a job of its own
-def test_a_flying_seams_straight_moves_end_at_its_leads_at_any_sample_rate(flying, tmp_path):
-    """The approach's straight move ends where the lead-in starts (on the seal demo the
-    lead's lift takes the whole approach: it is the approach's start) and the retract's
-    starts where the lead-out ends, at 2 samples per second (the job's rows then hold
-    neither the leads' ends) as at the demo's rate: the same targets and lengths."""
+def test_a_flying_seams_leads_take_its_straight_moves_over_at_any_sample_rate(flying, tmp_path):
+    """On the seal demo the leads' lift takes the whole approach and retract (normal
+    moves at the process speed): the program record holds no straight approach or
+    retract (no 0 mm LIN), and the link before the seam ends where the lead-in starts,
+    the one after it starts where the lead-out ends, at 2 samples per second (the job's
+    rows then hold neither of the leads' ends) as at the demo's rate."""
     text = (CELLS / "seal_plate_kr16.yaml").read_text(encoding="utf-8")
     text = text.replace("  closed: true\n", "  closed: true\n  entry: flying\n")
     text = text.replace("  max_jerk:", "  sample_rate_hz: 2\n  max_jerk:", 1)
     _, slow_rate = planned_text(text, tmp_path)
     rule = PointRule("flange", "X_TP", 5e-5, 1e-3)
-    runs = [program_record(d, rule).runs()[0] for d in (flying, slow_rate)]
-    for run in runs:
-        dense = run.process.data
-        np.testing.assert_allclose(run.approach.X_PT, dense.X_PT[0], atol=1e-9)
-    np.testing.assert_allclose(runs[1].approach.X_PT, runs[0].approach.X_PT, atol=1e-6)
-    np.testing.assert_allclose(runs[1].retract.X_PT, runs[0].retract.X_PT, atol=1e-6)
-    assert runs[1].retract.length_m == pytest.approx(runs[0].retract.length_m, abs=1e-6)
+    ends = []
+    for data in (flying, slow_rate):
+        (run,) = program_record(data, rule).runs()
+        assert run.approach is None and run.retract is None
+        dense, rows = run.process.data, data.job
+        kinds = {s.kind: s for s in run.segments}
+        link_end = rows.X_PT[kinds["approach"].start]
+        next_link = rows.X_PT[min(kinds["retract"].stop, len(rows.t) - 1)]
+        np.testing.assert_allclose(link_end, dense.X_PT[0], atol=1e-9)
+        np.testing.assert_allclose(next_link, dense.X_PT[-1], atol=1e-9)
+        assert dense.path_m[0] < 0.0 < data.seam_lengths_m[0] < dense.path_m[-1]
+        ends.append((dense.X_PT[0], dense.X_PT[-1]))
+    np.testing.assert_allclose(ends[1], ends[0], atol=1e-6)
