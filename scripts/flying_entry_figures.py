@@ -11,8 +11,11 @@ temperature) is within ±5 % of the target (the model's band for heat input and 
 its own tolerance), the worst gun-on row against the target, the gun-on rows where the
 tool stands, the cycle time and the approach + retract time (a flying seam's leads
 count as approach and retract), and the leads' top tool speed against the seam's
-(at most 1: the process speed holds on the leads too). ``--approach-speed`` adds the
-weld demo's setting of the issue (approach and retract under 3 s). The programs
+(at most 1: the process speed holds on the leads too) and each seam's lowest tool speed
+against its top (1 where a flying seam runs at one speed from its first millimetre;
+``--cells seal_job_kr16``: a cell without a process model prints its motion alone).
+``--approach-speed`` adds the weld demo's setting of the issue (approach and retract
+under 3 s). The programs
 replay the plan's outputs within 1 % (tests/process/test_replay.py,
 tests/robot_import/test_fanuc_job.py), so these are the programs' figures too.
 """
@@ -53,9 +56,6 @@ def with_keys(inputs, *, entry: str | None = None, **motion):
 def figures(job) -> dict:
     """The acceptance figures of a planned job (module docstring)."""
     s, quality = job.samples, job.quality
-    ratio = quality.values / quality.model.target - 1.0
-    accepted = acceptance(job, ratio)
-    worst = accepted["worst_row"]
     moves = sum(g.t_stop - g.t_start for g in s.segments if g.kind in ("approach", "retract"))
     lead_over = [
         float(lead.tcp_speed.max() / o.plan.trajectory.tcp_speed.max())
@@ -63,19 +63,31 @@ def figures(job) -> dict:
         for lead in (o.plan.lead_in, o.plan.lead_out)
         if lead is not None
     ]
-    return {
+    lowest = min(
+        float(o.plan.trajectory.tcp_speed.min() / o.plan.trajectory.tcp_speed.max())
+        for o in job.chosen
+    )
+    out = {
+        "cycle_s": float(s.t[-1]),
+        "moves_s": float(moves),
+        "lead_over": max(lead_over, default=float("nan")),
+        "seam_lowest": lowest,
         "entries": [
             f"{o.name}: {o.plan.entry['entry']}"
             + (f" ({o.plan.entry['reason']})" if o.plan.entry["reason"] else "")
             for o in job.chosen
         ],
+    }
+    if quality is None:  # a cell without a process model: its motion alone
+        return out
+    ratio = quality.values / quality.model.target - 1.0
+    accepted = acceptance(job, ratio)
+    worst = accepted["worst_row"]
+    return out | {
         "share": accepted["share"],
         "worst": float(ratio[worst]),
         "worst_at": (s.labels()[worst], float(s.path_m[worst])),
         "standstill": accepted["standstill"],
-        "cycle_s": float(s.t[-1]),
-        "moves_s": float(moves),
-        "lead_over": max(lead_over, default=float("nan")),
     }
 
 
@@ -101,17 +113,21 @@ def main(names: list[str], approach_speed: float | None) -> None:
             )
             f = figures(job)
             cycles[label] = f["cycle_s"]
-            segment, at = f["worst_at"]
             print(f"{name:22s} {label:28s} {'; '.join(f['entries'])}")
             if not job.feasible:  # its figures are of a plan that cannot be run
                 print(f"{'':22s} INFEASIBLE: {job.failure}")
+            if "share" in f:
+                segment, at = f["worst_at"]
+                print(
+                    f"{'':22s} gun-on within ±{BAND * 100:g} %: {f['share'] * 100:6.2f} %, "
+                    f"worst {f['worst'] * 100:+8.2f} % ({segment} at σ = {at * 1e3:.1f} mm; "
+                    f"{'ok' if abs(f['worst']) <= WORST_ALLOWED else 'beyond'} ±20 %), "
+                    f"gun-on standstill rows {f['standstill']}"
+                )
             print(
-                f"{'':22s} gun-on within ±{BAND * 100:g} %: {f['share'] * 100:6.2f} %, worst "
-                f"{f['worst'] * 100:+8.2f} % ({segment} at σ = {at * 1e3:.1f} mm; "
-                f"{'ok' if abs(f['worst']) <= WORST_ALLOWED else 'beyond'} ±20 %), "
-                f"gun-on standstill rows {f['standstill']}, cycle {f['cycle_s']:.2f} s, "
-                f"approach+retract {f['moves_s']:.2f} s, "
-                f"leads' top tool speed / seam's {f['lead_over']:.3f}"
+                f"{'':22s} cycle {f['cycle_s']:.2f} s, approach+retract {f['moves_s']:.2f} s, "
+                f"leads' top tool speed / seam's {f['lead_over']:.3f}, "
+                f"seams' lowest tool speed / their top {f['seam_lowest']:.3f}"
             )
         print(f"{'':22s} cycle flying / rest {cycles['flying'] / cycles['rest']:.3f}")
 
