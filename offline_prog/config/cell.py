@@ -205,6 +205,12 @@ class ApproachConfig:
     kind: str = "normal"  # normal | tangent | none
     distance_mm: float = 50.0
 
+    @property
+    def normal_m(self) -> float:
+        """The move's distance off the surface [m]: a flying seam's lead may take it over
+        (timing.lead_length); 0 for a tangent move or none."""
+        return self.distance_mm * 1e-3 if self.kind == "normal" else 0.0
+
 
 @dataclasses.dataclass
 class SeamConfig(PathConfig):

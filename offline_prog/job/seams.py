@@ -86,10 +86,7 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
         points = load_points(job.file, seam_cell)
     if reverse:
         points = reversed_points(points)
-    moves = tuple(
-        spec.distance_mm * 1e-3 if spec.kind == "normal" else 0.0
-        for spec in (seam.approach, seam.retract)
-    )
+    moves = (seam.approach.normal_m, seam.retract.normal_m)
     return dataclasses.replace(
         job,
         cell=seam_cell,
