@@ -67,8 +67,8 @@ ROTATION_RATE_STEP_M = 1e-5
 
 @functools.lru_cache(maxsize=64)
 def unit_length(ratio: float) -> float:
-    """ℓ₁(r) = ∫₀¹ √(1 + (4r·x³)²) dx: the length of a straight lead lifting r·δ per its
-    extent δ (the trapezoid rule on ARC_SAMPLES points), for sizing leads."""
+    """ℓ₁(r) = ∫₀¹ √(1 + (4r·x³)²) dx: the length per extent δ of a lead on a straight
+    seam lifting r·δ (the trapezoid rule on ARC_SAMPLES points), for sizing leads."""
     x = np.linspace(0.0, 1.0, ARC_SAMPLES)
     g = np.sqrt(1.0 + (LIFT_POWER * ratio * x ** (LIFT_POWER - 1)) ** 2)
     return float(np.sum(0.5 * (g[1:] + g[:-1]) * np.diff(x)))
