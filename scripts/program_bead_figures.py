@@ -6,10 +6,11 @@ Run: ``PYTHONPATH=. python scripts/program_bead_figures.py [--controllers kuka a
 fanuc] [--fanuc-packages DIR]``.
 
 The jobs (scripts/support/replay_jobs.py): KUKA the seal job with every seam flying,
-ABB the weld demo's seam, UR the tape demo's seam (5 mm leads), FANUC the seal job's
-stripe on the M-20iA (imported from the ROS-Industrial FANUC support packages; left
-out when they are absent). From the program's own statements (KRL ``ANOUT``/
-``TRIGGER``, RAPID ``TriggSpeed``/``TriggIO``, URScript's servoj stream, FANUC's ``AO``
+ABB the weld demo's seam, UR the sealing demo's plate border carried by the tape demo's
+UR10e (flying on its default leads), FANUC the seal job's stripe on the M-20iA
+(imported from the ROS-Industrial FANUC support packages; left out when they are
+absent). From the program's own statements (KRL
+``ANOUT``/``TRIGGER``, RAPID ``TriggSpeed``/``TriggIO``, URScript's servoj stream, FANUC's ``AO``
 per ``L`` motion and ``DB`` switches; scripts/support/program_replay.py) it prints the
 share of the gun-on length within ±5 % of the target, the worst gun-on row, the gun-on
 rows at a standstill and the worst switch error against the plan [mm], with the plan's
@@ -50,7 +51,7 @@ def cell_text(controller: str, work: Path, fanuc: Path) -> str:
     if controller == "abb":
         return jobs.one_seam_flying(CELLS, "weld_seam_irb2400")
     if controller == "ur":
-        return jobs.one_seam_flying(CELLS, "tape_cylinder_ur10e", lead_mm=jobs.UR_LEAD_MM)
+        return jobs.plate_on_ur10e(CELLS)
     jobs.import_m20ia(work, fanuc)
     text = (CELLS / "seal_job_kr16.yaml").read_text(encoding="utf-8")
     return jobs.stripe_flying(jobs.on_m20ia(text))

@@ -3,11 +3,17 @@ back: demo cells laying the sealing demo's bead (lag 0.08 s) with their seams fl
 planned and exported to one controller's program.
 
 Per controller: KUKA the seal job (border, two holes, stripe) with every seam flying;
-ABB the weld demo's seam; UR the tape demo's seam with 5 mm leads (with its default leads the
-lead collides, link_3 with link_6, and the seam falls back to rest; 8, 12 and 20 mm
-leads leave the approach's start closer to the part than the clearance; 5 mm is too
-short for the ramp to 0.15 m/s: the seam starts at 0.03 m/s); FANUC the seal job's stripe
-on the M-20iA imported from the ROS-Industrial support packages.
+ABB the weld demo's seam; UR the sealing demo's plate border carried by the tape demo's
+UR10e past the nozzle, flying on its default leads (``plate_on_ur10e``); FANUC the seal
+job's stripe on the M-20iA imported from the ROS-Industrial support packages.
+
+The tape demo's own seam does not fly on its default leads: the lead-in, 76 mm of tool
+path before a start where the UR10e's forearm is already near its wrist, stretches the
+elbow (joint 3 from 49° to 35°) and link_3 meets link_6; the seam falls back to rest.
+Its leads reach into the clearance from 26 mm on, and the ramp to 0.15 m/s under the
+bead's caps needs 54 mm; 8, 12 and 20 mm leads leave the approach's start closer to the
+part than the clearance; 5 mm is too short for the ramp (the seam starts at 0.03 m/s).
+The replay tests still run its program with 5 mm leads (``UR_LEAD_MM``).
 """
 
 from __future__ import annotations
@@ -20,6 +26,14 @@ BEAD = (  # the bead of the sealing demo (lag 0.08 s), for any demo's robot
     "  bead: {area_mm2: 12.0, tolerance_pct: 5, flow_mm3_s_per_unit: 250.0, lag_s: 0.08}\n"
 )
 UR_LEAD_MM = 5.0  # the tape demo's leads that fly (module docstring)
+# Where the sealing demo's nozzle stands for the UR10e: the tape demo's roller contact
+# (X_IT) 0.7 m in front of the robot, 0.3 m high; its stand's top 0.2 m under the tip,
+# as in the sealing demo.
+UR_NOZZLE = ("[1.0, 0.0, 0.5]", "[0.7, 0.0, 0.3]")
+UR_NOZZLE_STAND = (
+    "size_mm: [200, 200, 300], pose: {translation: [1.0, 0, 0.150]}",
+    "size_mm: [200, 200, 100], pose: {translation: [0.7, 0, 0.050]}",
+)
 FLYING_IO = (  # the gun at the seam's ends, the flow following the speed
     "tool:\n  process_io:\n    on:  {digital_output: 2}\n    off: {digital_output: 2}\n"
     "    flow: {analog_output: 1}\n"
@@ -43,6 +57,21 @@ def one_seam_flying(cells: Path, name: str, *, lead_mm: float | None = None) -> 
     motion = "motion:\n" + (f"  lead_mm: {lead_mm}\n" if lead_mm is not None else "")
     text = text.replace("motion:\n", BEAD + motion, 1)
     return text.replace(": data/", f": {cells}/data/")
+
+
+def plate_on_ur10e(cells: Path) -> str:
+    """cells/seal_plate_kr16.yaml (the sealing demo: the plate's border, a closed seam)
+    laying BEAD with FLYING_IO, carried by the tape demo's UR10e (its ``robot:``) past
+    the nozzle placed for it (UR_NOZZLE, UR_NOZZLE_STAND); the seam flying (the default
+    entry) on its default leads."""
+    text = with_own_io((cells / "seal_plate_kr16.yaml").read_text(encoding="utf-8"), FLYING_IO)
+    tape = (cells / "tape_cylinder_ur10e.yaml").read_text(encoding="utf-8")
+    robot = re.search(r"(?ms)^robot:\n.*?(?=^\S)", tape).group(0)
+    text = re.sub(r"(?ms)^robot:\n.*?(?=^\S)", lambda _: robot, text, count=1)
+    for old, new in (UR_NOZZLE, UR_NOZZLE_STAND):
+        assert old in text, old  # the sealing demo's nozzle, as this helper knows it
+        text = text.replace(old, new, 1)
+    return text.replace("motion:\n", BEAD + "motion:\n", 1)
 
 
 def seal_job_flying(cells: Path) -> str:

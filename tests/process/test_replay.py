@@ -26,7 +26,14 @@ from program_replay import (
     urscript_flow,
     urscript_switch_errors,
 )
-from replay_jobs import BEAD, UR_LEAD_MM, exported, one_seam_flying, seal_job_flying
+from replay_jobs import (
+    BEAD,
+    UR_LEAD_MM,
+    exported,
+    one_seam_flying,
+    plate_on_ur10e,
+    seal_job_flying,
+)
 
 from offline_prog.process.registry import process_model
 
@@ -235,9 +242,31 @@ def test_a_flying_seam_in_urscript_holds_the_plans_bead(flying_urscript, tmp_pat
     "seam starts at 0.03 m/s and 96.9 % of the bead is within ±5 %)",
 )
 def test_a_flying_seam_in_urscript_lays_the_bead_from_its_first_millimetre(flying_urscript):
-    """Issue 37's acceptance of the UR program's bead (``assert_holds_the_bead``)."""
+    """Issue 37's acceptance of the tape demo's own UR program's bead
+    (``assert_holds_the_bead``); a UR job that flies on its default leads holds it
+    (``test_a_flying_seam_in_urscript_on_its_default_leads_lays_the_bead``)."""
     job, folder, _, _, t, value, _ = flying_urscript
     assert_holds_the_bead(job, folder, t, replayed(job, t, value))
+
+
+@pytest.mark.slow
+def test_a_flying_seam_in_urscript_on_its_default_leads_lays_the_bead(tmp_path):
+    """Issue 37's acceptance on a UR job: the sealing demo's plate border carried by the
+    tape demo's UR10e (``replay_jobs.plate_on_ur10e``), flying on its default leads
+    (no ``motion.lead_mm``), exported to URScript: the servoj stream's flow replayed at
+    the plan's speed holds the plan's bead within 1 %, ≥ 99 % of the gun-on length
+    within ±5 %, no row beyond ±20 % and no gun-on row at a standstill; the gun is
+    switched by the command the tool is at where the plan sets it."""
+    cell = tmp_path / "plate_on_ur10e.yaml"
+    cell.write_text(plate_on_ur10e(CELLS), encoding="utf-8")
+    job, folder, data, ur = exported(cell, "urscript", flying=True)
+    entry = job.chosen[0].plan.entry
+    assert job.cell.motion.lead_mm is None and entry["lead_in_mm"] > UR_LEAD_MM, entry
+    script = (ur / "offline_prog.script").read_text(encoding="utf-8")
+    t, value, period = urscript_flow(job, script, 1)
+    assert_holds_the_bead(job, folder, t, replayed(job, t, value))
+    late = urscript_switch_errors(data, script, t)  # set as the command before ends
+    assert np.all(late >= 0.0) and late.max() <= job.cell.motion.speed * period + 1e-6, late
 
 
 def _compensation_rows(job):
