@@ -12,23 +12,35 @@ must already run at v, so it is added; likewise before the end for the lead-out.
 Where the seam's normal approach (retract) runs at the process speed, the default, a
 lead may take that move over: it lifts by the move's distance (``path.lead``) and the
 tool comes down onto the seam along one curve, with no stop at the move's foot; it
-does where that is the shorter run (``_lifts_m``): on the sealing demo, not on the
+does where that is the shorter run (``_taken_over``): on the sealing demo, not on the
 8 mm/s weld, whose ramps are too short for a stop to cost much.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import brentq
 
 from offline_prog.config.cell import Cell
 from offline_prog.config.process_speed import approach_speed
-from offline_prog.path.lead import LeadPath, lead_shape, unwrapped
+from offline_prog.path.lead import (
+    LIFT_POWER,
+    LIFT_RATIO,
+    MAX_LIFT_RATIO,
+    LeadPath,
+    unit_length,
+    unwrapped,
+)
 from offline_prog.process.registry import process_model
 from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.timing.time_law import sin2_time_law
 
 RAMP_MARGIN = 1.2  # the lead's ramp room, a share of the sin² law's ramp
 RAMP_SAMPLES = 4001  # time samples of the ramp that find where it reaches v
+# A lead that takes a normal move over holds the nozzle within this of its working
+# height where the valve is open before the seam [m].
+AT_HEIGHT_TOL_M = 1e-4
+BEND_SAMPLES = 4001  # samples of x ∈ [0, 1] that find a lift's largest curvature
 
 
 def ramp_length_m(v: float, *, a_max: float, j_max: float) -> float:
@@ -65,28 +77,90 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         length = motion.lead_mm * 1e-3
         return LeadPath(flange, lead_in_m=length, lead_out_m=length)
     length = RAMP_MARGIN * ramp + _switch_m(cell, v)
-    lifts = _lifts_m(inputs, length, ramp)
-    return LeadPath(flange, lead_in_m=length, lead_out_m=length, lifts_m=lifts)
+    (lead_in, lead_out), lifts = _taken_over(inputs, flange, length, ramp, a_max=caps.a_max)
+    return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, lifts_m=lifts)
 
 
-def _lifts_m(inputs, length: float, ramp: float) -> tuple[float, float]:
-    """The least lifts of the default leads [m] (a ``motion.lead_mm`` keeps its length
-    and own lift): a normal approach's (retract's) distance (``Inputs.normal_moves_m``)
-    where the lead takes that move over, 0 where not. It does where the move runs at
-    the process speed (the default ``motion.approach_speed``) and the one longer lead
-    is shorter than the lead, the rest of the straight move and its stop (two ramps of
-    ``ramp`` [m]) run at that speed: the tool then comes down onto the seam along one
-    curve."""
+def _taken_over(
+    inputs, flange, length: float, ramp: float, *, a_max: float
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """((lead-in, lead-out) asked lengths [m], their least lifts [m]) of the default
+    leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own lift). A lead
+    takes a normal approach (retract) of distance D (``Inputs.normal_moves_m``) over,
+    lifting by D, where the move runs at the process speed (the default
+    ``motion.approach_speed``) and that is the shorter run: the tool then comes down
+    onto the seam along one curve instead of stopping at the move's foot. Both runs
+    start from rest at the same height, so they compare as the leads' path lengths as
+    built (the seam's curvature and turn included) with a ramp counted as ``ramp`` [m]
+    (the time a ramp loses at v is ramp/v): the lead taken over with one ramp, against
+    the plain lead, the move's rest D − H and its stop and start (two more ramps). The
+    lead taken over turns onto the seam as sharply as the tool's acceleration allows
+    (:func:`takeover_extent_m`); its asked length is that of a plain lead of its extent
+    (``path.lead.lead_shape``), at least ``length``."""
     v = inputs.speed.v_m_s
-    if not np.isclose(approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12):
-        return 0.0, 0.0
-    _, plain_lift, plain = lead_shape(length)
-    lifts = []
-    for distance in inputs.normal_moves_m:
-        taken = lead_shape(length, distance)[2]
-        shorter = taken < plain + (distance - plain_lift) + 2.0 * ramp
-        lifts.append(distance if distance > plain_lift and shorter else 0.0)
-    return lifts[0], lifts[1]
+    moves = inputs.normal_moves_m
+    plain = ((length, length), (0.0, 0.0))
+    if not any(moves) or not np.isclose(
+        approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12
+    ):
+        return plain
+    at_height = _at_height_m(inputs.cell)
+    asked = [
+        max(
+            length,
+            unit_length(LIFT_RATIO) * takeover_extent_m(d, v=v, a_max=a_max, at_height_m=at_height),
+        )
+        for d in moves
+    ]
+    kept = LeadPath(flange, lead_in_m=length, lead_out_m=length)
+    taken = LeadPath(flange, lead_in_m=asked[0], lead_out_m=asked[1], lifts_m=moves)
+    kept_m = (kept.lead_in_m, kept.lead_out_m)
+    taken_m = (taken.lead_in_m, taken.lead_out_m)
+    take = [
+        d > lift and taken_m[i] + ramp < kept_m[i] + (d - lift) + 3.0 * ramp
+        for i, (d, lift) in enumerate(zip(moves, kept.lifts_m, strict=True))
+    ]
+    lengths = tuple(asked[i] if take[i] else length for i in (0, 1))
+    return lengths, tuple(moves[i] if take[i] else 0.0 for i in (0, 1))
+
+
+def takeover_extent_m(lift: float, *, v: float, a_max: float, at_height_m: float) -> float:
+    """The extent δ along the tangent [m] of a lead that lifts by ``lift`` [m] to take a
+    normal move over: the sharpest turn, H/δ up to MAX_LIFT_RATIO, whose centripetal
+    acceleration at v [m/s] stays within a_max [m/s²] (the lift h = H·|u/δ|⁴ on a
+    straight seam bends at most c(H/δ)/δ, :func:`_bend`), and at least as long as the
+    nozzle needs to be within AT_HEIGHT_TOL_M of its working height over the last
+    ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at that x)."""
+    if lift <= 0.0:
+        return 0.0
+
+    def excess(ratio: float) -> float:  # the turn's acceleration over a_max [m/s²]
+        return v**2 * _bend(np.array([ratio]))[0] * ratio / lift - a_max
+
+    if excess(MAX_LIFT_RATIO) <= 0.0:
+        ratio = MAX_LIFT_RATIO
+    elif excess(LIFT_RATIO) >= 0.0:
+        ratio = LIFT_RATIO
+    else:  # the excess grows with the ratio: the sharpest turn within a_max
+        ratio = brentq(excess, LIFT_RATIO, MAX_LIFT_RATIO, xtol=1e-6)
+    height = at_height_m * (lift / AT_HEIGHT_TOL_M) ** (1.0 / LIFT_POWER)
+    return max(lift / ratio, height)
+
+
+def _bend(ratios: np.ndarray) -> np.ndarray:
+    """c(r) = max over x ∈ [0, 1] of δ·κ of h = r·δ·x⁴ (N,): its curvature per extent."""
+    x = np.linspace(0.0, 1.0, BEND_SAMPLES)[None, :]
+    n, r = LIFT_POWER, ratios[:, None]
+    slope = n * r * x ** (n - 1)
+    return (n * (n - 1) * r * x ** (n - 2) / (1.0 + slope**2) ** 1.5).max(axis=1)
+
+
+def _at_height_m(cell: Cell) -> float:
+    """How far from a seam end its valve is open off the seam [m]: the switches'
+    ``lead_mm`` (their ``delay_s`` moves the command, not the valve)."""
+    io = cell.tool.process_io
+    switches = [s for s in (io.on, io.off) if s is not None] if io else []
+    return max([abs(s.lead_mm) * 1e-3 for s in switches] + [0.0])
 
 
 def _switch_m(cell: Cell, v: float) -> float:
@@ -109,7 +183,7 @@ def at_rest(flange: LeadPath, reason: str) -> LeadPath:
 
 def fallbacks(flange: LeadPath, reason: str) -> list[LeadPath]:
     """What a flying seam whose leads cannot be run tries next, in order: leads with
-    their own lift (where they took a normal move over, ``_lifts_m``), then both ends
+    their own lift (where they took a normal move over, ``_taken_over``), then both ends
     at rest for ``reason``."""
     rest = at_rest(flange, reason)
     if not any(flange.asked["lifts_m"]):
