@@ -71,6 +71,8 @@ class Inputs:
     # The seam's normal approach and retract distances [m] (0: another kind), which a
     # flying seam's leads take over (timing.lead_length); set by job.seams.seam_inputs.
     normal_moves_m: tuple[float, float] = (0.0, 0.0)
+    # Likewise the seam's tangent approach and retract distances [m].
+    tangent_moves_m: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclasses.dataclass

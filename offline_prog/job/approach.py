@@ -25,7 +25,7 @@ from offline_prog.config.cell import ApproachConfig
 from offline_prog.config.process_speed import approach_speed
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.path_ik import base_poses, branch_results
-from offline_prog.path.lead import path_ends
+from offline_prog.path.lead import path_ends, unwrapped
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.time_law import sin2_time_law
 from offline_prog.timing.trajectory import sample_times
@@ -34,6 +34,9 @@ TWO_PI = 2.0 * np.pi
 # A move whose joints would exceed their speed limits is re-timed slower by the excess
 # times this margin, at most this many times.
 SLOWDOWN_MARGIN, MAX_SLOWDOWNS = 1.05, 4
+# The shortest approach or retract left where a flying seam's lead runs most of it [m]:
+# a robot programmer writes no shorter move (the lead ends that near the move's start).
+MIN_MOVE_M = 1e-3
 
 
 @dataclasses.dataclass(frozen=True)
@@ -174,13 +177,21 @@ def seam_ends(
     R_PE = inputs.X_PE.rotation().matrix()
     ends = flange(np.array(path_ends(flange)))  # a flying seam's: its leads' far ends
     lifts = getattr(flange, "lifts_m", (0.0, 0.0))
+    seam_ends_F = unwrapped(flange)(np.array([0.0, unwrapped(flange).length]))
     moves = []
     for kind, i, spec, lift in (
         ("approach", 0, seam.approach, lifts[0]),
         ("retract", -1, seam.retract, lifts[1]),
     ):
-        if spec.kind == "normal" and lift > 0.0:  # the lead lifted the tool that much
-            spec = dataclasses.replace(spec, distance_mm=max(0.0, spec.distance_mm - lift * 1e3))
+        covered = 0.0  # [m] of the move the lead runs already
+        if spec.kind == "normal":  # the lead lifted the tool that much
+            covered = lift
+        elif spec.kind == "tangent":  # the lead ran that far along the seam's tangent
+            t_P = seam_ends_F.R_PF[i][:, 0]
+            covered = abs(float((ends.p_PF[i] - seam_ends_F.p_PF[i]) @ t_P))
+        if covered > 0.0:
+            left = spec.distance_mm * 1e-3 - covered
+            spec = dataclasses.replace(spec, distance_mm=left * 1e3 if left >= MIN_MOVE_M else 0.0)
         moves.append(
             cartesian_move(
                 inputs.robot,

@@ -28,6 +28,7 @@ from offline_prog.path.lead import (
     LIFT_RATIO,
     MAX_LIFT_RATIO,
     LeadPath,
+    lead_shape,
     unit_length,
     unwrapped,
 )
@@ -86,42 +87,43 @@ def _taken_over(
 ) -> tuple[tuple[float, float], tuple[float, float]]:
     """((lead-in, lead-out) asked lengths [m], their least lifts [m]) of the default
     leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own lift). A lead
-    takes a normal approach (retract) of distance D (``Inputs.normal_moves_m``) over,
-    lifting by D, where the move runs at the process speed (the default
-    ``motion.approach_speed``) and that is the shorter run: the tool then comes down
-    onto the seam along one curve instead of stopping at the move's foot. Both runs
-    start from rest at the same height, so they compare as the leads' path lengths as
-    built (the seam's curvature and turn included) with a ramp counted as ``ramp`` [m]
-    (the time a ramp loses at v is ramp/v): the lead taken over with one ramp, against
-    the plain lead, the move's rest D − H and its stop and start (two more ramps). The
-    lead taken over turns onto the seam as sharply as the tool's acceleration allows
-    (:func:`takeover_extent_m`); its asked length is that of a plain lead of its extent
-    (``path.lead.lead_shape``), at least ``length``."""
+    takes the approach (retract) over where the move runs at the process speed (the
+    default ``motion.approach_speed``) and that is the shorter run: the tool then comes
+    onto the seam along one curve instead of stopping at the move's foot. A normal move
+    of distance D (``Inputs.normal_moves_m``) is taken over by a lead lifting by D that
+    turns onto the seam as sharply as the tool's acceleration allows
+    (:func:`takeover_extent_m`), a tangent one (``Inputs.tangent_moves_m``) by a lead
+    whose extent along the tangent is D (``job.approach`` drops the move a lead's
+    extent covers, and shortens it by that extent otherwise). A lead's asked length is
+    that of a plain lead of its extent (``path.lead.lead_shape``), at least ``length``.
+    Both runs start from rest, so they compare as path lengths, the leads' as built (the
+    seam's curvature and turn included), with a ramp counted as ``ramp`` [m] (the time
+    a ramp loses at v is ramp/v): the lead taken over with one ramp, against the plain
+    lead, the move's rest and its stop and start (two more ramps)."""
     v = inputs.speed.v_m_s
-    moves = inputs.normal_moves_m
+    normal, tangent = inputs.normal_moves_m, inputs.tangent_moves_m
     plain = ((length, length), (0.0, 0.0))
-    if not any(moves) or not np.isclose(
+    if not any(normal + tangent) or not np.isclose(
         approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12
     ):
         return plain
     at_height = _at_height_m(inputs.cell)
-    asked = [
-        max(
-            length,
-            unit_length(LIFT_RATIO) * takeover_extent_m(d, v=v, a_max=a_max, at_height_m=at_height),
-        )
-        for d in moves
+    extents = [
+        takeover_extent_m(d, v=v, a_max=a_max, at_height_m=at_height) if d > 0.0 else t
+        for d, t in zip(normal, tangent, strict=True)
     ]
+    asked = [max(length, unit_length(LIFT_RATIO) * extent) for extent in extents]
     kept = LeadPath(flange, lead_in_m=length, lead_out_m=length)
-    taken = LeadPath(flange, lead_in_m=asked[0], lead_out_m=asked[1], lifts_m=moves)
-    kept_m = (kept.lead_in_m, kept.lead_out_m)
-    taken_m = (taken.lead_in_m, taken.lead_out_m)
-    take = [
-        d > lift and taken_m[i] + ramp < kept_m[i] + (d - lift) + 3.0 * ramp
-        for i, (d, lift) in enumerate(zip(moves, kept.lifts_m, strict=True))
-    ]
+    taken = LeadPath(flange, lead_in_m=asked[0], lead_out_m=asked[1], lifts_m=normal)
+    kept_extent = lead_shape(length)[0]
+    take = []
+    for i, taken_m, kept_m in zip(
+        (0, 1), (taken.lead_in_m, taken.lead_out_m), (kept.lead_in_m, kept.lead_out_m), strict=True
+    ):
+        rest = normal[i] - kept.lifts_m[i] if normal[i] > 0.0 else tangent[i] - kept_extent
+        take.append(rest > 0.0 and taken_m + ramp < kept_m + rest + 3.0 * ramp)
     lengths = tuple(asked[i] if take[i] else length for i in (0, 1))
-    return lengths, tuple(moves[i] if take[i] else 0.0 for i in (0, 1))
+    return lengths, tuple(normal[i] if take[i] else 0.0 for i in (0, 1))
 
 
 def takeover_extent_m(lift: float, *, v: float, a_max: float, at_height_m: float) -> float:
