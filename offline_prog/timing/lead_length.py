@@ -78,12 +78,14 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         length = motion.lead_mm * 1e-3
         return LeadPath(flange, lead_in_m=length, lead_out_m=length)
     length = RAMP_MARGIN * ramp + _switch_m(cell, v)
-    (lead_in, lead_out), lifts = _taken_over(inputs, flange, length, ramp, a_max=caps.a_max)
+    (lead_in, lead_out), lifts = _taken_over(
+        inputs, flange, length, ramp, a_max=caps.a_max, j_max=caps.j_max
+    )
     return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, lifts_m=lifts)
 
 
 def _taken_over(
-    inputs, flange, length: float, ramp: float, *, a_max: float
+    inputs, flange, length: float, ramp: float, *, a_max: float, j_max: float
 ) -> tuple[tuple[float, float], tuple[float, float]]:
     """((lead-in, lead-out) asked lengths [m], their least lifts [m]) of the default
     leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own lift). A lead
@@ -109,7 +111,7 @@ def _taken_over(
         return plain
     at_height = _at_height_m(inputs.cell)
     extents = [
-        takeover_extent_m(d, v=v, a_max=a_max, at_height_m=at_height) if d > 0.0 else t
+        takeover_extent_m(d, v=v, a_max=a_max, j_max=j_max, at_height_m=at_height) if d > 0.0 else t
         for d, t in zip(normal, tangent, strict=True)
     ]
     asked = [max(length, unit_length(LIFT_RATIO) * extent) for extent in extents]
@@ -126,35 +128,43 @@ def _taken_over(
     return lengths, tuple(normal[i] if take[i] else 0.0 for i in (0, 1))
 
 
-def takeover_extent_m(lift: float, *, v: float, a_max: float, at_height_m: float) -> float:
+def takeover_extent_m(
+    lift: float, *, v: float, a_max: float, j_max: float, at_height_m: float
+) -> float:
     """The extent δ along the tangent [m] of a lead that lifts by ``lift`` [m] to take a
     normal move over: the sharpest turn, H/δ up to MAX_LIFT_RATIO, whose centripetal
-    acceleration at v [m/s] stays within a_max [m/s²] (the lift h = H·|u/δ|⁴ on a
-    straight seam bends at most c(H/δ)/δ, :func:`_bend`), and at least as long as the
-    nozzle needs to be within AT_HEIGHT_TOL_M of its working height over the last
-    ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at that x)."""
+    acceleration v²·κ and its rate v³·dκ/ds at v [m/s] stay within a_max [m/s²] and
+    j_max [m/s³] (the lift h = H·|u/δ|⁴ on a straight seam bends at most c₁(H/δ)/δ, its
+    bend changing by at most c₂(H/δ)/δ² per metre: :func:`_bend`), and at least as long
+    as the nozzle needs to be within AT_HEIGHT_TOL_M of its working height over the
+    last ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at x)."""
     if lift <= 0.0:
         return 0.0
 
-    def excess(ratio: float) -> float:  # the turn's acceleration over a_max [m/s²]
-        return v**2 * _bend(np.array([ratio]))[0] * ratio / lift - a_max
+    def excess(ratio: float) -> float:  # the turn's acceleration or jerk over its cap, − 1
+        bend, rate = _bend(ratio)
+        extent = lift / ratio
+        return max(v**2 * bend / extent / a_max, v**3 * rate / extent**2 / j_max) - 1.0
 
     if excess(MAX_LIFT_RATIO) <= 0.0:
         ratio = MAX_LIFT_RATIO
     elif excess(LIFT_RATIO) >= 0.0:
         ratio = LIFT_RATIO
-    else:  # the excess grows with the ratio: the sharpest turn within a_max
+    else:  # the excess grows with the ratio: the sharpest turn within both caps
         ratio = brentq(excess, LIFT_RATIO, MAX_LIFT_RATIO, xtol=1e-6)
     height = at_height_m * (lift / AT_HEIGHT_TOL_M) ** (1.0 / LIFT_POWER)
     return max(lift / ratio, height)
 
 
-def _bend(ratios: np.ndarray) -> np.ndarray:
-    """c(r) = max over x ∈ [0, 1] of δ·κ of h = r·δ·x⁴ (N,): its curvature per extent."""
-    x = np.linspace(0.0, 1.0, BEND_SAMPLES)[None, :]
-    n, r = LIFT_POWER, ratios[:, None]
-    slope = n * r * x ** (n - 1)
-    return (n * (n - 1) * r * x ** (n - 2) / (1.0 + slope**2) ** 1.5).max(axis=1)
+def _bend(ratio: float) -> tuple[float, float]:
+    """(c₁, c₂) of the lift h = r·δ·x⁴, x ∈ [0, 1], over a straight seam: the largest
+    curvature times δ and the largest rate of curvature per arc length times δ²."""
+    x = np.linspace(0.0, 1.0, BEND_SAMPLES)
+    n = LIFT_POWER
+    slope = n * ratio * x ** (n - 1)
+    bend = n * (n - 1) * ratio * x ** (n - 2) / (1.0 + slope**2) ** 1.5
+    arc = np.sqrt(1.0 + slope**2)  # ds/dx per extent
+    return float(bend.max()), float(np.abs(np.gradient(bend, x) / arc).max())
 
 
 def _at_height_m(cell: Cell) -> float:
