@@ -78,9 +78,10 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         length = motion.lead_mm * 1e-3
         return LeadPath(flange, lead_in_m=length, lead_out_m=length)
     length = RAMP_MARGIN * ramp + _switch_m(cell, v)
-    (lead_in, lead_out), lifts = _taken_over(
-        inputs, flange, length, ramp, a_max=caps.a_max, j_max=caps.j_max
-    )
+    # The turn onto the seam changes the tool's heading, not its speed (nor the flow):
+    # it keeps to the robot's path limits, not the process model's caps.
+    turn = {"a_max": motion.max_acceleration, "j_max": motion.max_jerk}
+    (lead_in, lead_out), lifts = _taken_over(inputs, flange, length, ramp, **turn)
     return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, lifts_m=lifts)
 
 
