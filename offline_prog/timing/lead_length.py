@@ -9,11 +9,14 @@ lead-in the gun is switched before the seam's start (``lead_mm`` and the valve's
 ``delay_s`` at v) and the flow command leads by the dispenser's lag: that stretch
 must already run at v, so it is added; likewise before the end for the lead-out.
 
-Where the seam's normal approach (retract) runs at the process speed, the default, a
-lead may take that move over: it lifts by the move's distance (``path.lead``) and the
-tool comes down onto the seam along one curve, with no stop at the move's foot; it
-does where that is the shorter run (``_taken_over``): on the sealing demo, not on the
-8 mm/s weld, whose ramps are too short for a stop to cost much.
+Where the seam's approach (retract) runs at the process speed, the default, a lead
+may take that move over where that is the shorter run (``_taken_over``): the tool
+comes onto the seam along one curve, with no stop at the move's foot. A flying seam
+that stops at its lead's far end has as many ramps as one at rest and a longer path,
+so the take-over is what lets it be no slower: a normal move's lead lifts by the
+move's distance and turns onto the seam as sharply as the tool's path limits allow
+(on the 8 mm/s weld almost straight down: 2.3 mm along the tangent for a 50 mm lift),
+a tangent move's lead runs the move's distance along the tangent.
 """
 
 from __future__ import annotations
