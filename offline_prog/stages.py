@@ -68,9 +68,10 @@ class Inputs:
     # The process model's caps on the process stretch's time law (process.timing_bound);
     # False plans under the user's caps alone (the trade-off's comparison).
     process_bound: bool = True
-    # The seam's normal approach and retract distances [m] (0: another kind), which a
-    # flying seam's leads take over (timing.lead_length); set by job.seams.seam_inputs.
+    # The seam's normal (tangent) approach and retract distances [m] (0: another kind),
+    # which its leads may take over (timing.lead_length); job.seams.seam_inputs sets them.
     normal_moves_m: tuple[float, float] = (0.0, 0.0)
+    tangent_moves_m: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclasses.dataclass

@@ -3,7 +3,7 @@ with every seam at rest (``entry: rest``) and flying (``entry: flying``, the def
 in one process.
 
 Run: ``PYTHONPATH=. python scripts/flying_entry_figures.py [--cells NAME ...]
-[--approach-speed 0.05]``.
+[--approach-speed 0.05] [--baseline FOLDER]``.
 
 Prints per cell and entry: each seam's entry as planned (flying, or rest and why), the
 share of the gun-on length whose predicted quality (bead area, heat input, nip
@@ -15,7 +15,8 @@ count as approach and retract), and the leads' top tool speed against the seam's
 against its top (1 where a flying seam runs at one speed from its first millimetre;
 ``--cells seal_job_kr16``: a cell without a process model prints its motion alone).
 ``--approach-speed`` adds the weld demo's setting of the issue (approach and retract
-under 3 s). The programs
+under 3 s). ``--baseline FOLDER`` compares each cycle with a plan folder per cell
+(``FOLDER/<cell>/report.json``'s ``job.cycle_time_s``, e.g. an older main's). The programs
 replay the plan's outputs within 1 % (tests/process/test_replay.py,
 tests/robot_import/test_fanuc_job.py), so these are the programs' figures too.
 """
@@ -24,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import sys
 from pathlib import Path
 
@@ -91,7 +93,15 @@ def figures(job) -> dict:
     }
 
 
-def main(names: list[str], approach_speed: float | None) -> None:
+def baseline_cycle_s(folder: Path | None, name: str) -> float | None:
+    """The cycle time [s] of the cell's plan folder under ``folder`` (None without one)."""
+    report = None if folder is None else folder / name / "report.json"
+    if report is None or not report.is_file():
+        return None
+    return float(json.loads(report.read_text(encoding="utf-8"))["job"]["cycle_time_s"])
+
+
+def main(names: list[str], approach_speed: float | None, baseline: Path | None = None) -> None:
     for name in names:
         inputs = load_inputs(CELLS / f"{name}.yaml", ROBOTS_DIR)
         settings = {"rest": {"entry": "rest"}, "flying": {"entry": "flying"}}
@@ -130,11 +140,18 @@ def main(names: list[str], approach_speed: float | None) -> None:
                 f"seams' lowest tool speed / their top {f['seam_lowest']:.3f}"
             )
         print(f"{'':22s} cycle flying / rest {cycles['flying'] / cycles['rest']:.3f}")
+        before = baseline_cycle_s(baseline, name)
+        if before is not None:
+            print(
+                f"{'':22s} cycle flying {cycles['flying']:.3f} s against the baseline's "
+                f"{before:.3f} s ({cycles['flying'] - before:+.3f} s)"
+            )
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", nargs="*", help="cell stems (default: those with process:)")
     parser.add_argument("--approach-speed", type=float, default=0.05, help="m/s (weld demo)")
+    parser.add_argument("--baseline", type=Path, help="folder of plan folders per cell")
     args = parser.parse_args()
-    main(args.cells or process_cells(), args.approach_speed)
+    main(args.cells or process_cells(), args.approach_speed, args.baseline)

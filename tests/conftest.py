@@ -131,6 +131,24 @@ def planned_job(tmp_path_factory):
     return _planned_once(tmp_path_factory, plan_job, write_job_outputs)
 
 
+@pytest.fixture(scope="session")
+def planned_with_moves(tmp_path_factory):
+    """name ↦ (job plan, its JobProgramData): a demo cell planned once per session with
+    ``motion.approach_speed: 0.05``, so that its seams have straight approach and
+    retract moves (at the default, the process speed, a flying seam's leads take them
+    over and the programs write none)."""
+    cache = {}
+
+    def get(name: str):
+        if name not in cache:
+            text = (CELLS / f"{name}.yaml").read_text(encoding="utf-8")
+            text = text.replace("\nmotion:\n", "\nmotion:\n  approach_speed: 0.05\n", 1)
+            cache[name] = planned_text(text, tmp_path_factory.mktemp(f"{name}_moves"))
+        return cache[name]
+
+    return get
+
+
 def _one_seam(file: Path) -> bool:
     from offline_prog.config.cell import load_cell
 

@@ -211,6 +211,12 @@ class ApproachConfig:
         (timing.lead_length); 0 for a tangent move or none."""
         return self.distance_mm * 1e-3 if self.kind == "normal" else 0.0
 
+    @property
+    def tangent_m(self) -> float:
+        """The move's distance along the seam's tangent [m]: a flying seam's lead may
+        take it over (timing.lead_length); 0 for a normal move or none."""
+        return self.distance_mm * 1e-3 if self.kind == "tangent" else 0.0
+
 
 @dataclasses.dataclass
 class SeamConfig(PathConfig):

@@ -25,7 +25,7 @@ from offline_prog.config.cell import ApproachConfig
 from offline_prog.config.process_speed import approach_speed
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.joints.path_ik import base_poses, branch_results
-from offline_prog.path.lead import path_ends
+from offline_prog.path.lead import path_ends, unwrapped
 from offline_prog.robot.model import RobotModel
 from offline_prog.timing.time_law import sin2_time_law
 from offline_prog.timing.trajectory import sample_times
@@ -34,6 +34,9 @@ TWO_PI = 2.0 * np.pi
 # A move whose joints would exceed their speed limits is re-timed slower by the excess
 # times this margin, at most this many times.
 SLOWDOWN_MARGIN, MAX_SLOWDOWNS = 1.05, 4
+# The shortest approach or retract left where a flying seam's lead runs most of it [m]:
+# a robot programmer writes no shorter move (the lead ends that near the move's start).
+MIN_MOVE_M = 1e-3
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,14 +176,13 @@ def seam_ends(
     motion = inputs.cell.motion
     R_PE = inputs.X_PE.rotation().matrix()
     ends = flange(np.array(path_ends(flange)))  # a flying seam's: its leads' far ends
-    lifts = getattr(flange, "lifts_m", (0.0, 0.0))
+    covered = lead_covers_m(flange, seam)
     moves = []
-    for kind, i, spec, lift in (
-        ("approach", 0, seam.approach, lifts[0]),
-        ("retract", -1, seam.retract, lifts[1]),
+    for kind, i, spec, run in (
+        ("approach", 0, seam.approach, covered[0]),
+        ("retract", -1, seam.retract, covered[1]),
     ):
-        if spec.kind == "normal" and lift > 0.0:  # the lead lifted the tool that much
-            spec = dataclasses.replace(spec, distance_mm=max(0.0, spec.distance_mm - lift * 1e3))
+        spec = dataclasses.replace(spec, distance_mm=move_left_m(spec, run) * 1e3)
         moves.append(
             cartesian_move(
                 inputs.robot,
@@ -202,6 +204,38 @@ def seam_ends(
             )
         )
     return moves[0], moves[1]
+
+
+def lead_covers_m(flange, seam) -> tuple[float, float]:
+    """(approach, retract) [m]: how much of each move a flying seam's lead already runs
+    (0 at rest): a normal move's by the lead's lift, a tangent one's by the lead's reach
+    along the seam's tangent at that end.
+
+    Args:
+        flange: the seam's flange path as run (a ``path.lead.LeadPath`` when flying).
+        seam: its ``SeamConfig`` (the kinds of its approach and retract).
+    """
+    lifts = getattr(flange, "lifts_m", (0.0, 0.0))
+    inner = unwrapped(flange)
+    at_seam = inner(np.array([0.0, inner.length]))
+    far = flange(np.array(path_ends(flange)))  # the leads' far ends
+    covered = []
+    for i, spec in enumerate((seam.approach, seam.retract)):
+        if spec.kind == "normal":
+            covered.append(float(lifts[i]))
+        elif spec.kind == "tangent":
+            t_P = at_seam.R_PF[i][:, 0]
+            covered.append(abs(float((far.p_PF[i] - at_seam.p_PF[i]) @ t_P)))
+        else:
+            covered.append(0.0)
+    return covered[0], covered[1]
+
+
+def move_left_m(spec: ApproachConfig, covered: float) -> float:
+    """The distance [m] the approach (retract) ``spec`` still runs after a lead that
+    covers ``covered`` [m] of it: 0 where less than MIN_MOVE_M is left."""
+    left = spec.distance_mm * 1e-3 - covered
+    return left if covered <= 0.0 or left >= MIN_MOVE_M else 0.0
 
 
 def plan_ends(inputs, plan, seam) -> tuple[CartesianMove | None, CartesianMove | None]:

@@ -93,6 +93,7 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
         points=points,
         speed=process_speed(cell, k),
         normal_moves_m=moves,
+        tangent_moves_m=(seam.approach.tangent_m, seam.retract.tangent_m),
     )
 
 

@@ -320,8 +320,15 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
     if attempt is not None and attempt.collisions.collision_free:
         timer("collision", "collision avoidance: not needed", lambda: None)
         plan = Plan.of_attempt(u.inputs, u.fit, u.frames, attempt, timings_s=timer.timings_s)
-        options[i] = dataclasses.replace(option, plan=plan, untimed=None)
-        return options, True
+        moves = {"approach": option.approach, "retract": option.retract}
+        if attempt.flange is not u.run.flange:  # its leads fell back: the moves for these
+            try:
+                moves = dict(zip(moves, plan_ends(u.inputs, plan, seam), strict=True))
+            except PlanFailedError:
+                moves = None  # planned in full below
+        if moves is not None:
+            options[i] = dataclasses.replace(option, plan=plan, untimed=None, **moves)
+            return options, True
     # The direction planned in full from here: the collision avoidance for timed
     # samples that collide (no other branches offered then), or the failure named.
     block = []

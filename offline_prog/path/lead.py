@@ -51,8 +51,9 @@ LIFT_RATIO = 1.0
 # The lift's power: h = H·|u/δ|⁴ rises with zero slope, curvature and jerk.
 LIFT_POWER = 4
 # The most lift per extent of a lead that takes over a normal approach or retract: its
-# extent grows with the lift beyond it, so it turns onto the seam no sharper than this.
-MAX_LIFT_RATIO = 2.0
+# extent grows with the lift beyond it, so it turns onto the seam no sharper than this
+# (``timing.lead_length`` asks for a longer extent where the tool's acceleration needs it).
+MAX_LIFT_RATIO = 32.0
 # Samples of ℓ(u)/δ over u/δ ∈ [0, 1] that invert the lead's arc length (by cubic
 # Hermite interpolation with the exact slopes 1/g: u and du/dσ agree to ~1e-11).
 ARC_SAMPLES = 2001

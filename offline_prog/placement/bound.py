@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from offline_prog.job.approach import move_left_m
 from offline_prog.job.link_costs import ptp_time
 from offline_prog.placement.variants import SeamVariants
 from offline_prog.timing.time_law import sin2_time_law
@@ -62,15 +63,13 @@ def _ramp_speeds(sigma: np.ndarray, *, v: float, a: float) -> np.ndarray:
     return np.minimum(v, np.minimum(rise, fall))
 
 
-def end_moves_s(seam, motion, speed: float, *, lifts: tuple[float, float] = (0.0, 0.0)) -> float:
+def end_moves_s(seam, motion, speed: float, *, covered: tuple[float, float] = (0.0, 0.0)) -> float:
     """The approach's and retract's sin² durations [s] (``job.approach``: at the seam's
-    process speed ``speed`` [m/s]); ``lifts`` [m]: a flying seam's leads' (approach,
-    retract), by which its normal moves are shorter (``job.approach.seam_ends``)."""
+    process speed ``speed`` [m/s]); ``covered`` [m]: how much of (approach, retract) a
+    flying seam's leads run already (``job.approach.lead_covers_m``)."""
     total = 0.0
-    for spec, lift in zip((seam.approach, seam.retract), lifts, strict=True):
-        d = spec.distance_mm * 1e-3
-        if spec.kind == "normal":
-            d = max(0.0, d - lift)
+    for spec, run in zip((seam.approach, seam.retract), covered, strict=True):
+        d = move_left_m(spec, run)
         if spec.kind != "none" and d > 0.0:
             law = sin2_time_law(
                 d, v_max=speed, a_max=motion.max_acceleration, j_max=motion.max_jerk

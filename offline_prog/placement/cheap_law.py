@@ -48,18 +48,17 @@ def planner_flange(view, X_IT: RigidTransform, X_PE: RigidTransform, phi: float)
 
 def law_seam_s(
     view, variants: SeamVariants, X_IT: RigidTransform, X_PE: RigidTransform
-) -> tuple[float, tuple[float, float]]:
+) -> tuple[float, object]:
     """(the cheaper law's duration of a seam on the planner's variant [s], NaN when no
-    variant is feasible or TOPP-RA finds no profile; its leads' lifts [m]): a flying
-    seam's law runs its leads too, and a lead that took a normal approach or retract
-    over lifted the tool by (part of) its distance (``path.lead``)."""
+    variant is feasible or TOPP-RA finds no profile; the flange path it runs): a flying
+    seam's law runs its leads too, and a lead runs part of the approach and retract
+    (``job.approach.lead_covers_m`` of that path)."""
     choice = variants.planner_choice()
     if choice is None:
-        return float("nan"), (0.0, 0.0)
+        return float("nan"), None
     a, branch = choice
     inputs, robot = view.inputs, view.inputs.robot
     run = motion_setup(inputs, planner_flange(view, X_IT, X_PE, float(variants.angles[a])))
-    lifts = run.flange.lifts_m
     grid = np.linspace(0.0, run.parameter.length, LAW_GRID_POINTS)
     # The variant's q on the screen's σ samples, as the 2π reference of the exact IK.
     fraction = variants.sigma / variants.sigma[-1]
@@ -69,7 +68,7 @@ def law_seam_s(
     path = BranchPath(robot, inputs.X_IB, run.flange, run.parameter, branch)
     rates = path.rates(grid, q_near)
     if not np.isfinite(rates.q).all():
-        return float("nan"), lifts
+        return float("nan"), run.flange
     controller = JointRates(
         rates.sigma, *(robot.controller_joints(v) for v in (rates.q, rates.dq, rates.ddq))
     )
@@ -80,4 +79,4 @@ def law_seam_s(
         v_cap=run.limits.v_process,
         a_path=run.limits.a_max,
     )
-    return (float(profile.duration) if profile.ok else float("nan")), lifts
+    return (float(profile.duration) if profile.ok else float("nan")), run.flange

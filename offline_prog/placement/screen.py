@@ -23,6 +23,7 @@ import time
 
 import numpy as np
 
+from offline_prog.job.approach import lead_covers_m
 from offline_prog.job.seams import job_config, job_seams
 from offline_prog.joints.path_ik import singularity_distances
 from offline_prog.placement.bound import SeamTimes, end_moves_s, job_times, seam_times
@@ -158,11 +159,11 @@ def rank(ctx: Context, candidate: Candidate) -> Evaluation:
     X_IT, X_PE = rigid(candidate.X_IT), rigid(candidate.X_PE)
     times = []
     for view, seam, (v, t) in zip(ctx.seams, job_seams(ctx.inputs.cell), seams, strict=True):
-        law, lifts = law_seam_s(view, v, X_IT, X_PE)  # a flying seam's leads included
+        law, flange = law_seam_s(view, v, X_IT, X_PE)  # a flying seam's leads included
         motion, speed = view.inputs.cell.motion, view.inputs.speed.v_m_s
-        times.append(
-            dataclasses.replace(t, estimate_s=law + end_moves_s(seam, motion, speed, lifts=lifts))
-        )
+        covered = (0.0, 0.0) if flange is None else lead_covers_m(flange, seam)
+        moves = end_moves_s(seam, motion, speed, covered=covered)
+        times.append(dataclasses.replace(t, estimate_s=law + moves))
     _, estimate = job_times(times, home_c(ctx), ctx.inputs.robot)
     inputs = placed_inputs(ctx, candidate)
     motion = inputs.cell.motion

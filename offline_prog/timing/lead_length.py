@@ -9,26 +9,42 @@ lead-in the gun is switched before the seam's start (``lead_mm`` and the valve's
 ``delay_s`` at v) and the flow command leads by the dispenser's lag: that stretch
 must already run at v, so it is added; likewise before the end for the lead-out.
 
-Where the seam's normal approach (retract) runs at the process speed, the default, a
-lead may take that move over: it lifts by the move's distance (``path.lead``) and the
-tool comes down onto the seam along one curve, with no stop at the move's foot; it
-does where that is the shorter run (``_lifts_m``): on the sealing demo, not on the
-8 mm/s weld, whose ramps are too short for a stop to cost much.
+Where the seam's approach (retract) runs at the process speed, the default, a lead
+may take that move over where that is the shorter run (``_taken_over``): the tool
+comes onto the seam along one curve, with no stop at the move's foot. A flying seam
+that stops at its lead's far end has as many ramps as one at rest and a longer path,
+so the take-over is what lets it be no slower: a normal move's lead lifts by the
+move's distance and turns onto the seam as sharply as the tool's path limits allow
+(on the 8 mm/s weld almost straight down: 2.3 mm along the tangent for a 50 mm lift),
+a tangent move's lead runs the move's distance along the tangent.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.optimize import brentq
 
 from offline_prog.config.cell import Cell
 from offline_prog.config.process_speed import approach_speed
-from offline_prog.path.lead import LeadPath, lead_shape, unwrapped
+from offline_prog.path.lead import (
+    LIFT_POWER,
+    LIFT_RATIO,
+    MAX_LIFT_RATIO,
+    LeadPath,
+    lead_shape,
+    unit_length,
+    unwrapped,
+)
 from offline_prog.process.registry import process_model
 from offline_prog.process.timing_bound import ProcessCaps
 from offline_prog.timing.time_law import sin2_time_law
 
 RAMP_MARGIN = 1.2  # the lead's ramp room, a share of the sin² law's ramp
 RAMP_SAMPLES = 4001  # time samples of the ramp that find where it reaches v
+# A lead that takes a normal move over holds the nozzle within this of its working
+# height where the valve is open before the seam [m].
+AT_HEIGHT_TOL_M = 1e-4
+BEND_SAMPLES = 4001  # samples of x ∈ [0, 1] that find a lift's largest curvature
 
 
 def ramp_length_m(v: float, *, a_max: float, j_max: float) -> float:
@@ -65,28 +81,102 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
         length = motion.lead_mm * 1e-3
         return LeadPath(flange, lead_in_m=length, lead_out_m=length)
     length = RAMP_MARGIN * ramp + _switch_m(cell, v)
-    lifts = _lifts_m(inputs, length, ramp)
-    return LeadPath(flange, lead_in_m=length, lead_out_m=length, lifts_m=lifts)
+    # The turn onto the seam changes the tool's heading, not its speed (nor the flow):
+    # it keeps to the robot's path limits, not the process model's caps.
+    turn = {"a_max": motion.max_acceleration, "j_max": motion.max_jerk}
+    (lead_in, lead_out), lifts = _taken_over(inputs, flange, length, ramp, **turn)
+    return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, lifts_m=lifts)
 
 
-def _lifts_m(inputs, length: float, ramp: float) -> tuple[float, float]:
-    """The least lifts of the default leads [m] (a ``motion.lead_mm`` keeps its length
-    and own lift): a normal approach's (retract's) distance (``Inputs.normal_moves_m``)
-    where the lead takes that move over, 0 where not. It does where the move runs at
-    the process speed (the default ``motion.approach_speed``) and the one longer lead
-    is shorter than the lead, the rest of the straight move and its stop (two ramps of
-    ``ramp`` [m]) run at that speed: the tool then comes down onto the seam along one
-    curve."""
+def _taken_over(
+    inputs, flange, length: float, ramp: float, *, a_max: float, j_max: float
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """((lead-in, lead-out) asked lengths [m], their least lifts [m]) of the default
+    leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own lift). A lead
+    takes the approach (retract) over where the move runs at the process speed (the
+    default ``motion.approach_speed``) and that is the shorter run: the tool then comes
+    onto the seam along one curve instead of stopping at the move's foot. A normal move
+    of distance D (``Inputs.normal_moves_m``) is taken over by a lead lifting by D that
+    turns onto the seam as sharply as the tool's acceleration allows
+    (:func:`takeover_extent_m`), a tangent one (``Inputs.tangent_moves_m``) by a lead
+    whose extent along the tangent is D (``job.approach`` drops the move a lead's
+    extent covers, and shortens it by that extent otherwise). A lead's asked length is
+    that of a plain lead of its extent (``path.lead.lead_shape``), at least ``length``.
+    Both runs start from rest, so they compare as path lengths, the leads' as built (the
+    seam's curvature and turn included), with a ramp counted as ``ramp`` [m] (the time
+    a ramp loses at v is ramp/v): the lead taken over with one ramp, against the plain
+    lead, the move's rest and its stop and start (two more ramps)."""
     v = inputs.speed.v_m_s
-    if not np.isclose(approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12):
-        return 0.0, 0.0
-    _, plain_lift, plain = lead_shape(length)
-    lifts = []
-    for distance in inputs.normal_moves_m:
-        taken = lead_shape(length, distance)[2]
-        shorter = taken < plain + (distance - plain_lift) + 2.0 * ramp
-        lifts.append(distance if distance > plain_lift and shorter else 0.0)
-    return lifts[0], lifts[1]
+    normal, tangent = inputs.normal_moves_m, inputs.tangent_moves_m
+    plain = ((length, length), (0.0, 0.0))
+    if not any(normal + tangent) or not np.isclose(
+        approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12
+    ):
+        return plain
+    at_height = _at_height_m(inputs.cell)
+    extents = [
+        takeover_extent_m(d, v=v, a_max=a_max, j_max=j_max, at_height_m=at_height) if d > 0.0 else t
+        for d, t in zip(normal, tangent, strict=True)
+    ]
+    asked = [max(length, unit_length(LIFT_RATIO) * extent) for extent in extents]
+    kept = LeadPath(flange, lead_in_m=length, lead_out_m=length)
+    taken = LeadPath(flange, lead_in_m=asked[0], lead_out_m=asked[1], lifts_m=normal)
+    kept_extent = lead_shape(length)[0]
+    take = []
+    for i, taken_m, kept_m in zip(
+        (0, 1), (taken.lead_in_m, taken.lead_out_m), (kept.lead_in_m, kept.lead_out_m), strict=True
+    ):
+        rest = normal[i] - kept.lifts_m[i] if normal[i] > 0.0 else tangent[i] - kept_extent
+        take.append(rest > 0.0 and taken_m + ramp < kept_m + rest + 3.0 * ramp)
+    lengths = tuple(asked[i] if take[i] else length for i in (0, 1))
+    return lengths, tuple(normal[i] if take[i] else 0.0 for i in (0, 1))
+
+
+def takeover_extent_m(
+    lift: float, *, v: float, a_max: float, j_max: float, at_height_m: float
+) -> float:
+    """The extent δ along the tangent [m] of a lead that lifts by ``lift`` [m] to take a
+    normal move over: the sharpest turn, H/δ up to MAX_LIFT_RATIO, whose centripetal
+    acceleration v²·κ and its rate v³·dκ/ds at v [m/s] stay within a_max [m/s²] and
+    j_max [m/s³] (the lift h = H·|u/δ|⁴ on a straight seam bends at most c₁(H/δ)/δ, its
+    bend changing by at most c₂(H/δ)/δ² per metre: :func:`_bend`), and at least as long
+    as the nozzle needs to be within AT_HEIGHT_TOL_M of its working height over the
+    last ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at x)."""
+    if lift <= 0.0:
+        return 0.0
+
+    def excess(ratio: float) -> float:  # the turn's acceleration or jerk over its cap, − 1
+        bend, rate = _bend(ratio)
+        extent = lift / ratio
+        return max(v**2 * bend / extent / a_max, v**3 * rate / extent**2 / j_max) - 1.0
+
+    if excess(MAX_LIFT_RATIO) <= 0.0:
+        ratio = MAX_LIFT_RATIO
+    elif excess(LIFT_RATIO) >= 0.0:
+        ratio = LIFT_RATIO
+    else:  # the excess grows with the ratio: the sharpest turn within both caps
+        ratio = brentq(excess, LIFT_RATIO, MAX_LIFT_RATIO, xtol=1e-6)
+    height = at_height_m * (lift / AT_HEIGHT_TOL_M) ** (1.0 / LIFT_POWER)
+    return max(lift / ratio, height)
+
+
+def _bend(ratio: float) -> tuple[float, float]:
+    """(c₁, c₂) of the lift h = r·δ·x⁴, x ∈ [0, 1], over a straight seam: the largest
+    curvature times δ and the largest rate of curvature per arc length times δ²."""
+    x = np.linspace(0.0, 1.0, BEND_SAMPLES)
+    n = LIFT_POWER
+    slope = n * ratio * x ** (n - 1)
+    bend = n * (n - 1) * ratio * x ** (n - 2) / (1.0 + slope**2) ** 1.5
+    arc = np.sqrt(1.0 + slope**2)  # ds/dx per extent
+    return float(bend.max()), float(np.abs(np.gradient(bend, x) / arc).max())
+
+
+def _at_height_m(cell: Cell) -> float:
+    """How far from a seam end its valve is open off the seam [m]: the switches'
+    ``lead_mm`` (their ``delay_s`` moves the command, not the valve)."""
+    io = cell.tool.process_io
+    switches = [s for s in (io.on, io.off) if s is not None] if io else []
+    return max([abs(s.lead_mm) * 1e-3 for s in switches] + [0.0])
 
 
 def _switch_m(cell: Cell, v: float) -> float:
@@ -109,7 +199,7 @@ def at_rest(flange: LeadPath, reason: str) -> LeadPath:
 
 def fallbacks(flange: LeadPath, reason: str) -> list[LeadPath]:
     """What a flying seam whose leads cannot be run tries next, in order: leads with
-    their own lift (where they took a normal move over, ``_lifts_m``), then both ends
+    their own lift (where they took a normal move over, ``_taken_over``), then both ends
     at rest for ``reason``."""
     rest = at_rest(flange, reason)
     if not any(flange.asked["lifts_m"]):

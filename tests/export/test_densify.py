@@ -109,8 +109,11 @@ def written_points(data, fmt: str, folder, rule: PointRule):
     else:
         text = (folder / "OfflineProg.mod").read_text()
         targets = dict(re.findall(r"robtarget (\w+) := \[(\[[^\]]*\],\[[^\]]*\])", text))
-        names = ["pA1"] + [f"seam_1_{m}" for m in range(1, len(indices))]
+        first = ["pA1"] if run.approach is not None else []  # else the link's MoveAbsJ
+        names = first + [f"seam_1_{m}" for m in range(1 - len(first), len(indices))]
         X_PT = np.array([rapid_pose(targets[n]) for n in names])
+        if run.approach is None:  # the link's last MoveAbsJ reaches the first point
+            X_PT = np.concatenate([rapid_absj_tool_in_part(data, text)[None], X_PT])
     assert len(X_PT) == len(indices)
     return seam.path_m[indices], X_PT, (run.process.max_chord_m, run.process.max_angle_rad)
 
@@ -127,6 +130,21 @@ def krl_ptp_tool_in_part(data, folder) -> np.ndarray:
     fields = {k: float(v) for k, v in (i.split() for i in axes.split(","))}
     q = np.deg2rad([fields[f"A{i}"] for i in range(1, 7)])
     X_BE = load_robot(data.robot).forward(q[None])[0]
+    rows = data.job
+    return np.linalg.inv(X_BE @ rows.X_EP) @ rows.X_BT  # X_PT = X_PE · X_EB · X_BT
+
+
+def rapid_absj_tool_in_part(data, text: str) -> np.ndarray:
+    """(4, 4) X_PT of the main routine's last MoveAbsJ before the seam's routine is
+    called: the jointtarget [deg] through the robot's forward kinematics."""
+    from offline_prog.robot.model import load_robot
+
+    before = text[: text.index("\n    seam_1;")]
+    name = re.findall(r"MoveAbsJ (\w+)\\NoEOffs", before)[-1]
+    axes = re.search(rf"jointtarget {name} := \[\[([^\]]*)\]", text)[1]
+    robot = load_robot(data.robot)
+    q = robot.urdf_joints(np.deg2rad([float(a) for a in axes.split(",")]))
+    X_BE = robot.forward(q[None])[0]
     rows = data.job
     return np.linalg.inv(X_BE @ rows.X_EP) @ rows.X_BT  # X_PT = X_PE · X_EB · X_BT
 

@@ -73,10 +73,15 @@ def off_seam(data: JobProgramData, *, approach_m_s: float, link_percent: float):
     return dataclasses.replace(data, job=job, seams=seams)
 
 
-def test_the_approach_speed_and_the_link_override_are_written(plans, planned_job, tmp_path):
+def test_the_approach_speed_and_the_link_override_are_written(
+    planned_with_moves, planned_job, tmp_path
+):
     """Approach and retract LIN / MoveL at motion.approach_speed; KRL's PTP override
-    and URScript's movej speed at motion.link_speed_percent (issue 37)."""
-    kuka, abb = (off_seam(d, approach_m_s=0.05, link_percent=40.0) for d in plans)
+    and URScript's movej speed at motion.link_speed_percent (issue 37). (The demos
+    planned with straight approach and retract moves: at the default approach speed a
+    flying seam's leads take them over.)"""
+    with_moves = [planned_with_moves(n)[1] for n in ("seal_plate_kr16", "weld_seam_irb2400")]
+    kuka, abb = (off_seam(d, approach_m_s=0.05, link_percent=40.0) for d in with_moves)
     krl = "".join(f.read_text() for f in export(kuka, "krl", tmp_path / "krl"))
     assert "BAS(#VEL_PTP,40)" in krl
     assert "$VEL.CP=0.0500" in krl

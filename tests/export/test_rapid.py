@@ -17,7 +17,6 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from offline_prog.export.abb.abb import confdata
 from offline_prog.export.formats import export
-from offline_prog.export.job_program import JobProgramData
 from offline_prog.export.points import PointRule
 from offline_prog.export.record import program_record
 from offline_prog.robot.model import ROBOTS_DIR, load_robot
@@ -125,9 +124,10 @@ def drake_cfx(q: np.ndarray) -> int:
 
 
 @pytest.fixture(scope="module")
-def data(planned_job):
-    """The weld demo (a one-seam job)."""
-    return JobProgramData.load(planned_job("weld_seam_irb2400")[1])
+def data(planned_with_moves):
+    """The weld demo (a one-seam job) with its approach and retract at 50 mm/s (the
+    issue's setting: straight MoveL moves; at 8 mm/s its leads take them over)."""
+    return planned_with_moves("weld_seam_irb2400")[1]
 
 
 @pytest.fixture(scope="module")

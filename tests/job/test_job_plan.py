@@ -9,6 +9,7 @@ import pytest
 from gripper_clearance import GRIPPER_CLEARANCE_TOL_M, gripper_clearance
 
 from offline_prog.config.cell import load_cell
+from offline_prog.job.approach import MIN_MOVE_M
 from offline_prog.robot.model import load_robot
 from offline_prog.robot.record import folder_sha256
 from offline_prog.scene.drake_cell import build_cell_model
@@ -107,8 +108,12 @@ def test_approach_and_retract_distances_as_asked(job):
                 assert length == 0.0 or abs(abs(chord[2]) - length) < 1e-6
                 if lead_in == 0.0:  # at rest: the straight move alone
                     assert length == pytest.approx(d, abs=1e-6), (option.name, end)
-            else:  # tangent: the straight move runs the asked distance
+            elif lead_in == 0.0:  # tangent at rest: the straight move runs the asked distance
                 assert length == pytest.approx(d, abs=1e-6), (option.name, end)
+            else:  # tangent, flying: the lead runs it along the tangent (the move the rest)
+                leaving = p_PT[0] if end == "approach" else p_PT[-1]
+                along = np.linalg.norm((leaving - on_seam)[:2])  # in the plate's plane
+                assert along == pytest.approx(d, abs=MIN_MOVE_M), (option.name, end)
     assert flying == len(plan.chosen)  # the default: every seam runs flying
 
 

@@ -1,0 +1,77 @@
+"""How long a flying seam's leads are and whether they take a normal move over
+(``timing.lead_length``): the turn onto the seam within the tool's acceleration, and the
+weld demo no slower flying than at rest."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO
+from offline_prog.plan import StageTimer, plan_loaded_job
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.stages import load_inputs
+from offline_prog.timing.lead_length import AT_HEIGHT_TOL_M, takeover_extent_m
+
+from conftest import CELLS
+
+ACCELERATION_RTOL = 1e-3  # the finite-difference curvature against the sized one
+
+
+@pytest.mark.parametrize(
+    ("v", "a_max", "j_max", "lift", "at_height"),
+    [
+        (0.008, 0.5, 5.0, 0.05, 0.0),  # the TIG weld demo
+        (0.1, 1.0, 10.0, 0.05, 0.0),  # the sealing demo
+        (0.1, 1.0, 10.0, 0.05, 0.005),  # the sealing job: the gun opens 5 mm before
+        (0.05, 1.0, 10.0, 0.03, 0.0),
+        (0.001, 1.0, 10.0, 0.05, 0.0),  # slow: MAX_LIFT_RATIO binds
+    ],
+)
+def test_a_lead_taking_a_move_over_turns_within_the_tools_limits(v, a_max, j_max, lift, at_height):
+    """The lift h = H·(u/δ)⁴ of a lead that takes a normal move of H over bends, run at
+    the process speed v, with a centripetal acceleration v²κ and jerk v³·dκ/ds within
+    the cell's max_acceleration and max_jerk (one of them at its cap unless
+    MAX_LIFT_RATIO or the valve's stretch binds), and where the valve is open the
+    nozzle is within AT_HEIGHT_TOL_M of its working height."""
+    extent = takeover_extent_m(lift, v=v, a_max=a_max, j_max=j_max, at_height_m=at_height)
+    u = np.linspace(0.0, extent, 100_001)
+    k = lift / extent**LIFT_POWER  # h = k·u⁴ and its derivatives in u, exactly
+    dh, ddh, dddh = 4.0 * k * u**3, 12.0 * k * u**2, 24.0 * k * u
+    bend = ddh / (1.0 + dh**2) ** 1.5  # κ [1/m]
+    bend_rate = (dddh / (1.0 + dh**2) ** 1.5 - 3.0 * ddh**2 * dh / (1.0 + dh**2) ** 2.5) / (
+        1.0 + dh**2
+    ) ** 0.5  # dκ/ds [1/m²]
+    acceleration = v**2 * np.abs(bend).max() / a_max
+    jerk = v**3 * np.abs(bend_rate).max() / j_max
+    assert max(acceleration, jerk) <= 1.0 + ACCELERATION_RTOL
+    bound = lift / extent == pytest.approx(MAX_LIFT_RATIO) or at_height > 0.0
+    assert bound or max(acceleration, jerk) >= 1.0 - ACCELERATION_RTOL
+    assert lift * (at_height / extent) ** LIFT_POWER <= AT_HEIGHT_TOL_M * (1.0 + 1e-9)
+
+
+def _job(entry: str):
+    inputs = load_inputs(CELLS / "weld_seam_irb2400.yaml", ROBOTS_DIR)
+    cell = inputs.cell
+    cell = dataclasses.replace(cell, path=dataclasses.replace(cell.path, entry=entry))
+    return plan_loaded_job(
+        dataclasses.replace(inputs, cell=cell),
+        StageTimer(lambda stage: None),
+        clearance_profile=False,
+    )
+
+
+@pytest.mark.slow
+def test_the_weld_demo_flying_is_no_slower_than_at_rest():
+    """The 8 mm/s TIG demo, flying: its leads take the 50 mm approach and retract over
+    (the torch comes down onto the seam along one curve), the seam runs at 8 mm/s from
+    its first millimetre to its last, and the cycle is no longer than at rest."""
+    flying, rest = _job("flying"), _job("rest")
+    assert flying.feasible and rest.feasible
+    plan = flying.chosen[0].plan
+    assert plan.entry["entry"] == "flying"
+    assert plan.flange.lifts_m == pytest.approx((0.05, 0.05))
+    assert flying.chosen[0].approach is None and flying.chosen[0].retract is None
+    speed = plan.trajectory.tcp_speed
+    assert speed.min() == pytest.approx(0.008, rel=1e-3)
+    assert flying.samples.t[-1] <= rest.samples.t[-1]
