@@ -344,16 +344,16 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
         known |= {"joints": unchecked, "check": attempt}
     except PlanFailedError:
         attempt = None  # the full plan below says why, as it did for every option
-    # Its approach and retract hold for the leads it was decided on (not a fallback's).
-    as_decided = attempt is not None and attempt.flange.asked == u.run.flange.asked
-    if as_decided and attempt.collisions.collision_free:
+    # A fallback's approach and retract hold for the leads it was decided on only.
+    free = attempt is not None and attempt.collisions.collision_free
+    if free and (u.start is None or attempt.flange.asked == u.run.flange.asked):
         timer("collision", "collision avoidance: not needed", lambda: None)
         plan = Plan.of_attempt(u.inputs, u.fit, u.frames, attempt, timings_s=timer.timings_s)
         options[i] = dataclasses.replace(option, plan=plan, untimed=None)
         return options, True
     # The direction planned in full from here: the collision avoidance for timed
-    # samples that collide (no other branches offered then), a timed plan on other
-    # leads than decided with its own approach and retract, or the failure named.
+    # samples that collide (no other branches offered then), a fallback's timed plan on
+    # other leads than decided with its own approach and retract, or the failure named.
     block = []
     try:
         plan = seam_planner(option.seam, reverse, u.inputs, scene, known=known)
