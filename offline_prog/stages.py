@@ -39,7 +39,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import fallbacks, with_leads
+from offline_prog.timing.lead_length import fallbacks, lead_failure, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -263,8 +263,7 @@ def plan_motion(
     except PlanFailedError as error:
         if not run.flange.flying:
             raise
-        reason = f"the lead-in or lead-out: {error.failure.reason}"
-        for leads in fallbacks(run.flange, reason):
+        for leads in fallbacks(run.flange, lead_failure(error.failure.reason)):
             run = motion_setup(inputs, leads)
             try:
                 joints = _joint_trajectory(inputs, run, branch)

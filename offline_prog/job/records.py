@@ -167,9 +167,14 @@ class UntimedSeam:
             them.
         first: the direction's first option (best rotation and branch); the others
             are the further branches offered beside it.
-        run: ``motion_setup`` of ``flange``; branches: every IK branch's verdict on
-            its σ grid (``path_branches``): the timed plan starts from them
-            (``stages.plan_motion``).
+        run: ``motion_setup`` of ``flange`` as run (the leads' fallback, below);
+            branches: every IK branch's verdict on its σ grid (``path_branches``): the
+            timed plan starts from them (``stages.plan_motion``).
+        start: where no branch follows the leads first asked, and ``run`` holds the
+            fallback ``stages.plan_motion`` turns to (``timing.lead_length.fallbacks``),
+            that path's ``motion_setup`` and verdicts: the direction's first timed plan
+            starts there and walks the same fallbacks as a plan in full (None: it
+            starts from ``run``).
     """
 
     inputs: Inputs
@@ -182,6 +187,7 @@ class UntimedSeam:
     first: bool
     run: MotionSetup
     branches: list[BranchResult]
+    start: tuple[MotionSetup, list[BranchResult]] | None = None
 
 
 @dataclasses.dataclass

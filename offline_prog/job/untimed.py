@@ -42,6 +42,7 @@ from offline_prog.stages import (
     motion_setup,
     plan_motion,
 )
+from offline_prog.timing.lead_length import fallbacks, lead_failure
 
 MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
 
@@ -88,8 +89,10 @@ def untimed_options(
     if inputs.robot.family == "drake":  # no analytic branches: planned in full
         return None
     rotation, flange = frames.rotations[0]
-    run = motion_setup(inputs, flange)
-    first, results = _untimed(inputs, scene, fit, frames, rotation, flange, run, None)
+    run, results, start = _first_run(inputs, flange)
+    first, results = _untimed(
+        inputs, scene, fit, frames, rotation, flange, run, None, results, start=start
+    )
     if first is None:
         return None
     try:
@@ -116,6 +119,26 @@ def untimed_options(
     return options
 
 
+def _first_run(inputs: Inputs, flange) -> tuple[MotionSetup, list, tuple | None]:
+    """The path a direction's first option runs on, as ``stages.plan_motion`` runs it
+    before its time law: (``motion_setup`` of ``flange``, every IK branch's verdict on
+    its grid, None); where no branch follows a flying path, the first of its leads'
+    fallbacks (``timing.lead_length.fallbacks``: own lift, then rest) one does, as
+    (its setup, its verdicts, (the path as first asked, its verdicts)): the timed plan
+    starts there and walks the same fallbacks (a fallback that cannot be timed)."""
+    run = motion_setup(inputs, flange)
+    robot, X_IB = inputs.robot, inputs.X_IB
+    _, results, chosen, _ = path_branches(robot, X_IB, run.flange, run.parameter)
+    if chosen.feasible or not run.flange.flying:
+        return run, results, None
+    for leads in fallbacks(run.flange, lead_failure(chosen.reason)):
+        again = motion_setup(inputs, leads)
+        _, found, followed, _ = path_branches(robot, X_IB, again.flange, again.parameter)
+        if followed.feasible:
+            return again, found, (run, results)
+    return run, results, None  # no branch follows it at rest either: planned in full
+
+
 def _untimed(
     inputs: Inputs,
     scene: DrakeCell,
@@ -126,9 +149,12 @@ def _untimed(
     run: MotionSetup,
     branch: int | None,
     results: list | None = None,
+    *,
+    start: tuple | None = None,
 ) -> tuple[UntimedSeam | None, list]:
     """(the option on ``branch`` (None: the best), or None if its path IK fails or its
-    path collides; every branch's verdict on ``run``'s path, ``results`` if known)."""
+    path collides; every branch's verdict on ``run``'s path, ``results`` if known).
+    ``start``: where its timed plan starts (``UntimedSeam.start``)."""
     motion = inputs.cell.motion
     grid, results, chosen, path = path_branches(
         inputs.robot, inputs.X_IB, run.flange, run.parameter, branch, results=results
@@ -149,7 +175,7 @@ def _untimed(
     q_ends = path.q(grid[[0, -1]], chosen.q[[0, -1]])
     first = branch is None
     option = UntimedSeam(
-        inputs, fit, frames, rotation, flange, chosen.branch, q_ends, first, run, results
+        inputs, fit, frames, rotation, flange, chosen.branch, q_ends, first, run, results, start
     )
     return option, results
 
@@ -308,8 +334,9 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
     u, reverse = option.untimed, option.reverse
     timer = seam_planner.timer(option.seam, reverse)  # the stages' names and wall times
     known = {"fit": u.fit, "frames": u.frames}
+    run, branches = u.start or (u.run, u.branches)  # a fallback's: from the leads asked
     try:
-        from_untimed = functools.partial(plan_motion, run=u.run, branches=u.branches)
+        from_untimed = functools.partial(plan_motion, run=run, branches=branches)
         unchecked = timer(
             "joints", "joint trajectory", from_untimed, u.inputs, u.rotation, u.flange
         )
@@ -321,7 +348,8 @@ def _time_first(options: list[SeamOption], i: int, scene, seam_planner, errors, 
         timer("collision", "collision avoidance: not needed", lambda: None)
         plan = Plan.of_attempt(u.inputs, u.fit, u.frames, attempt, timings_s=timer.timings_s)
         moves = {"approach": option.approach, "retract": option.retract}
-        if attempt.flange is not u.run.flange:  # its leads fell back: the moves for these
+        ran = attempt.flange
+        if ran is not u.run.flange and ran.asked != u.run.flange.asked:  # other leads ran:
             try:
                 moves = dict(zip(moves, plan_ends(u.inputs, plan, seam), strict=True))
             except PlanFailedError:

@@ -173,7 +173,10 @@ class LeadPath:
         self.lead_in_m, self.lead_out_m = (end.length for end in self._ends)
 
     def around(self, inner) -> LeadPath:
-        """These leads, as asked, around another flange path of the same seam."""
+        """These leads, as asked, around another flange path of the same seam (around
+        their own: these, whose tables are built already)."""
+        if inner is self.inner:
+            return self
         return LeadPath(inner, **self.asked, reason=self.reason)
 
     def _end(self, s: float, side: float, extent: float, lift: float) -> _End:

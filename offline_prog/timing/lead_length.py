@@ -21,6 +21,8 @@ a tangent move's lead runs the move's distance along the tangent.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.optimize import brentq
 
@@ -47,9 +49,10 @@ AT_HEIGHT_TOL_M = 1e-4
 BEND_SAMPLES = 4001  # samples of x ∈ [0, 1] that find a lift's largest curvature
 
 
+@functools.lru_cache(maxsize=256)
 def ramp_length_m(v: float, *, a_max: float, j_max: float) -> float:
     """The sin² law's distance from rest to the speed v [m] under a_max, j_max
-    [m/s², m/s³]."""
+    [m/s², m/s³] (kept per (v, a_max, j_max): every option of a job's seams asks)."""
     long = sin2_time_law(1e3 * v, v_max=v, a_max=a_max, j_max=j_max)
     ramp_s = 10.0 * (v / a_max + a_max / j_max + np.sqrt(v / j_max))  # ample
     t = np.linspace(0.0, min(long.duration, ramp_s), RAMP_SAMPLES)
@@ -190,6 +193,12 @@ def _switch_m(cell: Cell, v: float) -> float:
     model = process_model(cell.process)
     lag = max(io.flow.lag_s if io and io.flow else 0.0, model.output_lag_s if model else 0.0)
     return ahead + lag * v
+
+
+def lead_failure(reason: str) -> str:
+    """Why a seam runs at rest where no IK branch or joint timing runs its leads:
+    ``reason``, the failure's on them (``stages.plan_motion``, ``job.untimed``)."""
+    return f"the lead-in or lead-out: {reason}"
 
 
 def at_rest(flange: LeadPath, reason: str) -> LeadPath:

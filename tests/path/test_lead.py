@@ -5,7 +5,9 @@ seam itself."""
 
 import numpy as np
 import pytest
+from pydrake.math import RigidTransform, RotationMatrix
 
+from offline_prog.path.fixed_tcp import FlangePath
 from offline_prog.path.lead import MAX_LIFT_RATIO, LeadPath, path_ends
 
 from conftest import random_flange_path, rotation_log
@@ -124,3 +126,28 @@ def test_a_lead_that_takes_a_normal_move_over_lifts_by_its_distance(rng):
     extent = -(far @ t0)
     near = lead(np.linspace(-0.1 * extent, 0.0, 20)).p_PF - p0
     assert np.abs(near @ n0).max() <= 2e-3 * 0.05 + 0.5 * (0.1 * extent) ** 2 * 50
+
+
+def test_leads_around_their_own_path_are_the_fresh_ones(rng):
+    """``around`` the path they were built on, the leads are kept (their tables are not
+    built again) and equal leads built afresh, sample for sample; around another path
+    of the seam (the same fit, another tool placement) they are built anew for it and
+    differ."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M, lifts_m=(0.05, 0.0))
+    s = np.concatenate([np.linspace(-LEAD_M, 0.0, 30), flange.length + np.linspace(0, LEAD_M, 30)])
+    fresh = LeadPath(flange, **lead.asked)
+    kept = lead.around(flange)
+    assert kept is lead
+    for field in ("p_IE", "dp_IE", "ddp_IE", "R_IE", "w_s", "dw_s", "p_PF", "R_PF"):
+        np.testing.assert_array_equal(getattr(kept(s), field), getattr(fresh(s), field))
+    other = FlangePath(flange.path, flange.normal, X_IT=flange.X_IT, X_PE=_turned(flange.X_PE))
+    moved = lead.around(other)
+    assert moved is not lead and moved.inner is other
+    np.testing.assert_array_equal(moved(s).p_IE, LeadPath(other, **lead.asked)(s).p_IE)
+    assert np.abs(moved(s).p_IE - lead(s).p_IE).max() > 1e-3
+
+
+def _turned(X_PE: RigidTransform) -> RigidTransform:
+    """X_PE turned 0.3 rad about P's z and shifted 5 cm: another placement of E on P."""
+    return RigidTransform(RotationMatrix.MakeZRotation(0.3), [0.05, 0.0, 0.0]) @ X_PE

@@ -1,6 +1,6 @@
 """How long a flying seam's leads are and whether they take a normal move over
 (``timing.lead_length``): the turn onto the seam within the tool's acceleration, and the
-weld demo no slower flying than at rest."""
+weld demo no slower flying than at rest; the ramp room kept per (v, a_max, j_max)."""
 
 import dataclasses
 
@@ -11,7 +11,7 @@ from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
-from offline_prog.timing.lead_length import AT_HEIGHT_TOL_M, takeover_extent_m
+from offline_prog.timing.lead_length import AT_HEIGHT_TOL_M, ramp_length_m, takeover_extent_m
 
 from conftest import CELLS
 
@@ -75,3 +75,17 @@ def test_the_weld_demo_flying_is_no_slower_than_at_rest():
     speed = plan.trajectory.tcp_speed
     assert speed.min() == pytest.approx(0.008, rel=1e-3)
     assert flying.samples.t[-1] <= rest.samples.t[-1]
+
+
+def test_a_kept_ramp_is_the_fresh_one_for_each_changed_input():
+    """Each input changed in turn after a first call: the kept result is the one
+    computed afresh (bit for bit), and it differs from the first (the cache is keyed on
+    every input the ramp depends on)."""
+    base = dict(v=0.1, a_max=1.0, j_max=20.0)
+    first = ramp_length_m(base["v"], a_max=base["a_max"], j_max=base["j_max"])
+    for key, value in (("v", 0.05), ("a_max", 0.5), ("j_max", 5.0)):
+        args = base | {key: value}
+        kept = ramp_length_m(args["v"], a_max=args["a_max"], j_max=args["j_max"])
+        fresh = ramp_length_m.__wrapped__(args["v"], a_max=args["a_max"], j_max=args["j_max"])
+        assert kept == fresh, key
+        assert kept != first, key
