@@ -39,7 +39,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import fallbacks, lead_failure, with_leads
+from offline_prog.timing.lead_length import fallbacks, lead_failure, slowed_end, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -258,19 +258,24 @@ def plan_motion(
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
     run = motion_setup(inputs, flange) if run is None else run
+    v = inputs.speed.v_m_s
     try:
         joints = _joint_trajectory(inputs, run, branch, branches)
+        missed = slowed_end(run.flange, joints.retiming.reductions, v)
     except PlanFailedError as error:
         if not run.flange.flying:
             raise
-        for leads in fallbacks(run.flange, lead_failure(error.failure.reason)):
-            run = motion_setup(inputs, leads)
-            try:
-                joints = _joint_trajectory(inputs, run, branch)
-                break
-            except PlanFailedError:
-                if not leads.flying:  # at rest: the seam itself fails
-                    raise
+        missed = lead_failure(error.failure.reason)
+    for leads in fallbacks(run.flange, missed) if missed else ():
+        run = motion_setup(inputs, leads)
+        try:
+            joints = _joint_trajectory(inputs, run, branch)
+        except PlanFailedError:
+            if not leads.flying:  # at rest: the seam itself fails
+                raise
+            continue
+        if not slowed_end(leads, joints.retiming.reductions, v):
+            break
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 

@@ -201,6 +201,28 @@ def lead_failure(reason: str) -> str:
     return f"the lead-in or lead-out: {reason}"
 
 
+def slowed_end(flange: LeadPath, reductions, v: float) -> str:
+    """Why a flying seam's leads miss their purpose, "" where they do not: the joints'
+    speed ``reductions`` ((σ_start, σ_end, speed) [m, m, m/s] on the law's σ, 0 at the
+    lead-in's start: ``PathTiming.reductions``) hold a seam end that a lead meets below
+    the process speed v [m/s], so the tool crosses it slowed and runs its leads slowed
+    too (on a 15 mm circle the wrist's jerk held a whole seam at 1 % of v). Such a seam
+    is planned with the leads' fallbacks (:func:`fallbacks`): at rest its ends cost a
+    ramp at the speed the joints allow, not a lead at it."""
+    ends = (
+        ("start", flange.lead_in_m, flange.lead_in_m > 0.0),
+        ("end", flange.lead_in_m + flange.inner.length, flange.lead_out_m > 0.0),
+    )
+    for a, b, speed in reductions:
+        for name, at, led in ends:
+            if led and a <= at <= b:
+                share = 100.0 * speed / v
+                return lead_failure(
+                    f"the joint limits hold the seam's {name} at {share:.0f} % of the process speed"
+                )
+    return ""
+
+
 def at_rest(flange: LeadPath, reason: str) -> LeadPath:
     """``flange`` with both ends at rest, for ``reason`` (a lead that cannot be run)."""
     return LeadPath(unwrapped(flange), lead_in_m=0.0, lead_out_m=0.0, reason=reason)
