@@ -290,7 +290,8 @@ def _time_pending(inputs, scene, seam_planner, options, errors, pending, progres
 def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
     """Seam k's ``options`` with option j timed: (the options, whether they are the same
     ones as before). Another branch is timed on its direction's first flange path as
-    run, and its plan holds that path and its limits as the first's does."""
+    run, and its plan holds that path and its limits as the first's does; it is dropped
+    where it cannot run the leads the first runs (``stages.plan_motion``'s fallbacks)."""
     option = options[j]
     first = next(i for i, o in enumerate(options) if o.reverse == option.reverse)
     if j == first:
@@ -305,7 +306,12 @@ def _time(options: list[SeamOption], j: int, scene, seam_planner, errors, seam):
         attempt = timer("check", "collision check", check_attempt, u.inputs, scene, attempt)
     except PlanFailedError:
         attempt = None
-    if attempt is None or not attempt.collisions.collision_free:
+    held = options[first].plan or options[first].untimed.run  # the path its plan holds
+    if (
+        attempt is None
+        or not attempt.collisions.collision_free
+        or attempt.flange.asked != held.flange.asked  # its leads fell back, the first's not
+    ):
         return options[:j] + options[j + 1 :], False
     if options[first].plan is None:
         run = options[first].untimed.run  # the first's flange path, as run
