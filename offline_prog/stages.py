@@ -246,22 +246,19 @@ def plan_motion(
     run: MotionSetup | None = None,
     branches: list | None = None,
 ) -> Attempt:
-    """Time law (§4), path IK on a branch and joint retiming for one flange path; the
-    attempt's collision check is not run yet (``collisions`` None). The law runs under
-    the path caps of ``motion:``, lowered where the process model needs it
-    (``process.timing_bound.process_caps``: a bead's dispenser lag caps the jerk)
-    unless ``inputs.process_bound`` is False. ``run``, ``branches``: ``motion_setup``
-    of ``flange`` and every IK branch's verdict on its grid (``path_branches``), when
-    an untimed option has them (``job.untimed``).
+    """Time law (§4), path IK on a branch and joint retiming for one flange path (not
+    collision-checked), under ``motion:``'s caps lowered by ``process_caps`` unless
+    ``inputs.process_bound`` is False; leads that fail or are slowed (``slowed_end``)
+    give way to their fallbacks. ``run``, ``branches``: ``motion_setup`` of ``flange``
+    and every IK branch's verdict (``path_branches``), when an untimed option has them.
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
     run = motion_setup(inputs, flange) if run is None else run
-    v = inputs.speed.v_m_s
     try:
         joints = _joint_trajectory(inputs, run, branch, branches)
-        missed = slowed_end(run.flange, joints.retiming.reductions, v)
+        missed = slowed_end(run.flange, joints.retiming.reductions, inputs.speed.v_m_s)
     except PlanFailedError as error:
         if not run.flange.flying:
             raise
@@ -270,12 +267,11 @@ def plan_motion(
         run = motion_setup(inputs, leads)
         try:
             joints = _joint_trajectory(inputs, run, branch)
+            if not slowed_end(leads, joints.retiming.reductions, inputs.speed.v_m_s):
+                break
         except PlanFailedError:
             if not leads.flying:  # at rest: the seam itself fails
                 raise
-            continue
-        if not slowed_end(leads, joints.retiming.reductions, v):
-            break
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 

@@ -7,13 +7,18 @@ import dataclasses
 import numpy as np
 import pytest
 
-from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO
+from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO, LeadPath
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
 from offline_prog.stages import load_inputs
-from offline_prog.timing.lead_length import AT_HEIGHT_TOL_M, ramp_length_m, takeover_extent_m
+from offline_prog.timing.lead_length import (
+    AT_HEIGHT_TOL_M,
+    ramp_length_m,
+    slowed_end,
+    takeover_extent_m,
+)
 
-from conftest import CELLS
+from conftest import CELLS, random_flange_path
 
 ACCELERATION_RTOL = 1e-3  # the finite-difference curvature against the sized one
 
@@ -89,3 +94,37 @@ def test_a_kept_ramp_is_the_fresh_one_for_each_changed_input():
         fresh = ramp_length_m.__wrapped__(args["v"], a_max=args["a_max"], j_max=args["j_max"])
         assert kept == fresh, key
         assert kept != first, key
+
+
+def test_leads_are_missed_where_the_joint_limits_slow_a_seam_end_they_meet(rng):
+    """A speed reduction (on the law's σ, 0 at the lead-in's start) over the seam's start
+    or end that a lead meets: the leads miss their purpose, named with the share of the
+    process speed; one inside the seam, or over an end no lead meets: they do not."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=0.03, lead_out_m=0.0)
+    start, end = lead.lead_in_m, lead.lead_in_m + flange.length
+    reason = slowed_end(lead, ((0.0, start + 0.01, 0.033),), 0.1)
+    assert "seam's start at 33 % of the process speed" in reason
+    assert slowed_end(lead, ((start + 0.001, end - 0.001, 0.01),), 0.1) == ""
+    assert slowed_end(lead, ((end - 0.01, end, 0.01),), 0.1) == ""  # no lead-out there
+
+
+@pytest.mark.slow
+def test_a_small_circle_whose_leads_the_wrist_slows_runs_at_rest(tmp_path):
+    """A 7.5 mm circle on the sealing job's plate: flying, its leads turn the wrist so
+    fast that the joints' jerk held the whole seam at 1 % of the process speed (50 s
+    instead of 1.5 s); it runs at rest, at 40 % or more of it, and report.json says why."""
+    text = (CELLS / "seal_job_kr16.yaml").read_text(encoding="utf-8")
+    head, tail = text[: text.index("\nseams:") + 1], text[text.index("\njob:") + 1 :]
+    circle = "{kind: arc, center: [104.6, -12.5, 0], radius: 7.5, start_deg: 0, end_deg: 360}"
+    seam = f"  - {{name: dot, analytic: {circle}, closed: true, units: mm, normal: [0, 0, 1]}}"
+    cell = tmp_path / "dot.yaml"
+    cell.write_text(f"{head}seams:\n{seam}\n{tail}", encoding="utf-8")
+    job = plan_loaded_job(
+        load_inputs(cell, ROBOTS_DIR), StageTimer(lambda stage: None), clearance_profile=False
+    )
+    assert job.feasible
+    plan = job.chosen[0].plan
+    assert plan.entry["entry"] == "rest"
+    assert "the joint limits hold the seam's" in plan.entry["reason"]
+    assert plan.trajectory.tcp_speed.max() >= 0.4 * job.cell.motion.speed
