@@ -39,7 +39,8 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import fallbacks, lead_failure, slowed_end, with_leads
+from offline_prog.timing.fallback_walk import walk_fallbacks
+from offline_prog.timing.lead_length import fallbacks, slowed_end, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -255,23 +256,14 @@ def plan_motion(
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
-    run = motion_setup(inputs, flange) if run is None else run
-    try:
-        joints = _joint_trajectory(inputs, run, branch, branches)
-        missed = slowed_end(run.flange, joints.retiming.reductions, inputs.speed.v_m_s)
-    except PlanFailedError as error:
-        if not run.flange.flying:
-            raise
-        missed = lead_failure(error.failure.reason)
-    for leads in fallbacks(run.flange, missed) if missed else ():
-        run = motion_setup(inputs, leads)
-        try:
-            joints = _joint_trajectory(inputs, run, branch)
-            if not slowed_end(leads, joints.retiming.reductions, inputs.speed.v_m_s):
-                break
-        except PlanFailedError:
-            if not leads.flying:  # at rest: the seam itself fails
-                raise
+    first = motion_setup(inputs, flange) if run is None else run
+
+    def timed(run: MotionSetup):
+        known = branches if run is first else None  # the verdicts are the first path's
+        joints = _joint_trajectory(inputs, run, branch, known)
+        return joints, slowed_end(run.flange, joints.retiming.reductions, inputs.speed.v_m_s)
+
+    run, joints = walk_fallbacks(first, timed, setup=lambda leads: motion_setup(inputs, leads)).last
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 
