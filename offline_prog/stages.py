@@ -8,6 +8,7 @@ and outputs (the dataclasses below), in the paper's order:
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from pathlib import Path
 
@@ -39,7 +40,7 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.fallback_walk import walk_fallbacks
+from offline_prog.timing.fallback_walk import kept_slowed, slowed_rank, walk_fallbacks
 from offline_prog.timing.lead_length import fallbacks, slowed_end, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
@@ -250,20 +251,27 @@ def plan_motion(
     """Time law (§4), path IK on a branch and joint retiming for one flange path (not
     collision-checked), under ``motion:``'s caps lowered by ``process_caps`` unless
     ``inputs.process_bound`` is False; leads that fail or are slowed (``slowed_end``)
-    give way to their fallbacks. ``run``, ``branches``: ``motion_setup`` of ``flange``
-    and every IK branch's verdict (``path_branches``), when an untimed option has them.
+    give way to their fallbacks (``timing.fallback_walk``); where the process model
+    ``flies_slowed``, the least-slowed flying leads that ran rather than rest. ``run``,
+    ``branches``: ``motion_setup`` of ``flange`` and every IK branch's verdict
+    (``path_branches``), when an untimed option has them.
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
     first = motion_setup(inputs, flange) if run is None else run
+    v = inputs.speed.v_m_s
 
     def timed(run: MotionSetup):
         known = branches if run is first else None  # the verdicts are the first path's
         joints = _joint_trajectory(inputs, run, branch, known)
-        return joints, slowed_end(run.flange, joints.retiming.reductions, inputs.speed.v_m_s)
+        return joints, slowed_end(run.flange, joints.retiming.reductions, v)
 
-    run, joints = walk_fallbacks(first, timed, setup=lambda leads: motion_setup(inputs, leads)).last
+    rank = slowed_rank(process_model(inputs.cell.process), v)
+    walk = walk_fallbacks(first, timed, setup=functools.partial(motion_setup, inputs), rank=rank)
+    run, joints = walk.last
+    if walk.missed:  # flying, slowed: the process keeps its band, at rest it would not
+        run = dataclasses.replace(run, flange=kept_slowed(run.flange, walk.missed))
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 

@@ -3,11 +3,17 @@ leads with their own lift, then rest, each tried only where the one before misse
 rest named with the first miss's reason, and a path at rest failing as the seam."""
 
 import dataclasses
+import re
 
 import pytest
+from job.bead_job import bead_job
+from job.test_flying_entry import _gun_on_figures
 
 from offline_prog.errors import Failure, PlanFailedError, PlanFailure
 from offline_prog.path.lead import LeadPath
+from offline_prog.plan import StageTimer, plan_loaded_job
+from offline_prog.robot.model import ROBOTS_DIR
+from offline_prog.stages import load_inputs
 from offline_prog.timing.fallback_walk import walk_fallbacks
 
 from conftest import random_flange_path
@@ -82,3 +88,38 @@ def test_leads_without_a_lift_fall_to_rest_and_a_path_at_rest_has_no_fallback(rn
     at_rest = LeadPath(flange, lead_in_m=0.0, lead_out_m=0.0, reason="entry: rest")
     walk, checked = _walk(at_rest, {"rest": "missed"})
     assert checked == ["rest"] and not walk.served
+
+
+def _bead_circle(tmp_path, entry: str):
+    """A 20 mm circle on the sealing job's plate with a bead model (12 mm², lag 0.08 s),
+    planned with ``entry``: flying, its takeover leads turn the wrist so fast that the
+    joints hold the seam's start at 10 % of the process speed."""
+    text = bead_job()
+    head, tail = text[: text.index("\nseams:") + 1], text[text.index("\njob:") + 1 :]
+    circle = "{kind: arc, center: [104.6, -12.5, 0], radius: 20, start_deg: 0, end_deg: 360}"
+    seam = f"{{name: dot, analytic: {circle}, closed: true, units: mm, normal: [0, 0, 1]"
+    cell = tmp_path / f"{entry}.yaml"
+    cell.write_text(f"{head}seams:\n  - {seam}, entry: {entry}}}\n{tail}", encoding="utf-8")
+    inputs = load_inputs(cell, ROBOTS_DIR)
+    job = plan_loaded_job(inputs, StageTimer(lambda stage: None), clearance_profile=False)
+    assert job.feasible, job.failure
+    return job
+
+
+@pytest.mark.slow
+def test_a_bead_seam_whose_start_the_joints_slow_keeps_flying(tmp_path):
+    """Where the process model judges a bead, a seam end the joint limits slow keeps its
+    leads, run slowed, rather than rest: no gun-on standstill and no blob at the ends
+    (at rest the first rows are thousands of percent over), and report.json names the
+    end and the share of the process speed."""
+    flying = _bead_circle(tmp_path, "flying")
+    entry = flying.chosen[0].plan.entry
+    assert entry["entry"] == "flying", entry
+    assert re.search(r"hold the seam's (start|end) at \d+ % of the process speed", entry["reason"])
+    assert "kept flying" in entry["reason"]
+    share, worst, standstill = _gun_on_figures(flying)
+    rest = _bead_circle(tmp_path, "rest")
+    rest_share, rest_worst, rest_standstill = _gun_on_figures(rest)
+    assert standstill == 0 and rest_standstill > 0
+    assert worst <= 0.25 and rest_worst > 10.0
+    assert share >= rest_share
