@@ -28,7 +28,7 @@ def _failed(reason: str) -> PlanFailedError:
     return PlanFailedError(PlanFailure(Failure.JOINT_LIMIT, 0.01, 0.1, reason))
 
 
-def _walk(first: LeadPath, verdicts: dict[str, str | PlanFailedError]):
+def _walk(first: LeadPath, verdicts: dict[str, str | PlanFailedError], rank=None):
     """The walk from ``first`` where a run's check gives ``verdicts`` by the run's kind
     (asked, own lift, rest); the kinds in the order they were checked."""
     checked = []
@@ -40,7 +40,7 @@ def _walk(first: LeadPath, verdicts: dict[str, str | PlanFailedError]):
             raise verdicts[kind]
         return kind, verdicts[kind]
 
-    return walk_fallbacks(Run(first), check, setup=Run), checked
+    return walk_fallbacks(Run(first), check, setup=Run, rank=rank), checked
 
 
 @pytest.fixture
@@ -77,6 +77,31 @@ def test_a_flying_path_that_fails_is_a_miss_a_path_at_rest_the_seams_failure(tak
             taken_over,
             {"asked": _failed("wrist"), "own": _failed("wrist"), "rest": _failed("elbow")},
         )
+
+
+def test_a_ranked_walk_keeps_the_best_flying_run_that_ran_rather_than_rest(taken_over):
+    """With ``rank`` (a bead: the slowest led end's speed), slowed leads are kept: the
+    better of the asked and own-lift runs, rest never checked; one that failed is not
+    ranked, and where none ran the walk still ends at rest."""
+    speeds = {"asked": 0.01, "own": 0.03}
+    walk, checked = _walk(
+        taken_over,
+        {"asked": "slowed", "own": "slowed", "rest": ""},
+        rank=lambda run, out: speeds[out],
+    )
+    assert checked == ["asked", "own"] and walk.last[1] == "own" and walk.missed == "slowed"
+    walk, checked = _walk(
+        taken_over,
+        {"asked": "slowed", "own": _failed("wrist"), "rest": ""},
+        rank=lambda run, out: speeds[out],
+    )
+    assert checked == ["asked", "own"] and walk.last[1] == "asked" and not walk.served
+    walk, checked = _walk(
+        taken_over,
+        {"asked": _failed("wrist"), "own": _failed("wrist"), "rest": ""},
+        rank=lambda run, out: speeds[out],
+    )
+    assert checked == ["asked", "own", "rest"] and walk.served
 
 
 def test_leads_without_a_lift_fall_to_rest_and_a_path_at_rest_has_no_fallback(rng):
