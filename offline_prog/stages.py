@@ -18,7 +18,7 @@ from pydrake.math import RigidTransform
 from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.calibration_keys import check_controller_frames
-from offline_prog.config.cell import ApproachConfig, Cell, load_cell, transform
+from offline_prog.config.cell import ApproachConfig, Cell, load_cell, seam_moves_m, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
 from offline_prog.config.process_speed import ProcessSpeed, process_speed
@@ -121,8 +121,8 @@ def load_inputs(file: Path, robots_dir: Path, cell: Cell | None = None) -> Input
         transform(cell.tool.X_IT),
         transform(cell.part.X_PE),
         process_speed(cell, 0) if cell.path is not None else None,
-        # A path: cell's seam moves on and off it as job.seams.job_seams gives it.
-        normal_moves_m=(ApproachConfig().normal_m,) * 2 if cell.path is not None else (0, 0),
+        # A path: cell's seam: the default approach and retract (job.seams.job_seams).
+        **(seam_moves_m(ApproachConfig(), ApproachConfig()) if cell.path is not None else {}),
     )
 
 
