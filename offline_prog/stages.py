@@ -8,6 +8,7 @@ and outputs (the dataclasses below), in the paper's order:
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from pydrake.math import RigidTransform
 from offline_prog.collision.avoidance import Attempt, avoid_collisions, turn_tool_along_path
 from offline_prog.collision.check import check_trajectory
 from offline_prog.config.calibration_keys import check_controller_frames
-from offline_prog.config.cell import ApproachConfig, Cell, load_cell, transform
+from offline_prog.config.cell import ApproachConfig, Cell, load_cell, seam_moves_m, transform
 from offline_prog.config.checks import check_cell
 from offline_prog.config.job_checks import check_process_io
 from offline_prog.config.process_speed import ProcessSpeed, process_speed
@@ -39,7 +40,8 @@ from offline_prog.process.timing_bound import ProcessCaps, process_caps
 from offline_prog.robot.model import RobotModel, load_robot
 from offline_prog.scene.drake_cell import DrakeCell, build_cell_model
 from offline_prog.scene.shapes import ShapeError
-from offline_prog.timing.lead_length import fallbacks, lead_failure, slowed_end, with_leads
+from offline_prog.timing.fallback_walk import kept_slowed, slowed_rank, walk_fallbacks
+from offline_prog.timing.lead_length import fallbacks, slowed_end, with_leads
 from offline_prog.timing.path_timing import PathLimits
 from offline_prog.timing.trajectory import TimeLawParameter
 
@@ -119,8 +121,8 @@ def load_inputs(file: Path, robots_dir: Path, cell: Cell | None = None) -> Input
         transform(cell.tool.X_IT),
         transform(cell.part.X_PE),
         process_speed(cell, 0) if cell.path is not None else None,
-        # A path: cell's seam moves on and off it as job.seams.job_seams gives it.
-        normal_moves_m=(ApproachConfig().normal_m,) * 2 if cell.path is not None else (0, 0),
+        # A path: cell's seam: the default approach and retract (job.seams.job_seams).
+        **(seam_moves_m(ApproachConfig(), ApproachConfig()) if cell.path is not None else {}),
     )
 
 
@@ -249,29 +251,27 @@ def plan_motion(
     """Time law (§4), path IK on a branch and joint retiming for one flange path (not
     collision-checked), under ``motion:``'s caps lowered by ``process_caps`` unless
     ``inputs.process_bound`` is False; leads that fail or are slowed (``slowed_end``)
-    give way to their fallbacks. ``run``, ``branches``: ``motion_setup`` of ``flange``
-    and every IK branch's verdict (``path_branches``), when an untimed option has them.
+    give way to their fallbacks (``timing.fallback_walk``); where the process model
+    ``flies_slowed``, the least-slowed flying leads that ran rather than rest. ``run``,
+    ``branches``: ``motion_setup`` of ``flange`` and every IK branch's verdict
+    (``path_branches``), when an untimed option has them.
 
     Raises:
         PlanFailedError: the robot cannot follow the path (σ, t and why).
     """
-    run = motion_setup(inputs, flange) if run is None else run
-    try:
-        joints = _joint_trajectory(inputs, run, branch, branches)
-        missed = slowed_end(run.flange, joints.retiming.reductions, inputs.speed.v_m_s)
-    except PlanFailedError as error:
-        if not run.flange.flying:
-            raise
-        missed = lead_failure(error.failure.reason)
-    for leads in fallbacks(run.flange, missed) if missed else ():
-        run = motion_setup(inputs, leads)
-        try:
-            joints = _joint_trajectory(inputs, run, branch)
-            if not slowed_end(leads, joints.retiming.reductions, inputs.speed.v_m_s):
-                break
-        except PlanFailedError:
-            if not leads.flying:  # at rest: the seam itself fails
-                raise
+    first = motion_setup(inputs, flange) if run is None else run
+    v = inputs.speed.v_m_s
+
+    def timed(run: MotionSetup):
+        known = branches if run is first else None  # the verdicts are the first path's
+        joints = _joint_trajectory(inputs, run, branch, known)
+        return joints, slowed_end(run.flange, joints.retiming.reductions, v)
+
+    rank = slowed_rank(process_model(inputs.cell.process), v)
+    walk = walk_fallbacks(first, timed, setup=functools.partial(motion_setup, inputs), rank=rank)
+    run, joints = walk.last
+    if walk.missed:  # flying, slowed: the process keeps its band, at rest it would not
+        run = dataclasses.replace(run, flange=kept_slowed(run.flange, walk.missed))
     return Attempt(rotation, run.flange, run.limits, joints, None)
 
 

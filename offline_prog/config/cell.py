@@ -218,6 +218,15 @@ class ApproachConfig:
         return self.distance_mm * 1e-3 if self.kind == "tangent" else 0.0
 
 
+def seam_moves_m(approach: ApproachConfig, retract: ApproachConfig) -> dict[str, tuple]:
+    """A seam's ``stages.Inputs.normal_moves_m`` and ``tangent_moves_m`` [m], (approach,
+    retract) each, as keyword arguments: the moves its leads may take over."""
+    return {
+        "normal_moves_m": (approach.normal_m, retract.normal_m),
+        "tangent_moves_m": (approach.tangent_m, retract.tangent_m),
+    }
+
+
 @dataclasses.dataclass
 class SeamConfig(PathConfig):
     """One seam of a job: a processing path (every key of ``path:``) plus its name,

@@ -90,11 +90,14 @@ class Plan:
     @property
     def entry(self) -> dict:
         """How the seam is entered and left: ``{"entry": "flying" | "rest", "reason":
-        why at rest ("" when flying), "lead_in_mm", "lead_out_mm"}`` (report.json)."""
+        why at rest (flying: "", or the joint limits' hold on a seam end its leads run
+        slowed, ``timing.fallback_walk.kept_slowed``), "lead_in_mm", "lead_out_mm"}``
+        (report.json)."""
         lead_in = 0.0 if self.lead_in is None else self.lead_in.length_m
         lead_out = 0.0 if self.lead_out is None else self.lead_out.length_m
         flying = lead_in > 0.0 or lead_out > 0.0
-        reason = "" if flying else getattr(self.flange, "reason", "") or "entry: rest"
+        reason = getattr(self.flange, "reason", "")
+        reason = reason if flying else reason or "entry: rest"
         return {
             "entry": "flying" if flying else "rest",
             "reason": reason,

@@ -17,7 +17,7 @@ import dataclasses
 
 import numpy as np
 
-from offline_prog.config.cell import Cell, JobConfig, PathConfig, SeamConfig
+from offline_prog.config.cell import Cell, JobConfig, PathConfig, SeamConfig, seam_moves_m
 from offline_prog.config.process_speed import process_speed
 from offline_prog.errors import InputError
 from offline_prog.path.inputs import load_points
@@ -86,14 +86,12 @@ def seam_inputs(job: Inputs, k: int, *, reverse: bool = False) -> Inputs:
         points = load_points(job.file, seam_cell)
     if reverse:
         points = reversed_points(points)
-    moves = (seam.approach.normal_m, seam.retract.normal_m)
     return dataclasses.replace(
         job,
         cell=seam_cell,
         points=points,
         speed=process_speed(cell, k),
-        normal_moves_m=moves,
-        tangent_moves_m=(seam.approach.tangent_m, seam.retract.tangent_m),
+        **seam_moves_m(seam.approach, seam.retract),
     )
 
 

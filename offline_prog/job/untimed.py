@@ -42,7 +42,8 @@ from offline_prog.stages import (
     motion_setup,
     plan_motion,
 )
-from offline_prog.timing.lead_length import fallbacks, lead_failure
+from offline_prog.timing.fallback_walk import walk_fallbacks
+from offline_prog.timing.lead_length import lead_failure
 
 MAX_OTHER_BRANCHES = 2  # IK branches per seam direction offered to the order besides the best
 
@@ -126,17 +127,19 @@ def _first_run(inputs: Inputs, flange) -> tuple[MotionSetup, list, tuple | None]
     fallbacks (``timing.lead_length.fallbacks``: own lift, then rest) one does, as
     (its setup, its verdicts, (the path as first asked, its verdicts)): the timed plan
     starts there and walks the same fallbacks (a fallback that cannot be timed)."""
-    run = motion_setup(inputs, flange)
     robot, X_IB = inputs.robot, inputs.X_IB
-    _, results, chosen, _ = path_branches(robot, X_IB, run.flange, run.parameter)
-    if chosen.feasible or not run.flange.flying:
-        return run, results, None
-    for leads in fallbacks(run.flange, lead_failure(chosen.reason)):
-        again = motion_setup(inputs, leads)
-        _, found, followed, _ = path_branches(robot, X_IB, again.flange, again.parameter)
-        if followed.feasible:
-            return again, found, (run, results)
-    return run, results, None  # no branch follows it at rest either: planned in full
+
+    def followed(run: MotionSetup):
+        _, results, chosen, _ = path_branches(robot, X_IB, run.flange, run.parameter)
+        return results, "" if chosen.feasible else lead_failure(chosen.reason)
+
+    walk = walk_fallbacks(
+        motion_setup(inputs, flange), followed, setup=lambda leads: motion_setup(inputs, leads)
+    )
+    first = walk.tried[0][:2]
+    if len(walk.tried) == 1 or not walk.served:  # as asked, or planned in full (no
+        return (*first, None)  # branch follows it at rest either)
+    return (*walk.last, first)
 
 
 def _untimed(

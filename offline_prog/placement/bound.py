@@ -6,12 +6,19 @@ faster): a seam takes at least, on each interval between the screen's σ samples
 max(Δσ / v̄, max_j |Δq_j| / q̇max_j), where v̄ is the most the path speed can be there
 (the process speed, and the rest-to-rest ramps under the path acceleration:
 v ≤ √(2aσ), v ≤ √(2a(L − σ))) and the joint term holds because a joint that turns by
-Δq at q̇ ≤ q̇max needs Δq / q̇max (coarser samples only lower it). The approach and
-retract run the sin² law of their distance at the seam's speed (``job.approach``, or
-slower). A link is a rest-to-rest joint move: at least the synchronised move at the
-joints' speed and acceleration limits (``job.link_costs.ptp_time``), from home to the
-approach's start and from the retract's end home; links between a job's seams count
-as zero. The least over every usable variant (tool turn, branch) of each seam.
+Δq at q̇ ≤ q̇max needs Δq / q̇max (coarser samples only lower it). A seam at rest
+(``entry: rest``) runs its approach and retract as the sin² law of their distance at the
+approach speed (``job.approach``, or slower). A flying seam (the default) crosses its
+ends at the process speed, so its seam stretch has no ramps, and its leads may take
+the approach and retract over or shorten them (``job.approach.move_left_m``): whatever
+the split, the tool runs at least the move's distance D from the move's far end to the
+seam's end, on the straight move at ≤ the approach speed v_a and on the lead at ≤ the
+process speed v, so an end takes at least D / max(v, v_a) (a lead that cannot be run
+falls back to rest, which takes longer). A link is a rest-to-rest joint move: at
+least the synchronised move at the joints' speed and acceleration limits
+(``job.link_costs.ptp_time``), from home to the approach's start and from the retract's
+end home; links between a job's seams count as zero. The least over every usable
+variant (tool turn, branch) of each seam.
 
 **Estimate** (a cheaper law, to rank candidates): on the variant the planner's first
 attempt takes, the steady speed the joints allow, v ≤ q̇max_j / |q′_j| and
@@ -26,6 +33,7 @@ import math
 
 import numpy as np
 
+from offline_prog.config.process_speed import approach_speed
 from offline_prog.job.approach import move_left_m
 from offline_prog.job.link_costs import ptp_time
 from offline_prog.placement.variants import SeamVariants
@@ -63,11 +71,13 @@ def _ramp_speeds(sigma: np.ndarray, *, v: float, a: float) -> np.ndarray:
     return np.minimum(v, np.minimum(rise, fall))
 
 
-def end_moves_s(seam, motion, speed: float, *, covered: tuple[float, float] = (0.0, 0.0)) -> float:
-    """The approach's and retract's sin² durations [s] (``job.approach``: at the seam's
-    process speed ``speed`` [m/s]); ``covered`` [m]: how much of (approach, retract) a
-    flying seam's leads run already (``job.approach.lead_covers_m``)."""
-    total = 0.0
+def end_moves_s(seam, inputs, *, covered: tuple[float, float] = (0.0, 0.0)) -> float:
+    """The approach's and retract's sin² durations [s] as ``job.approach`` times them
+    (at ``config.process_speed.approach_speed``) for the seam's ``SeamConfig`` and its
+    ``stages.Inputs``; ``covered`` [m]: how much of (approach, retract) a flying seam's
+    leads run already (``job.approach.lead_covers_m``)."""
+    motion, total = inputs.cell.motion, 0.0
+    speed = approach_speed(inputs.cell, inputs.speed).v_m_s
     for spec, run in zip((seam.approach, seam.retract), covered, strict=True):
         d = move_left_m(spec, run)
         if spec.kind != "none" and d > 0.0:
@@ -76,6 +86,19 @@ def end_moves_s(seam, motion, speed: float, *, covered: tuple[float, float] = (0
             )
             total += law.duration
     return total
+
+
+def end_moves_bound_s(seam, inputs) -> float:
+    """A lower bound [s] on the approach's and retract's durations with the leads that
+    run them (module docstring): at rest their sin² laws (:func:`end_moves_s`), flying
+    each move's distance at the faster of the process and the approach speed."""
+    if inputs.cell.path.entry == "rest":
+        return end_moves_s(seam, inputs)
+    fastest = max(inputs.speed.v_m_s, approach_speed(inputs.cell, inputs.speed).v_m_s)
+    moves = [
+        spec.distance_mm * 1e-3 for spec in (seam.approach, seam.retract) if spec.kind != "none"
+    ]
+    return sum(moves) / fastest
 
 
 def seam_times(variants: SeamVariants, seam_inputs, seam) -> SeamTimes:
@@ -89,13 +112,13 @@ def seam_times(variants: SeamVariants, seam_inputs, seam) -> SeamTimes:
     joint = (np.abs(np.diff(seam_q, axis=2)) / robot.qd_max).max(axis=-1)  # (A, 8, N − 1)
     speed = seam_inputs.speed.v_m_s  # the seam's own (config.process_speed)
     v_up = _ramp_speeds(sigma, v=speed, a=motion.max_acceleration)
-    path = ds / v_up if tcp else np.zeros_like(ds)
-    moves = end_moves_s(seam, motion, speed)
+    flying = seam_inputs.cell.path.entry != "rest"  # its ends crossed at the speed
+    path = ds / (np.full_like(ds, speed) if flying else v_up) if tcp else np.zeros_like(ds)
     with np.errstate(invalid="ignore"):
-        seam_s = np.maximum(joint, path).sum(axis=-1) + moves
+        seam_s = np.maximum(joint, path).sum(axis=-1) + end_moves_bound_s(seam, seam_inputs)
     bound = np.where(variants.usable, seam_s, np.inf)
     choice = variants.planner_choice()
-    estimate = math.nan
+    estimate, moves = math.nan, end_moves_s(seam, seam_inputs)
     if choice is not None:
         estimate = _steady_time(seam_q[choice], sigma, v_up, robot, tcp=tcp) + moves
     return SeamTimes(bound, estimate, q_c[:, :, [0, -1]], choice, moves)

@@ -160,9 +160,8 @@ def rank(ctx: Context, candidate: Candidate) -> Evaluation:
     times = []
     for view, seam, (v, t) in zip(ctx.seams, job_seams(ctx.inputs.cell), seams, strict=True):
         law, flange = law_seam_s(view, v, X_IT, X_PE)  # a flying seam's leads included
-        motion, speed = view.inputs.cell.motion, view.inputs.speed.v_m_s
         covered = (0.0, 0.0) if flange is None else lead_covers_m(flange, seam)
-        moves = end_moves_s(seam, motion, speed, covered=covered)
+        moves = end_moves_s(seam, view.inputs, covered=covered)
         times.append(dataclasses.replace(t, estimate_s=law + moves))
     _, estimate = job_times(times, home_c(ctx), ctx.inputs.robot)
     inputs = placed_inputs(ctx, candidate)

@@ -77,6 +77,7 @@ class BeadModel(SpeedFollowingModel):
     sets_flow = True  # the flow's gain, offset and lead are the bead's
     lag_key = "process.bead.lag_s"
     compares_uncompensated = True  # the share with the flow set at the speed of the moment
+    flies_slowed = True  # at rest the flow's lag spoils the ends (+1800 % rows)
 
     @classmethod
     def check_keys(cls, file, keys: BeadConfig, flow) -> None:

@@ -58,6 +58,9 @@ class ProcessModel(abc.ABC):
     sets_flow: ClassVar[bool] = False  # its output law is tool.process_io.flow's
     lag_key: ClassVar[str | None] = None  # the key that sets the flow's lead, if it does
     compares_uncompensated: ClassVar[bool] = False  # quality with the lead off, beside
+    # A seam end the joint limits slow keeps its leads, run slowed, rather than rest: at
+    # rest the model's output spoils both ends, at a slowed speed it follows it.
+    flies_slowed: ClassVar[bool] = False
 
     # Cell keys.
     @classmethod

@@ -3,32 +3,55 @@
 
 Summary: the verdict, the seam order (and the estimated saving against the given
 order), the cycle time split into process and air time, one row per seam and per link,
-and the process I/O switches. Plots (uPlot, inlined, as in the one-seam report): the
-TCP speed over the whole job with the process output and the flow value on the same
-time axis (the I/O timeline), and the joints against their limits. Views (SVG, as in
-the one-seam report): the part with each seam's path and process frames and the
-gripper's outline in P, and the flange path of the whole job in the cell I, from
-plan.npz + job.npz.
+and the process I/O switches. Plots (uPlot, inlined: ``viz.report_plots``): the TCP
+speed over the whole job with the process output and the flow value on the same time
+axis (the I/O timeline), and the joints against their limits. Views (SVG,
+``viz.report_plots.views_svg``): the part with each seam's path and process frames and
+the gripper's outline in P, and the flange path of the whole job in the cell I, from
+plan.npz + job.npz. Every plan folder's report.html is this page (a ``path:`` cell is a
+one-seam job).
 """
 
 from __future__ import annotations
 
 import csv
+import html
 import json
 from pathlib import Path
 
 import numpy as np
 
 from offline_prog.atomic import MANIFEST, write_atomic
+from offline_prog.export.formats import PROGRAMS_DIR
 from offline_prog.export.job_program import JobProgramData
-from offline_prog.viz.report_html import _CSS, PROGRAMS_DIR, REPORT_FILE
 from offline_prog.viz.report_plots import PLOT_SCRIPT, plot_assets, views_svg
-from offline_prog.viz.report_summary import escape as _e
 
+REPORT_FILE = "report.html"
 JOINT_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
 MAX_PLOT_POINTS = 6000  # rows kept for the page's plots (every k-th row beyond)
 XYZ_ABG = ("x", "y", "z", "alpha", "beta", "gamma")  # the flange in I (trajectory.csv)
 QUALITY_SPAN = 3.0  # the quality plot's value axis: at most this many band widths beyond
+
+
+_CSS = """
+body{font-family:system-ui,sans-serif;margin:24px auto;max-width:1180px;color:#222}
+h1{margin-bottom:4px} .sub{color:#666;margin-top:0}
+table{border-collapse:collapse;width:100%;font-size:14px}
+th,td{border-bottom:1px solid #ddd;padding:5px 8px;text-align:left;vertical-align:top}
+th{width:190px;background:#f6f6f6} ul{margin:2px 0;padding-left:20px}
+.lbl{color:#666} .pass,.fail{font-weight:bold;padding:2px 10px;border-radius:4px;color:#fff}
+.pass{background:#2e7d32} .fail{background:#c62828}
+figure{margin:18px 0} figcaption{color:#444;font-size:14px}
+.plot{display:flex;flex-wrap:wrap;gap:8px} .views{display:flex;flex-wrap:wrap;gap:8px}
+.view{border:1px solid #eee} .hint{color:#666;font-size:13px}
+.u-legend{font-size:11px;line-height:1.2} .u-legend tr{display:inline-block;margin-right:8px}
+.u-legend th,.u-legend td{padding:0 2px} .u-title{font-size:13px}
+"""
+
+
+def _e(value) -> str:
+    """``value`` as HTML text (quotes escaped too: safe in an attribute)."""
+    return html.escape(str(value), quote=True)
 
 
 def _columns(plan_dir: Path, report: dict) -> dict[str, np.ndarray]:
@@ -236,9 +259,9 @@ def _table(header: list[str], rows: list[list]) -> str:
 
 
 def render_job_report_html(plan_dir: Path, *, folder_name: str | None = None) -> str:
-    """The report page of a job's plan folder, as one HTML string; ``folder_name`` as
-    for ``report_html.render_report_html`` (the name the user sees, not the staged
-    folder's)."""
+    """The report page of a job's plan folder, as one HTML string; ``folder_name``: the
+    plan folder's name as the user sees it (the writer renders into a staged temporary
+    folder swapped in under it); default ``plan_dir``'s own name."""
     plan_dir = Path(plan_dir)
     folder_name = folder_name or plan_dir.name
     report = json.loads((plan_dir / "report.json").read_text(encoding="utf-8"))

@@ -1,20 +1,17 @@
-"""The plots of report.html, drawn in the browser: interactive uPlot charts and SVG views.
+"""What report.html draws besides its own charts: the uPlot assets and SVG views.
 
-Visualization only: numerical code never imports this module. Python does no drawing
-here (matplotlib took seconds per report): it gathers the plan folder's columns once
-(trajectory.csv, clearance.csv; SI converted to mm and degrees at this edge) and
-describes each chart as a list of panels and series by column name; the page's script
-draws them with uPlot (vendored in ``viz/assets``, MIT licence), which zooms on a
-drag (double-click resets) and shows every value under the cursor, synchronised across
-panels. The 3D views are two static SVG projections (top and side) of the part's path
-with its process frames F in P, and of the flange path with the base B and tool T in I.
+Visualization only: numerical code never imports this module. The page's charts are
+drawn in the browser by uPlot (vendored in ``viz/assets``, MIT licence; the page's
+chart script ``assets/plots.js``), which zooms on a drag (double-click resets) and shows
+every value under the cursor; the job page (``viz.job_report_html``) describes them.
+The 3D views are two static SVG projections (top and side) of the part's paths with
+their process frames F in P, and of the flange path with the base B and tool T in I.
 Frames: I inertial, B robot base, E flange, P part, F process frame, T fixed tool.
 """
 
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 
 import numpy as np
@@ -25,182 +22,11 @@ from offline_prog.viz.outline import outline_in
 
 XYZ_COLORS = ("#0072bd", "#d95318", "#edb120")  # x|α, y|β, z|γ, as in the paper's fig. 5
 TRIAD_COLORS = ("#d62728", "#2ca02c", "#1f77b4")  # a frame's x, y, z axes
-LIMIT_COLOR = "#c62828"
 GRIPPER_COLOR = "#3b5b8c"
 GROUP_COLORS = [*XYZ_COLORS, "#7e2f8e", "#77ac30", "#4dbeee"]  # distance per pair group
 N_TRIADS = 24  # process frames drawn along the path
 MAX_SVG_POINTS = 800  # per polyline of a view (a drawing, not data)
-SIGNIFICANT_DIGITS = 6  # of each plotted value (the CSV keeps 10)
 ASSETS = Path(__file__).resolve().parent / "assets"
-
-
-def _series(label: str, column: str, color: str, *, dash: bool = False) -> dict:
-    return {"label": label, "col": column, "color": color, "dash": dash}
-
-
-def _limit(label: str, value: float) -> dict:
-    return {"label": label, "const": float(value), "color": LIMIT_COLOR, "dash": True}
-
-
-def _xyz(ylabel: str, columns: tuple[str, str, str], labels: str) -> dict:
-    series = [_series(lab, c, col) for lab, c, col in zip(labels, columns, XYZ_COLORS, strict=True)]
-    return {"ylabel": ylabel, "series": series}
-
-
-def commanded_speed(report: dict, s: np.ndarray) -> np.ndarray:
-    """(N,) speed cap of the time law at its parameter s [m]: top speed, lowered on
-    report.json's speed-reduction stretches [m/s]."""
-    cap = np.full(len(s), report["motion"]["top_speed_m_s"])
-    for r in report["robot_motion"]["speed_reductions"]:
-        inside = (s >= r["sigma_start_m"]) & (s <= r["sigma_end_m"])
-        cap[inside] = np.minimum(cap[inside], r["speed_m_s"])
-    return cap
-
-
-def plot_columns(report: dict, col: dict, data: ProgramData, clearance: dict | None) -> dict:
-    """Every plotted column once, at the page's units (mm, mm/s, °, °/s), by name."""
-    out = {"t": col["t"]}
-    for name in ("x", "y", "z"):
-        out[f"{name}_mm"] = col[name] * 1e3
-    for name in ("alpha", "beta", "gamma"):
-        out[f"{name}_deg"] = np.rad2deg(col[name])
-    for name in ("vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az", "dwx", "dwy", "dwz"):
-        out[name] = col[name]
-    flange = np.linalg.norm(np.column_stack([col["vx"], col["vy"], col["vz"]]), axis=1)
-    if report["motion"]["speed_reference"] == "tcp":
-        s, measured, other = col["sigma"], col["tcp_speed"], flange
-    else:  # the law runs on the flange path's arc length
-        p = np.column_stack([col["x"], col["y"], col["z"]])
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-        measured, other = flange, col["tcp_speed"]
-    out["speed_mm_s"], out["other_speed_mm_s"] = measured * 1e3, other * 1e3
-    out["command_mm_s"] = commanded_speed(report, s) * 1e3
-    for j in range(len(data.joint_names)):
-        out[f"q{j + 1}_deg"] = np.rad2deg(data.controller_column(col, "q", j))
-        out[f"qd{j + 1}_deg_s"] = np.rad2deg(data.controller_column(col, "qd", j))
-    if clearance:
-        out["clearance_t"] = clearance["t_s"]
-        for name, values in clearance.items():
-            if name != "t_s":
-                out[f"distance:{name.removesuffix('_m')}"] = values * 1e3
-    return out
-
-
-def _joint_panels(data: ProgramData, rates: bool) -> list[dict]:
-    panels = []
-    for j, name in enumerate(data.joint_names):
-        formula = "q2 + q3" if data.j23_factor > 0 else "q3 − q2"
-        coupled = f" (controller: {formula})" if data.j23_coupled and j == 2 else ""
-        low, high = (
-            (-data.qd_max[j], data.qd_max[j]) if rates else (data.q_lower[j], data.q_upper[j])
-        )
-        column = f"qd{j + 1}_deg_s" if rates else f"q{j + 1}_deg"
-        panels.append(
-            {
-                "title": f"J{j + 1} {name}{coupled}",
-                "ylabel": "q̇ [°/s]" if rates else "q [°]",
-                "series": [
-                    _series(f"J{j + 1}", column, XYZ_COLORS[0]),
-                    _limit("lower limit", np.rad2deg(low)),
-                    _limit("upper limit", np.rad2deg(high)),
-                ],
-            }
-        )
-    return panels
-
-
-def plot_specs(report: dict, data: ProgramData, columns: dict) -> list[dict]:
-    """The charts in page order: caption, panel grid width and panels (series by column)."""
-    ref = report["motion"]["speed_reference"].replace("tcp", "TCP")
-    measured, other = ("TCP speed", "flange") if ref == "TCP" else ("flange speed", "TCP")
-    pose = [
-        _xyz("flange position p_IE [mm]", ("x_mm", "y_mm", "z_mm"), "xyz"),
-        _xyz("angles [°]", ("alpha_deg", "beta_deg", "gamma_deg"), "αβγ"),
-        _xyz("velocity v_IE [m/s]", ("vx", "vy", "vz"), "xyz"),
-        _xyz("angular velocity w_IE [rad/s]", ("wx", "wy", "wz"), "xyz"),
-        _xyz("acceleration a_IE [m/s²]", ("ax", "ay", "az"), "xyz"),
-        _xyz("angular acc. [rad/s²]", ("dwx", "dwy", "dwz"), "xyz"),
-    ]
-    speed = {
-        "ylabel": "speed [mm/s]",
-        "series": [
-            _series(f"{other} speed (not commanded)", "other_speed_mm_s", "#bbbbbb"),
-            _series("commanded (limit, reductions)", "command_mm_s", "#000000", dash=True),
-            _series(measured, "speed_mm_s", XYZ_COLORS[0]),
-        ],
-        "bands": slowdown_bands(report),
-    }
-    specs = [
-        (
-            "pose",
-            "Flange trajectory in I (as the paper's fig. 5): position, Tait-Bryan angles "
-            "R = Rx(α)Ry(β)Rz(γ), linear and angular velocity and acceleration.",
-            2,
-            pose,
-        ),
-        (
-            "speed",
-            f"Speed at the {ref} against the command: the speed limit, lowered where "
-            "the joint limits forced a speed reduction; time-optimal slowdowns are shaded, "
-            "each named by its limiting joint and constraint.",
-            1,
-            [speed],
-        ),
-        ("joints", "Joint positions with their limits (dashed).", 3, _joint_panels(data, False)),
-        ("rates", "Joint velocities with their limits (dashed).", 3, _joint_panels(data, True)),
-    ]
-    groups = [name for name in columns if name.startswith("distance:")]
-    if groups:
-        series = [
-            _series(name.removeprefix("distance:"), name, color)
-            for name, color in zip(groups, GROUP_COLORS * len(groups), strict=False)
-        ]
-        series.append(_limit("contact", 0.0))
-        if report.get("clearance_m") is not None:
-            series.append({**_limit("clearance", report["clearance_m"] * 1e3), "color": "#ef6c00"})
-        panel = {"x": "clearance_t", "ylabel": "minimum distance [mm]", "series": series}
-        specs.append(
-            (
-                "distance",
-                "Minimum distance over time per pair group (robot, part, tool, "
-                "obstacles), against the required clearance.",
-                1,
-                [panel],
-            )
-        )
-    return [{"id": i, "caption": c, "columns": n, "panels": p} for i, c, n, p in specs]
-
-
-def slowdown_bands(report: dict) -> list[dict]:
-    """The time law's slowdowns (time_optimal) as shaded bands of the speed plot:
-    {t0, t1 [s], label: the limiting joint and constraint, e.g. "J3 acceleration"}."""
-    bands = []
-    for slow in report["robot_motion"].get("slowdowns", []):
-        joint = f"J{slow['joint']} " if slow["joint"] is not None else ""
-        bands.append(
-            {"t0": slow["t_start_s"], "t1": slow["t_end_s"], "label": joint + slow["constraint"]}
-        )
-    return bands
-
-
-def _rounded(values: np.ndarray) -> list[float]:
-    """Values rounded to SIGNIFICANT_DIGITS of the column's largest magnitude."""
-    values = np.asarray(values, dtype=float)
-    top = float(np.abs(values).max()) if values.size else 0.0
-    decimals = SIGNIFICANT_DIGITS - 1 - (int(np.floor(np.log10(top))) if top > 0 else 0)
-    return np.round(values, max(decimals, 0)).tolist()
-
-
-def plot_data_json(report: dict, col: dict, data: ProgramData, clearance: dict | None) -> str:
-    """The page's plot data: {"columns": {name: values}, "plots": plot_specs}, as JSON
-    that is safe inside a ``<script type="application/json">`` element."""
-    columns = plot_columns(report, col, data, clearance)
-    payload = {
-        "columns": {name: _rounded(values) for name, values in columns.items()},
-        "plots": plot_specs(report, data, columns),
-    }
-    text = json.dumps(payload, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
-    return text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
 
 
 def _svg_view(lines: list[tuple[np.ndarray, str, float]], labels, axes: tuple[int, int], title):
@@ -302,16 +128,6 @@ def views_svg(
             _svg_view(cell, cell_labels, (0, 2), "Cell I: side"),
         ]
     )
-
-
-def read_clearance(plan_dir: Path) -> dict | None:
-    """clearance.csv by column ({"t_s": ..., "<group>_m": ...}), or None if absent."""
-    file = Path(plan_dir) / "clearance.csv"
-    if not file.is_file():
-        return None
-    names = file.read_text(encoding="utf-8").splitlines()[0].split(",")
-    table = np.loadtxt(file, delimiter=",", skiprows=1, ndmin=2)
-    return {name: table[:, i] for i, name in enumerate(names)}
 
 
 # Draws every chart of the JSON in #plot-data into its <div id=...> (uPlot, one per panel).

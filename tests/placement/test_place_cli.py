@@ -5,9 +5,11 @@ scheduler and Ctrl-C end with one line."""
 
 import json
 import os
+import queue
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -152,22 +154,29 @@ def test_ctrl_c_stops_the_workers_exit_130_one_line_no_folder(tmp_path):
         text=True,
         start_new_session=True,
     )
-    # Wait until the LocalCluster's worker processes run (they share the command's
-    # process group), then interrupt it while it screens: no fixed 12 s sleep.
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and process.poll() is None:
-        group = subprocess.run(["pgrep", "-g", str(process.pid)], capture_output=True, text=True)
-        if len(group.stdout.split()) >= 3:  # the command and its 2 worker processes
+    # Interrupt it once its workers take candidates: its first screening line (piped,
+    # the command prints its progress as lines on stdout) comes after the LocalCluster's
+    # workers started and loaded the cell and a candidate was screened on one; a signal
+    # while a worker still starts (dask's Status.init) is not what this test is about.
+    lines = queue.Queue()
+    reader = threading.Thread(target=lambda: [lines.put(line) for line in process.stdout])
+    reader.start()
+    deadline, line = time.monotonic() + 180, ""
+    while not line.startswith("place: screening") and process.poll() is None:
+        try:
+            line = lines.get(timeout=max(0.0, deadline - time.monotonic()))
+        except queue.Empty:
             break
-        time.sleep(0.2)
-    assert process.poll() is None, process.communicate()[1]
-    assert len(group.stdout.split()) >= 3, "the cluster's workers never started"
-    time.sleep(3.0)  # the workers have imported the planner and take candidates
+    assert line.startswith("place: screening"), (line, process.poll())
+    group = subprocess.run(["pgrep", "-g", str(process.pid)], capture_output=True, text=True)
+    assert len(group.stdout.split()) >= 3, "the command and its 2 worker processes"
     os.killpg(process.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
     try:
-        _, err = process.communicate(timeout=30)
+        process.wait(timeout=30)
+        err = process.stderr.read()  # one line (stdout: the reader's)
     finally:
         process.kill()
+        reader.join(timeout=30)
     assert process.returncode == 130, err
     assert err.strip().splitlines()[-1] == "interrupted", err
     assert not out.exists() and not list(tmp_path.glob(".offline_prog*"))
