@@ -286,12 +286,19 @@ class LeadPath:
         return self.end - self.start
 
     def __call__(self, s: np.ndarray) -> FlangeSamples:
-        """The flange path at the seam's σ (N,) [m] (within [start, end])."""
+        """The flange path at the seam's σ (N,) [m] (within [start, end]); its arrays are
+        read-only (an evaluation at the same σ, bit for bit, returns the same
+        FlangeSamples, as the seam's own path does: a joint plan evaluates its samples
+        several times in a row)."""
         s = np.asarray(s, dtype=float)
         L = self.inner.length
         before, after = s < 0.0, s > L
         if not (before.any() or after.any()):
             return self.inner(s)
+        key = s.tobytes()
+        last_key, last = self.__dict__.get("_last", (None, None))  # one tuple, replaced whole
+        if key == last_key:
+            return last
         inside = ~(before | after)
         parts = [(self.inner(s[inside]) if inside.any() else None, inside)]
         for end, mask in ((self._ends[0], before), (self._ends[1], after)):
@@ -304,8 +311,15 @@ class LeadPath:
             for samples, mask in parts:
                 if samples is not None:
                     out[mask] = getattr(samples, field.name)
+            out.setflags(write=False)
             fields[field.name] = out
-        return FlangeSamples(**fields)
+        samples = FlangeSamples(**fields)
+        self._last = (key, samples)
+        return samples
+
+    def __getstate__(self) -> dict:
+        """Pickled without the last evaluation (a cache)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_last"}
 
     def poses(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(p_IE (N, 3) [m], R_IE (N, 3, 3)) at σ (N,)."""

@@ -3,6 +3,10 @@ smooth there as the seam (position, velocity, acceleration; angular velocity and
 rate), starts on the seam's tangent and lifts off the part, and changes nothing on the
 seam itself."""
 
+import dataclasses
+import pickle
+
+import cloudpickle
 import numpy as np
 import pytest
 from pydrake.math import RigidTransform, RotationMatrix
@@ -207,6 +211,28 @@ def test_joined_leads_are_the_ones_asked_for(rng):
     other = FlangePath(flange.path, flange.normal, X_IT=flange.X_IT, X_PE=_turned(flange.X_PE))
     with pytest.raises(ValueError, match="two flange paths"):
         LeadPath.joined(plain, LeadPath(other, lead_in_m=LEAD_M, lead_out_m=LEAD_M))
+
+
+def test_an_evaluation_at_the_same_sigma_is_kept_read_only(rng):
+    """Asked again at the same σ (bit for bit), a path with leads returns the samples it
+    returned (read-only), equal to a fresh path's; at other σ it evaluates them; pickled,
+    it leaves the kept samples out and evaluates the same."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M, lifts_m=(0.05, 0.0))
+    s = np.linspace(lead.start, lead.end, 301)
+    first = lead(s)
+    assert lead(s.copy()) is first
+    fresh = LeadPath(flange, **lead.asked)(s)
+    for field in dataclasses.fields(first):
+        value = getattr(first, field.name)
+        assert not value.flags.writeable, field.name
+        np.testing.assert_array_equal(value, getattr(fresh, field.name))
+    other = lead(s[::2])
+    assert other is not first and len(other.s) == len(s[::2])
+    np.testing.assert_array_equal(lead(s).p_IE, first.p_IE)
+    copied = pickle.loads(cloudpickle.dumps(lead))  # as a forked child sends it back
+    assert "_last" not in copied.__dict__
+    np.testing.assert_array_equal(copied(s).R_IE, first.R_IE)
 
 
 def _turned(X_PE: RigidTransform) -> RigidTransform:

@@ -7,12 +7,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from offline_prog.job.seams import seam_inputs
 from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO, LeadPath
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.stages import load_inputs
-from offline_prog.job.seams import seam_inputs
-from offline_prog.stages import fit_path, flange_paths, motion_setup
+from offline_prog.stages import fit_path, flange_paths, load_inputs, motion_setup
 from offline_prog.timing.lead_length import (
     AT_HEIGHT_TOL_M,
     _bend,
