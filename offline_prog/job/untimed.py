@@ -104,8 +104,10 @@ def untimed_options(
     if not branches:
         return options
     others = other_branches(results, first.branch, MAX_OTHER_BRANCHES)
-    # As the timed plan of another branch gets it: the first option's path as run.
-    again, known = (motion_setup(inputs, run.flange) if others else None), None
+    # As the timed plan of another branch gets it: the first option's path as run (the
+    # first's verdicts where that is the path they were found on: no cusp smoothing).
+    again = motion_setup(inputs, run.flange) if others else None
+    known = results if again is not None and again.flange is run.flange else None
     for other in others:  # one path IK on the path as run serves each
         variant, known = _untimed(
             inputs, scene, fit, frames, rotation, run.flange, again, other.branch, known

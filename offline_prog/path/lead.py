@@ -77,33 +77,29 @@ def unit_length(ratio: float) -> float:
 
 def _skew(a: np.ndarray) -> np.ndarray:
     """(N, 3, 3) skew matrices of (N, 3) vectors."""
-    z = np.zeros(len(a))
-    return np.stack(
-        [
-            np.stack([z, -a[:, 2], a[:, 1]], axis=1),
-            np.stack([a[:, 2], z, -a[:, 0]], axis=1),
-            np.stack([-a[:, 1], a[:, 0], z], axis=1),
-        ],
-        axis=1,
-    )
+    K = np.zeros((len(a), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = a[:, 2], -a[:, 1], a[:, 0]
+    return K
 
 
-def _exp_and_left_jacobian(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(Exp(a), J_l(a)) (N, 3, 3) of rotation vectors a (N, 3) [rad]: Rodrigues' formula
-    and SO(3)'s left Jacobian (d Exp(a) = [J_l(a)·da]× Exp(a)), by series near 0."""
+def _exp_and_left_jacobian(a: np.ndarray, *, exp: int) -> tuple[np.ndarray, np.ndarray]:
+    """(Exp(a) (exp, 3, 3) of the first ``exp`` rows, J_l(a) (N, 3, 3)) of rotation
+    vectors a (N, 3) [rad]: Rodrigues' formula and SO(3)'s left Jacobian
+    (d Exp(a) = [J_l(a)·da]× Exp(a)), by series near 0."""
     theta = np.linalg.norm(a, axis=1)
     small = theta < 1e-6
     t = np.where(small, 1.0, theta)
     t2 = t * t
-    s1 = np.where(small, 1.0 - theta**2 / 6.0, np.sin(t) / t)  # sin θ / θ
     c1 = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(t)) / t2)  # (1 − cos θ)/θ²
     d1 = np.where(small, 1.0 / 6.0 - theta**2 / 120.0, (t - np.sin(t)) / (t2 * t))
     K = _skew(a)
     K2 = K @ K
     eye = np.eye(3)
-    R = eye + s1[:, None, None] * K + c1[:, None, None] * K2
     J = eye + c1[:, None, None] * K + d1[:, None, None] * K2
-    return R, J
+    small, theta, t = small[:exp], theta[:exp], t[:exp]
+    s1 = np.where(small, 1.0 - theta**2 / 6.0, np.sin(t) / t)  # sin θ / θ
+    return eye + s1[:, None, None] * K[:exp] + c1[:exp, None, None] * K2[:exp], J
 
 
 def lead_shape(length_m: float, lift_m: float = 0.0) -> tuple[float, float, float]:
@@ -172,6 +168,24 @@ class LeadPath:
         ]
         self.lead_in_m, self.lead_out_m = (end.length for end in self._ends)
 
+    @classmethod
+    def joined(cls, lead_in: LeadPath, lead_out: LeadPath) -> LeadPath:
+        """The lead-in of ``lead_in`` and the lead-out of ``lead_out`` (leads around the
+        same flange path, flying): the path ``LeadPath`` builds when asked for these two
+        leads, with their tables as built (not built again)."""
+        if lead_in.inner is not lead_out.inner:
+            raise ValueError("leads around two flange paths cannot be joined")
+        joined = cls.__new__(cls)
+        joined.inner, joined.reason = lead_in.inner, ""
+        joined.asked = {
+            "lead_in_m": lead_in.asked["lead_in_m"],
+            "lead_out_m": lead_out.asked["lead_out_m"],
+            "lifts_m": (lead_in.asked["lifts_m"][0], lead_out.asked["lifts_m"][1]),
+        }
+        joined._ends = [lead_in._ends[0], lead_out._ends[1]]
+        joined.lead_in_m, joined.lead_out_m = lead_in.lead_in_m, lead_out.lead_out_m
+        return joined
+
     def around(self, inner) -> LeadPath:
         """These leads, as asked, around another flange path of the same seam (around
         their own: these, whose tables are built already)."""
@@ -203,7 +217,7 @@ class LeadPath:
         the trapezoid rule with its end correction (d/dx = g, d²/dx² = ±δ·g′), inverted
         by cubic Hermite interpolation with the exact slopes 1/g."""
         x = np.linspace(0.0, 1.0, ARC_SAMPLES)
-        g, dg = self._speed(end, *self._along(end, end.side * x * end.extent)[:5])
+        g, dg = self._speed(end, *self._along(end, end.side * x * end.extent, pose=False)[:5])
         slope, curvature = g, end.side * end.extent * dg
         step = np.diff(x)
         pieces = 0.5 * step * (slope[1:] + slope[:-1])
@@ -211,9 +225,9 @@ class LeadPath:
         arc = np.concatenate([[0.0], np.cumsum(pieces)])
         return float(arc[-1] * end.extent), CubicHermiteSpline(arc, x, 1.0 / g)
 
-    def _along(self, end: _End, u: np.ndarray):
+    def _along(self, end: _End, u: np.ndarray, *, pose: bool = True):
         """The lead at u (N,) [m] from its end, per metre of u: (p_IE, p′_IE, p″_IE
-        (N, 3), w_u, w′_u (N, 3), R_IE (N, 3, 3))."""
+        (N, 3), w_u, w′_u (N, 3), R_IE (N, 3, 3); None unless ``pose``)."""
         f = end.samples
         x, n = u / end.extent, LIFT_POWER
         h = end.lift * np.abs(x) ** n
@@ -223,9 +237,7 @@ class LeadPath:
         p_IE = p0 + u[:, None] * dp0 + 0.5 * (u**2)[:, None] * ddp0 + h[:, None] * end.e_I
         dp_u = dp0 + u[:, None] * ddp0 + dh[:, None] * end.e_I
         ddp_u = ddp0 + ddh[:, None] * end.e_I
-        R_IE, w_u = self._rotation(end, u)
-        step = ROTATION_RATE_STEP_M
-        dw_u = (self._rotation(end, u + step)[1] - self._rotation(end, u - step)[1]) / (2 * step)
+        R_IE, w_u, dw_u = self._rotation(end, u, pose=pose)
         return p_IE, dp_u, ddp_u, w_u, dw_u, R_IE
 
     def _speed(self, end, p_IE, dp_u, ddp_u, w_u, dw_u) -> tuple[np.ndarray, np.ndarray]:
@@ -274,12 +286,19 @@ class LeadPath:
         return self.end - self.start
 
     def __call__(self, s: np.ndarray) -> FlangeSamples:
-        """The flange path at the seam's σ (N,) [m] (within [start, end])."""
+        """The flange path at the seam's σ (N,) [m] (within [start, end]); its arrays are
+        read-only (an evaluation at the same σ, bit for bit, returns the same
+        FlangeSamples, as the seam's own path does: a joint plan evaluates its samples
+        several times in a row)."""
         s = np.asarray(s, dtype=float)
         L = self.inner.length
         before, after = s < 0.0, s > L
         if not (before.any() or after.any()):
             return self.inner(s)
+        key = s.tobytes()
+        last_key, last = self.__dict__.get("_last", (None, None))  # one tuple, replaced whole
+        if key == last_key:
+            return last
         inside = ~(before | after)
         parts = [(self.inner(s[inside]) if inside.any() else None, inside)]
         for end, mask in ((self._ends[0], before), (self._ends[1], after)):
@@ -292,22 +311,36 @@ class LeadPath:
             for samples, mask in parts:
                 if samples is not None:
                     out[mask] = getattr(samples, field.name)
+            out.setflags(write=False)
             fields[field.name] = out
-        return FlangeSamples(**fields)
+        samples = FlangeSamples(**fields)
+        self._last = (key, samples)
+        return samples
+
+    def __getstate__(self) -> dict:
+        """Pickled without the last evaluation (a cache)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_last"}
 
     def poses(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(p_IE (N, 3) [m], R_IE (N, 3, 3)) at σ (N,)."""
         f = self(s)
         return f.p_IE, f.R_IE
 
-    def _rotation(self, end: _End, u: np.ndarray):
-        """(R_IE (N, 3, 3), w_s (N, 3) [rad/m]) on a lead at u (N,) from the end."""
+    def _rotation(self, end: _End, u: np.ndarray, *, pose: bool = True):
+        """(R_IE (N, 3, 3), None unless ``pose``; w_s (N, 3) [rad/m]; its rate per metre
+        of u (N, 3), the central difference over ±ROTATION_RATE_STEP_M) on a lead at u
+        (N,) from the end: the rotation vector's Exp and left Jacobian at u and u ± the
+        step in one evaluation."""
         f = end.samples
         w, dw = f.w_s[0], f.dw_s[0]
-        a = u[:, None] * w + 0.5 * (u**2)[:, None] * dw
-        da = w + u[:, None] * dw
-        Exp, J = _exp_and_left_jacobian(a)
-        return Exp @ f.R_IE[0], np.einsum("nij,nj->ni", J, da)
+        n, step = len(u), ROTATION_RATE_STEP_M
+        at = np.concatenate([u, u + step, u - step])
+        a = at[:, None] * w + 0.5 * (at**2)[:, None] * dw
+        da = w + at[:, None] * dw
+        Exp, J = _exp_and_left_jacobian(a, exp=n if pose else 0)
+        w_at = np.einsum("nij,nj->ni", J, da)
+        rate = (w_at[n : 2 * n] - w_at[2 * n :]) / (2 * step)
+        return (Exp @ f.R_IE[0] if pose else None), w_at[:n], rate
 
     def _lead(self, end: _End, s: np.ndarray) -> FlangeSamples:
         """The lead's samples at σ (N,) beyond its end (module docstring)."""

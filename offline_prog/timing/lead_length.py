@@ -87,15 +87,15 @@ def with_leads(inputs, flange, caps: ProcessCaps, decided: LeadPath | None) -> L
     # The turn onto the seam changes the tool's heading, not its speed (nor the flow):
     # it keeps to the robot's path limits, not the process model's caps.
     turn = {"a_max": motion.max_acceleration, "j_max": motion.max_jerk}
-    (lead_in, lead_out), lifts = _taken_over(inputs, flange, length, ramp, **turn)
-    return LeadPath(flange, lead_in_m=lead_in, lead_out_m=lead_out, lifts_m=lifts)
+    return _taken_over(inputs, flange, length, ramp, **turn)
 
 
 def _taken_over(
     inputs, flange, length: float, ramp: float, *, a_max: float, j_max: float
-) -> tuple[tuple[float, float], tuple[float, float]]:
-    """((lead-in, lead-out) asked lengths [m], their least lifts [m]) of the default
-    leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own lift). A lead
+) -> LeadPath:
+    """The default leads of ``flange`` (a ``motion.lead_mm`` keeps its length and own
+    lift), each ``length`` long or taking its move over; the leads compared are the
+    ones run (``LeadPath.joined``: their tables built once). A lead
     takes the approach (retract) over where the move runs at the process speed (the
     default ``motion.approach_speed``) and that is the shorter run: the tool then comes
     onto the seam along one curve instead of stopping at the move's foot. A normal move
@@ -111,11 +111,10 @@ def _taken_over(
     lead, the move's rest and its stop and start (two more ramps)."""
     v = inputs.speed.v_m_s
     normal, tangent = inputs.normal_moves_m, inputs.tangent_moves_m
-    plain = ((length, length), (0.0, 0.0))
     if not any(normal + tangent) or not np.isclose(
         approach_speed(inputs.cell, inputs.speed).v_m_s, v, rtol=1e-12
     ):
-        return plain
+        return LeadPath(flange, lead_in_m=length, lead_out_m=length)
     at_height = _at_height_m(inputs.cell)
     extents = [
         takeover_extent_m(d, v=v, a_max=a_max, j_max=j_max, at_height_m=at_height) if d > 0.0 else t
@@ -131,10 +130,10 @@ def _taken_over(
     ):
         rest = normal[i] - kept.lifts_m[i] if normal[i] > 0.0 else tangent[i] - kept_extent
         take.append(rest > 0.0 and taken_m + ramp < kept_m + rest + 3.0 * ramp)
-    lengths = tuple(asked[i] if take[i] else length for i in (0, 1))
-    return lengths, tuple(normal[i] if take[i] else 0.0 for i in (0, 1))
+    return LeadPath.joined(*(taken if take[i] else kept for i in (0, 1)))
 
 
+@functools.lru_cache(maxsize=256)
 def takeover_extent_m(
     lift: float, *, v: float, a_max: float, j_max: float, at_height_m: float
 ) -> float:
@@ -144,7 +143,8 @@ def takeover_extent_m(
     j_max [m/s³] (the lift h = H·|u/δ|⁴ on a straight seam bends at most c₁(H/δ)/δ, its
     bend changing by at most c₂(H/δ)/δ² per metre: :func:`_bend`), and at least as long
     as the nozzle needs to be within AT_HEIGHT_TOL_M of its working height over the
-    last ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at x)."""
+    last ``at_height_m`` before the seam (where the valve is open: H·(x/δ)⁴ at x)
+    (kept per arguments: a job's seams ask with the same few)."""
     if lift <= 0.0:
         return 0.0
 
@@ -163,9 +163,11 @@ def takeover_extent_m(
     return max(lift / ratio, height)
 
 
+@functools.lru_cache(maxsize=1024)
 def _bend(ratio: float) -> tuple[float, float]:
     """(c₁, c₂) of the lift h = r·δ·x⁴, x ∈ [0, 1], over a straight seam: the largest
-    curvature times δ and the largest rate of curvature per arc length times δ²."""
+    curvature times δ and the largest rate of curvature per arc length times δ² (kept
+    per ratio)."""
     x = np.linspace(0.0, 1.0, BEND_SAMPLES)
     n = LIFT_POWER
     slope = n * ratio * x ** (n - 1)
@@ -174,12 +176,16 @@ def _bend(ratio: float) -> tuple[float, float]:
     return float(bend.max()), float(np.abs(np.gradient(bend, x) / arc).max())
 
 
+def _switches(cell: Cell) -> list:
+    """The process switches of ``tool.process_io`` (on, off) the cell sets."""
+    io = cell.tool.process_io
+    return [s for s in (io.on, io.off) if s is not None] if io else []
+
+
 def _at_height_m(cell: Cell) -> float:
     """How far from a seam end its valve is open off the seam [m]: the switches'
     ``lead_mm`` (their ``delay_s`` moves the command, not the valve)."""
-    io = cell.tool.process_io
-    switches = [s for s in (io.on, io.off) if s is not None] if io else []
-    return max([abs(s.lead_mm) * 1e-3 for s in switches] + [0.0])
+    return max([abs(s.lead_mm) * 1e-3 for s in _switches(cell)] + [0.0])
 
 
 def _switch_m(cell: Cell, v: float) -> float:
@@ -188,8 +194,7 @@ def _switch_m(cell: Cell, v: float) -> float:
     command leads the speed by it; it goes live earlier still, ``job.process_io``, while
     the tool may still ramp: the command follows the speed)."""
     io = cell.tool.process_io
-    switches = [s for s in (io.on, io.off) if s is not None] if io else []
-    ahead = max([s.lead_mm * 1e-3 + s.delay_s * v for s in switches] + [0.0])
+    ahead = max([s.lead_mm * 1e-3 + s.delay_s * v for s in _switches(cell)] + [0.0])
     model = process_model(cell.process)
     lag = max(io.flow.lag_s if io and io.flow else 0.0, model.output_lag_s if model else 0.0)
     return ahead + lag * v

@@ -3,12 +3,21 @@ smooth there as the seam (position, velocity, acceleration; angular velocity and
 rate), starts on the seam's tangent and lifts off the part, and changes nothing on the
 seam itself."""
 
+import dataclasses
+import pickle
+
+import cloudpickle
 import numpy as np
 import pytest
 from pydrake.math import RigidTransform, RotationMatrix
 
 from offline_prog.path.fixed_tcp import FlangePath
-from offline_prog.path.lead import MAX_LIFT_RATIO, LeadPath, path_ends
+from offline_prog.path.lead import (
+    MAX_LIFT_RATIO,
+    ROTATION_RATE_STEP_M,
+    LeadPath,
+    path_ends,
+)
 
 from conftest import random_flange_path, rotation_log
 
@@ -146,6 +155,84 @@ def test_leads_around_their_own_path_are_the_fresh_ones(rng):
     assert moved is not lead and moved.inner is other
     np.testing.assert_array_equal(moved(s).p_IE, LeadPath(other, **lead.asked)(s).p_IE)
     assert np.abs(moved(s).p_IE - lead(s).p_IE).max() > 1e-3
+
+
+def test_the_rotation_rate_is_the_central_difference_of_the_rotations_rate(rng):
+    """On a real lead, the rotation, its rate w_s and the rate's rate evaluated at u and
+    u ± ROTATION_RATE_STEP_M in one go are, bit for bit, those evaluated one point set
+    at a time (the central difference of w_s over the step), and the rate's rate is a
+    five-point difference of w_s over a wider step to 1e-9 of its scale."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M, lifts_m=(0.05, 0.0))
+    step = ROTATION_RATE_STEP_M
+    for end in lead._ends:
+        u = end.side * end.extent * np.linspace(0.0, 1.0, 257)
+        R_IE, w_u, dw_u = lead._rotation(end, u)
+        alone = [lead._rotation(end, x[None]) for x in (*u, *(u + step), *(u - step))]
+        rotations, rates = np.array([a[0][0] for a in alone]), np.array([a[1][0] for a in alone])
+        np.testing.assert_array_equal(R_IE, rotations[: len(u)])
+        np.testing.assert_array_equal(w_u, rates[: len(u)])
+        np.testing.assert_array_equal(
+            dw_u, (rates[len(u) : 2 * len(u)] - rates[2 * len(u) :]) / (2 * step)
+        )
+        untimed = lead._rotation(end, u, pose=False)
+        assert untimed[0] is None
+        np.testing.assert_array_equal(untimed[1], w_u)
+        np.testing.assert_array_equal(untimed[2], dw_u)
+        h = 1e-3  # the five-point difference (error ∝ h⁴): the rate's rate is smooth in u
+        w = [lead._rotation(end, u + k * h)[1] for k in (-2, -1, 1, 2)]
+        fd = (w[0] - 8.0 * w[1] + 8.0 * w[2] - w[3]) / (12.0 * h)
+        assert np.abs(fd - dw_u).max() <= 1e-9 * np.abs(dw_u).max()
+
+
+def test_joined_leads_are_the_ones_asked_for(rng):
+    """The lead-in of one LeadPath and the lead-out of another around the same flange
+    path, joined: their tables are kept (not built again) and the path equals the one
+    built afresh for those two leads, sample for sample; around two paths: refused."""
+    flange = random_flange_path(rng, closed=False)
+    plain = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M)
+    lifted = LeadPath(flange, lead_in_m=0.04, lead_out_m=0.05, lifts_m=(0.05, 0.05))
+    s = np.concatenate([np.linspace(-0.04, 0.0, 40), flange.length + np.linspace(0, LEAD_M, 30)])
+    for first, second in ((lifted, plain), (plain, lifted)):
+        joined = LeadPath.joined(first, second)
+        assert joined._ends[0] is first._ends[0] and joined._ends[1] is second._ends[1]
+        asked = {
+            "lead_in_m": first.asked["lead_in_m"],
+            "lead_out_m": second.asked["lead_out_m"],
+            "lifts_m": (first.asked["lifts_m"][0], second.asked["lifts_m"][1]),
+        }
+        fresh = LeadPath(flange, **asked)
+        assert joined.asked == fresh.asked and joined.reason == fresh.reason == ""
+        assert (joined.lead_in_m, joined.lead_out_m) == (fresh.lead_in_m, fresh.lead_out_m)
+        assert joined.lifts_m == fresh.lifts_m
+        at = s[s >= joined.start] if first is plain else s
+        for field in ("p_IE", "dp_IE", "ddp_IE", "R_IE", "w_s", "dw_s", "p_PF", "R_PF"):
+            np.testing.assert_array_equal(getattr(joined(at), field), getattr(fresh(at), field))
+    other = FlangePath(flange.path, flange.normal, X_IT=flange.X_IT, X_PE=_turned(flange.X_PE))
+    with pytest.raises(ValueError, match="two flange paths"):
+        LeadPath.joined(plain, LeadPath(other, lead_in_m=LEAD_M, lead_out_m=LEAD_M))
+
+
+def test_an_evaluation_at_the_same_sigma_is_kept_read_only(rng):
+    """Asked again at the same σ (bit for bit), a path with leads returns the samples it
+    returned (read-only), equal to a fresh path's; at other σ it evaluates them; pickled,
+    it leaves the kept samples out and evaluates the same."""
+    flange = random_flange_path(rng, closed=False)
+    lead = LeadPath(flange, lead_in_m=LEAD_M, lead_out_m=LEAD_M, lifts_m=(0.05, 0.0))
+    s = np.linspace(lead.start, lead.end, 301)
+    first = lead(s)
+    assert lead(s.copy()) is first
+    fresh = LeadPath(flange, **lead.asked)(s)
+    for field in dataclasses.fields(first):
+        value = getattr(first, field.name)
+        assert not value.flags.writeable, field.name
+        np.testing.assert_array_equal(value, getattr(fresh, field.name))
+    other = lead(s[::2])
+    assert other is not first and len(other.s) == len(s[::2])
+    np.testing.assert_array_equal(lead(s).p_IE, first.p_IE)
+    copied = pickle.loads(cloudpickle.dumps(lead))  # as a forked child sends it back
+    assert "_last" not in copied.__dict__
+    np.testing.assert_array_equal(copied(s).R_IE, first.R_IE)
 
 
 def _turned(X_PE: RigidTransform) -> RigidTransform:

@@ -7,12 +7,14 @@ import dataclasses
 import numpy as np
 import pytest
 
+from offline_prog.job.seams import seam_inputs
 from offline_prog.path.lead import LIFT_POWER, MAX_LIFT_RATIO, LeadPath
 from offline_prog.plan import StageTimer, plan_loaded_job
 from offline_prog.robot.model import ROBOTS_DIR
-from offline_prog.stages import load_inputs
+from offline_prog.stages import fit_path, flange_paths, load_inputs, motion_setup
 from offline_prog.timing.lead_length import (
     AT_HEIGHT_TOL_M,
+    _bend,
     ramp_length_m,
     slowed_end,
     takeover_extent_m,
@@ -94,6 +96,39 @@ def test_a_kept_ramp_is_the_fresh_one_for_each_changed_input():
         fresh = ramp_length_m.__wrapped__(args["v"], a_max=args["a_max"], j_max=args["j_max"])
         assert kept == fresh, key
         assert kept != first, key
+
+
+def test_a_kept_takeover_extent_and_bend_are_the_fresh_ones():
+    """The take-over's extent and the lift's bend, kept per arguments: bit for bit the
+    ones computed afresh, for each argument changed in turn."""
+    base = dict(lift=0.05, v=0.1, a_max=1.0, j_max=10.0, at_height_m=0.005)
+    for key, value in (("lift", 0.03), ("v", 0.008), ("a_max", 0.5), ("j_max", 5.0)):
+        for args in (base, base | {key: value}):
+            kept = takeover_extent_m(args["lift"], **{k: args[k] for k in list(args)[1:]})
+            fresh = takeover_extent_m.__wrapped__(
+                args["lift"], **{k: args[k] for k in list(args)[1:]}
+            )
+            assert kept == fresh, key
+    for ratio in (1.0, 7.3, MAX_LIFT_RATIO):
+        assert _bend(ratio) == _bend(ratio) == _bend.__wrapped__(ratio)
+
+
+@pytest.mark.parametrize("k", [0, 3])
+def test_the_leads_as_run_are_the_ones_built_for_what_they_ask(k):
+    """A seam of the sealing job (a stripe, a circle) with its default leads: the path
+    ``with_leads`` gives, joined from the leads it compared, equals a LeadPath built
+    afresh for the leads it asks (lengths and lifts), sample for sample; its leads take
+    the approach and retract over."""
+    job = load_inputs(CELLS / "seal_job_kr16.yaml", ROBOTS_DIR)
+    inputs = seam_inputs(job, k)
+    flange = flange_paths(inputs, fit_path(inputs)).rotations[0][1]
+    run = motion_setup(inputs, flange).flange
+    fresh = LeadPath(flange, **run.asked)
+    assert run.lifts_m == fresh.lifts_m and min(run.lifts_m) >= 0.03  # moves taken over
+    assert (run.lead_in_m, run.lead_out_m) == (fresh.lead_in_m, fresh.lead_out_m)
+    s = np.linspace(run.start, run.end, 501)
+    for field in ("p_IE", "dp_IE", "ddp_IE", "R_IE", "w_s", "dw_s", "p_PF", "R_PF"):
+        np.testing.assert_array_equal(getattr(run(s), field), getattr(fresh(s), field))
 
 
 def test_leads_are_missed_where_the_joint_limits_slow_a_seam_end_they_meet(rng):
