@@ -237,14 +237,16 @@ def test_a_flying_seam_in_urscript_holds_the_plans_bead(flying_urscript, tmp_pat
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="issue 37 open: the tape demo's UR10e cannot fly at 0.15 m/s (its default "
+    reason="the tape demo's UR10e cannot fly at 0.15 m/s (docs/jobs.md: its default "
     "leads collide, link_3 with link_6; 5 mm leads are too short for the ramp, so the "
     "seam starts at 0.03 m/s and 96.9 % of the bead is within ±5 %)",
 )
 def test_a_flying_seam_in_urscript_lays_the_bead_from_its_first_millimetre(flying_urscript):
-    """Issue 37's acceptance of the tape demo's own UR program's bead
-    (``assert_holds_the_bead``); a UR job that flies on its default leads holds it
-    (``test_a_flying_seam_in_urscript_on_its_default_leads_lays_the_bead``)."""
+    """A bead model's acceptance (``assert_holds_the_bead``) on the tape demo's own UR
+    program, whose seam runs at rest: a limit of that cell, not of URScript (its own
+    tape-heating model holds from the first millimetre; a UR job that flies on its
+    default leads holds the bead:
+    ``test_a_flying_seam_in_urscript_on_its_default_leads_lays_the_bead``)."""
     job, folder, _, _, t, value, _ = flying_urscript
     assert_holds_the_bead(job, folder, t, replayed(job, t, value))
 
