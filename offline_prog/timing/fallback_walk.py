@@ -21,7 +21,7 @@ from collections.abc import Callable
 from typing import Any
 
 from offline_prog.errors import PlanFailedError
-from offline_prog.timing.lead_length import fallbacks, lead_failure
+from offline_prog.timing.lead_length import fallbacks, held_ends, lead_failure
 
 
 @dataclasses.dataclass(frozen=True)
@@ -113,13 +113,8 @@ def led_end_speed(flange, reductions, v: float) -> float:
     """The lowest speed [m/s] at which the joints' speed ``reductions`` ((σ_start, σ_end,
     speed) [m, m, m/s] on the law's σ, 0 at the lead-in's start:
     ``PathTiming.reductions``) hold a seam end that a lead of ``flange`` (a LeadPath)
-    meets; the process speed v [m/s] where they hold none (as ``slowed_end`` reads them)."""
-    ends = (
-        (flange.lead_in_m, flange.lead_in_m > 0.0),
-        (flange.lead_in_m + flange.inner.length, flange.lead_out_m > 0.0),
-    )
-    held = [speed for a, b, speed in reductions for at, led in ends if led and a <= at <= b]
-    return min(held + [v])
+    meets (``held_ends``); the process speed v [m/s] where they hold none."""
+    return min([speed for _, speed in held_ends(flange, reductions)] + [v])
 
 
 def slowed_rank(model, v: float) -> Callable[[Any, Any], float] | None:

@@ -214,18 +214,30 @@ def slowed_end(flange: LeadPath, reductions, v: float) -> str:
     too (on a 15 mm circle the wrist's jerk held a whole seam at 1 % of v). Such a seam
     is planned with the leads' fallbacks (:func:`fallbacks`): at rest its ends cost a
     ramp at the speed the joints allow, not a lead at it."""
+    held = held_ends(flange, reductions)
+    if not held:
+        return ""
+    name, speed = held[0]
+    share = 100.0 * speed / v
+    return lead_failure(
+        f"the joint limits hold the seam's {name} at {share:.0f} % of the process speed"
+    )
+
+
+def held_ends(flange: LeadPath, reductions) -> list[tuple[str, float]]:
+    """The led seam ends that the joints' speed ``reductions`` (as for
+    :func:`slowed_end`) hold: ("start" or "end", the reduction's speed [m/s]) in the
+    reductions' order."""
     ends = (
         ("start", flange.lead_in_m, flange.lead_in_m > 0.0),
         ("end", flange.lead_in_m + flange.inner.length, flange.lead_out_m > 0.0),
     )
-    for a, b, speed in reductions:
-        for name, at, led in ends:
-            if led and a <= at <= b:
-                share = 100.0 * speed / v
-                return lead_failure(
-                    f"the joint limits hold the seam's {name} at {share:.0f} % of the process speed"
-                )
-    return ""
+    return [
+        (name, speed)
+        for a, b, speed in reductions
+        for name, at, led in ends
+        if led and a <= at <= b
+    ]
 
 
 def at_rest(flange: LeadPath, reason: str) -> LeadPath:
